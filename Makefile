@@ -1,0 +1,36 @@
+# mbcontrol: every target creates .venv and installs what it needs, from nothing.
+PYTHON ?= python3
+VENV   := .venv
+PY     := $(VENV)/bin/python
+OUT    ?= out
+
+.PHONY: demo test bench clean help
+
+help:
+	@echo "make demo   - hinged barge: scene -> hydro -> linear model -> Bode -> control -> closed loop ($(OUT)/demo)"
+	@echo "make test   - the whole test suite, notebooks included"
+	@echo "make bench  - speed and accuracy benchmarks (ratios against baselines, one run)"
+
+$(VENV)/bin/python:
+	$(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install --quiet --upgrade pip
+
+$(VENV)/.installed: pyproject.toml | $(VENV)/bin/python
+	$(PY) -m pip install --quiet -e .
+	touch $@
+
+$(VENV)/.installed-test: pyproject.toml | $(VENV)/bin/python
+	$(PY) -m pip install --quiet -e ".[test]"
+	touch $@ $(VENV)/.installed
+
+demo: $(VENV)/.installed
+	$(PY) -m mbcontrol.demo --out $(OUT)/demo
+
+test: $(VENV)/.installed-test
+	$(PY) -m pytest -q
+
+bench: $(VENV)/.installed-test
+	$(PY) benchmarks/run.py --out $(OUT)/bench
+
+clean:
+	rm -rf $(OUT) .pytest_cache

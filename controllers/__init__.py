@@ -1,0 +1,20 @@
+"""PTO controllers. Each implements the Controller protocol of `controllers.base`.
+
+`make(name, **settings)` builds one by name (as the CLI's --controller NAME --set k=v does).
+"""
+from __future__ import annotations
+
+from .base import Controller
+from .passive import Passive
+
+REGISTRY = {"passive": Passive}
+
+
+def make(name: str, **settings) -> Controller:
+    """A controller by registry name with keyword settings, e.g. make('passive', damping=2)."""
+    if name not in REGISTRY:
+        raise KeyError(f"unknown controller {name!r}; expected one of {', '.join(REGISTRY)}")
+    try:
+        return REGISTRY[name](**settings)
+    except TypeError as exc:
+        raise KeyError(f"controller {name!r}: {exc}") from None

@@ -1,0 +1,36 @@
+"""The Controller protocol: what `simulate` needs from a PTO controller.
+
+A controller is bound to a plant by `reset(plant)` (it looks up the signals it measures by
+name), then called as `controller(t, y) -> u` every `period` seconds with the plant's output
+vector y; u (one force or torque per PTO, N or N m) is held until the next call (zero-order
+hold). A controller whose law is a static CasADi expression of y may also return it from
+`casadi_law(plant)`; with period equal to the simulation step it then runs inside compiled code.
+"""
+from __future__ import annotations
+
+from typing import Protocol, runtime_checkable
+
+import numpy as np
+
+
+@runtime_checkable
+class Controller(Protocol):
+    name: str
+    period: float | None   # s, zero-order-hold period; None: every simulation step
+
+    def reset(self, plant) -> None: ...
+
+    def __call__(self, t: float, y: np.ndarray) -> np.ndarray: ...
+
+    def casadi_law(self, plant): ...
+
+    def describe(self) -> dict: ...
+
+
+def signal_indices(plant, names: list[str]) -> list[int]:
+    """Indices of named outputs, with an error that lists what the plant offers."""
+    missing = [n for n in names if n not in plant.outputs]
+    if missing:
+        raise KeyError(f"{plant.name}: no output(s) {missing}; outputs are "
+                       f"{', '.join(plant.outputs)}")
+    return [plant.outputs.index(n) for n in names]

@@ -1,0 +1,207 @@
+"""The hydrodynamics a plant needs, restricted to the DOFs its joints can move.
+
+`HydroModel` holds body-frame BEM data (NED, at each CoG, exp(-i omega t); see mbcontrol.hydro)
+for the active DOFs and the radiation state-space model fitted to them. Fits are cached on disk
+(keyed by the data, the DOFs and the tolerance), written to a temporary file and renamed.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+from . import hydro as bem
+from .errors import HydroError
+from .scene import DOF_NAMES, Scene
+from .ssforms import modal_form
+from .waves import Wave, excitation_series, interpolate_complex
+
+
+def cache_dir() -> Path:
+    """Where BEM results, radiation fits and compiled code are cached ($MBCONTROL_CACHE)."""
+    path = Path(os.environ.get("MBCONTROL_CACHE", Path.home() / ".cache" / "mbcontrol"))
+    path.mkdir(parents=True, exist_ok=True)
+    return path
+
+
+@dataclass(frozen=True)
+class HydroModel:
+    dofs: tuple[str, ...]
+    data: xr.Dataset                   # body-frame BEM data on `dofs`
+    radiation: "bem.RadiationModel"
+    source: str
+
+    def _matrix(self, name: str) -> np.ndarray:
+        """(..., influenced, radiating) array: rows are the DOFs the force acts on."""
+        da = self.data[name].sel(influenced_dof=list(self.dofs), radiating_dof=list(self.dofs))
+        dims = [d for d in da.dims if d not in ("influenced_dof", "radiating_dof")]
+        return da.transpose(*dims, "influenced_dof", "radiating_dof").values
+
+    @property
+    def added_mass_inf(self) -> np.ndarray:
+        return self._matrix("added_mass_inf")
+
+    @property
+    def omega(self) -> np.ndarray:
+        return self.data["omega"].values
+
+    def added_mass(self) -> np.ndarray:
+        return self._matrix("added_mass")
+
+    def radiation_damping(self) -> np.ndarray:
+        return self._matrix("radiation_damping")
+
+    def hydrostatic_stiffness(self) -> np.ndarray:
+        return self._matrix("hydrostatic_stiffness")
+
+    def excitation_coefficients(self, direction: float = 0.0) -> np.ndarray:
+        """Complex excitation per unit amplitude (n_omega, n_dof), exp(-i omega t)."""
+        directions = self.data["wave_direction"].values
+        i = int(np.argmin(np.abs(directions - direction)))
+        if abs(directions[i] - direction) > 1e-6:
+            raise HydroError(f"{self.source}: no excitation data for wave direction "
+                             f"{direction:.4g} rad; the data has {np.round(directions, 4)}")
+        da = self.data["excitation_force"].isel(wave_direction=i)
+        return da.sel(influenced_dof=list(self.dofs)).transpose("omega", "influenced_dof").values
+
+    def excitation(self, wave: Wave, t) -> np.ndarray:
+        try:
+            return excitation_series(wave, self.omega, self.excitation_coefficients(
+                wave.direction), t)
+        except ValueError as exc:
+            raise HydroError(f"{self.source}: {exc}") from None
+
+    def stiffness_by_body(self) -> dict[str, np.ndarray]:
+        """6x6 hydrostatic stiffness at each body's CoG (zeros on DOFs not in the data)."""
+        G = self.hydrostatic_stiffness()
+        out: dict[str, np.ndarray] = {}
+        for i, dof_i in enumerate(self.dofs):
+            body, name_i = dof_i.split("__")
+            for j, dof_j in enumerate(self.dofs):
+                body_j, name_j = dof_j.split("__")
+                if body_j == body:
+                    block = out.setdefault(body, np.zeros((6, 6)))
+                    block[DOF_NAMES.index(name_i), DOF_NAMES.index(name_j)] = G[i, j]
+        return out
+
+    def radiation_matrices(self):
+        """(A_r, B_r, C_r, D_r) in real modal form: same input-output map, sparse A_r."""
+        r = self.radiation
+        order = [r.dofs.index(d) for d in self.dofs]
+        B, C, D = r.B[:, order], r.C[order, :], r.D[np.ix_(order, order)]
+        try:
+            A, B, C = modal_form(r.A, B, C)
+        except ValueError:
+            A = r.A
+        return A, B, C, D
+
+    def restricted(self, dofs) -> "HydroModel":
+        dofs = tuple(dofs)
+        if dofs == self.dofs:
+            return self
+        missing = [d for d in dofs if d not in self.dofs]
+        if missing:
+            raise HydroError(f"{self.source}: the plant moves {missing} but the hydro model "
+                             f"only has {list(self.dofs)}")
+        return HydroModel(dofs, self.data, _fit_cached(self.data, dofs, None, self.source),
+                          self.source)
+
+    def frequency_domain_matrices(self, omega):
+        """A(omega), B(omega) interpolated to omega (n, n_dof, n_dof), for FD solutions."""
+        return (interpolate_complex(self.omega, self.added_mass(), np.asarray(omega)).real,
+                interpolate_complex(self.omega, self.radiation_damping(),
+                                    np.asarray(omega)).real)
+
+
+def load_hydro_model(scene: Scene, dofs, tol: float | None = None) -> HydroModel:
+    """Body-frame data for `dofs` (from scene.hydro.file, or a cached BEM run) and its fit."""
+    tol = scene.hydro.radiation_tol if tol is None else tol
+    if scene.hydro.file:
+        source = scene.hydro.file
+        try:
+            data = xr.load_dataset(source)
+        except (OSError, ValueError) as exc:
+            raise HydroError(f"{source}: cannot read hydro data: {exc}") from None
+        data = _decode_complex(data)
+    else:
+        source, data = _run_bem(scene, dofs)
+    _check_dofs(data, dofs, source)
+    return HydroModel(tuple(dofs), data, _fit_cached(data, tuple(dofs), tol, source), source)
+
+
+def _run_bem(scene: Scene, dofs):
+    if not scene.hydro.omega:
+        raise HydroError(f"{scene.path}: hydro.omega: expected BEM frequencies to compute the "
+                         f"hydrodynamics of the scene's geometry (or a hydro.file)")
+    bodies = []
+    for body in scene.bodies:
+        body_dofs = tuple(d.split("__")[1] for d in dofs if d.split("__")[0] == body.name)
+        if body.hydro and body_dofs:
+            bodies.append(bem.BemBody(name=body.name, geometry=_geometry_dict(body.geometry),
+                                      cog=body.cog, mass=body.mass,
+                                      panel_size=scene.hydro.panel_size, dofs=body_dofs))
+    data = bem.compute(bodies, rho=scene.water.rho, g=scene.water.g, depth=scene.water.depth,
+                       omegas=np.array(scene.hydro.omega), headings=scene.hydro.headings,
+                       lid=scene.hydro.lid, cache_dir=cache_dir())
+    return f"BEM of {scene.path}", data
+
+
+def _geometry_dict(geometry) -> dict:
+    g = {"type": geometry.kind, "center": list(geometry.center)}
+    for key in ("size", "radius", "length", "file"):
+        value = getattr(geometry, key)
+        if value is not None:
+            g[key] = list(value) if isinstance(value, tuple) else value
+    if geometry.kind == "cylinder":
+        g["axis"] = geometry.axis
+    return g
+
+
+def _decode_complex(data: xr.Dataset) -> xr.Dataset:
+    """Join real/imag pairs stored for netCDF (`<name>__re`, `<name>__im`) into complex."""
+    for name in [v for v in data.data_vars if str(v).endswith("__re")]:
+        base = name[:-4]
+        data[base] = data[name] + 1j * data[f"{base}__im"]
+        data = data.drop_vars([name, f"{base}__im"])
+    return data
+
+
+def _check_dofs(data: xr.Dataset, dofs, source: str) -> None:
+    for var in ("added_mass", "radiation_damping", "added_mass_inf", "excitation_force",
+                "hydrostatic_stiffness"):
+        if var not in data:
+            raise HydroError(f"{source}: missing variable {var!r}")
+    have = set(data["radiating_dof"].values.tolist())
+    missing = [d for d in dofs if d not in have]
+    if missing:
+        raise HydroError(f"{source}: the scene's joints move {missing}, but the hydro data "
+                         f"has only {sorted(have)}")
+
+
+def _fit_cached(data: xr.Dataset, dofs, tol, source: str):
+    """fit_radiation with an on-disk cache keyed by the data, the DOFs and the tolerance."""
+    tol = 0.01 if tol is None else tol
+    digest = hashlib.sha256()
+    for var in ("added_mass", "radiation_damping", "added_mass_inf"):
+        digest.update(np.ascontiguousarray(data[var].values).tobytes())
+    digest.update(json.dumps([list(dofs), tol, bem.__name__]).encode())
+    path = cache_dir() / f"radiation_{digest.hexdigest()[:20]}.npz"
+    if path.exists():
+        try:
+            with np.load(path, allow_pickle=False) as z:
+                return bem.RadiationModel.from_arrays(dict(z))
+        except (OSError, ValueError, KeyError):
+            path.unlink(missing_ok=True)       # a stale or foreign file: refit
+    model = bem.fit_radiation(data, dofs=list(dofs), tol=tol)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".npz.tmp")
+    os.close(fd)
+    with open(tmp, "wb") as fh:
+        np.savez(fh, **model.to_arrays())
+    os.replace(tmp, path)
+    return model

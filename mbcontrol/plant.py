@@ -1,0 +1,179 @@
+"""ProcessPlant: the scene's nonlinear equations of motion as CasADi Functions.
+
+    q' = K(q) s
+    M^g(q) s' = -C^g(q,s) s - mu^g - restoring + P tau_exc + PTO + friction + mooring + drag
+    chi' = A_r chi + B_r nu_h ,  mu_h = C_r chi + D_r nu_h ,  nu_h = (P^T s)[hydro DOFs]
+
+with M^g = P (M_RB + A_inf) P^T (ERRATA section 4). The state is x = [q, s, chi]; inputs are
+u (one force command per PTO) and w (the excitation wrench on each hydro DOF, body axes at the
+CoG); parameters p (PTO, friction, mooring, drag coefficients) stay symbolic.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import casadi as ca
+import numpy as np
+import xarray as xr
+
+from . import loads
+from .errors import HydroError
+from .hydro_data import HydroModel, load_hydro_model
+from .scene import DOF_NAMES, Scene, load_scene
+from .topology import Topology, build_topology
+
+
+@dataclass(frozen=True, eq=False)      # identity semantics: compiled code is cached per plant
+class ProcessPlant:
+    """x' = f(x, u, w, p), y = h(x, u, w, p) with named signals; built once, immutable."""
+    scene: Scene
+    topology: Topology
+    hydro: HydroModel | None
+    states: tuple[str, ...]
+    inputs: tuple[str, ...]          # u: PTO force commands (N or N m)
+    disturbances: tuple[str, ...]    # w: excitation on each hydro DOF (N or N m, body axes)
+    outputs: tuple[str, ...]
+    parameters: tuple[str, ...]
+    p0: np.ndarray
+    f: ca.Function = field(repr=False)
+    h: ca.Function = field(repr=False)
+    energy: ca.Function = field(repr=False)   # (x, p) -> [kinetic, restoring potential] (J)
+
+    @property
+    def name(self) -> str:
+        return self.scene.name
+
+    @property
+    def nx(self) -> int:
+        return len(self.states)
+
+    @property
+    def n_q(self) -> int:
+        return self.topology.tree.n_q
+
+    def x0(self) -> np.ndarray:
+        """The rest state (all bodies at their scene pose, still water)."""
+        return np.zeros(self.nx)
+
+    def params(self, **overrides) -> np.ndarray:
+        """Parameter vector with named overrides, e.g. params(hinge_pto__damping=3.0)."""
+        p = self.p0.copy()
+        for key, value in overrides.items():
+            if key not in self.parameters:
+                raise KeyError(f"{self.name}: unknown parameter {key!r}; known: "
+                               f"{', '.join(self.parameters)}")
+            p[self.parameters.index(key)] = value
+        return p
+
+    def excitation(self, wave, t) -> np.ndarray:
+        """Excitation w(t) (len(t), n_w) of a wave on this plant's hydro DOFs."""
+        if self.hydro is None:
+            return np.zeros((np.size(t), 0))
+        return self.hydro.excitation(wave, t)
+
+
+def build_plant(scene: Scene | str, hydro: HydroModel | None = None, *,
+                radiation_tol: float | None = None) -> ProcessPlant:
+    """Assemble the process plant of a scene (a Scene, a scene file or a catalogue name).
+
+    Hydrodynamics come from `hydro` or the scene's hydro.file; the radiation model is fitted
+    to `radiation_tol` (default: the scene's) on the DOFs the joints can move.
+    """
+    scene = load_scene(scene) if not isinstance(scene, Scene) else scene
+    topo = build_topology(scene)
+    tree = topo.tree
+    q, s = ca.SX.sym("q", tree.n_q), ca.SX.sym("s", tree.n_s)
+    u = ca.SX.sym("u", len(scene.ptos))
+
+    hydro_dofs = active_hydro_dofs(scene, topo)
+    if hydro is None and hydro_dofs:
+        hydro = load_hydro_model(scene, hydro_dofs, tol=radiation_tol)
+    elif hydro is not None:
+        hydro = hydro.restricted(hydro_dofs)
+    n_w = len(hydro_dofs)
+    n_r = hydro.radiation.A.shape[0] if hydro else 0
+    w, chi = ca.SX.sym("w", n_w), ca.SX.sym("chi", n_r)
+
+    params = loads.Parameters()
+    P = tree.P(q)
+    select = _selector(topo, hydro_dofs)                  # 6N -> hydro DOFs
+    added_mass = select.T @ hydro.added_mass_inf @ select if hydro else None
+    nu_h = ca.mtimes(select, ca.mtimes(P.T, s))
+
+    tau = -tree.bias(q, s, added_mass)
+    chi_dot = ca.SX(0, 1)
+    if hydro:
+        A_r, B_r, C_r, D_r = hydro.radiation_matrices()
+        mu_h = ca.mtimes(C_r, chi) + ca.mtimes(D_r, nu_h)
+        chi_dot = ca.mtimes(A_r, chi) + ca.mtimes(B_r, nu_h)
+        tau += ca.mtimes(P, ca.mtimes(select.T, w - mu_h))
+    restoring, potential = loads.restoring_forces(topo, q, hydro.stiffness_by_body() if hydro
+                                                  else {})
+    tau += restoring
+    tau_pto, pto_signals = loads.pto_forces(scene, topo, q, s, u, params)
+    tau += tau_pto + loads.friction_forces(scene, topo, s, params)
+    tau += loads.mooring_forces(scene, topo, q, s, params)
+    tau += loads.drag_forces(scene, topo, q, s, params)
+    tau += loads.gravity_forces(scene, topo, q)
+
+    M = tree.mass_matrix(q, added_mass)
+    s_dot = ca.solve(M, tau)
+    x = ca.vertcat(q, s, chi)
+    x_dot = ca.vertcat(ca.mtimes(tree.K(q), s), s_dot, chi_dot)
+    y, output_names = _outputs(scene, topo, q, s, pto_signals)
+    p = params.vector
+
+    coords = list(tree.coordinate_names)
+    states = coords + [f"{c}__vel" for c in coords] + [f"radiation_{i}" for i in range(n_r)]
+    inputs = [f"u__{pto.name}" for pto in scene.ptos]
+    disturbances = [f"w__{d}" for d in hydro_dofs]
+    kinetic = 0.5 * ca.mtimes([s.T, M, s])
+    f = ca.Function("f", [x, u, w, p], [x_dot], ["x", "u", "w", "p"], ["xdot"])
+    h = ca.Function("h", [x, u, w, p], [y], ["x", "u", "w", "p"], ["y"])
+    energy = ca.Function("energy", [x, p], [ca.vertcat(kinetic, potential)], ["x", "p"], ["E"])
+    return ProcessPlant(scene, topo, hydro, tuple(states), tuple(inputs), tuple(disturbances),
+                        tuple(output_names), tuple(params.names), np.array(params.values),
+                        f, h, energy)
+
+
+def active_hydro_dofs(scene: Scene, topo: Topology) -> list[str]:
+    """Body DOFs ("<body>__<Dof>") of hydro bodies that the joints let move.
+
+    A DOF is active when its column of P(q) is non-zero at some configuration; probing random
+    configurations finds every column that is not identically zero.
+    """
+    tree = topo.tree
+    q = ca.SX.sym("q", tree.n_q)
+    P_fun = ca.Function("P", [q], [tree.P(q)])
+    rng = np.random.default_rng(12345)
+    norms = sum(np.abs(np.array(P_fun(rng.uniform(-0.5, 0.5, tree.n_q)))) for _ in range(4))
+    moving = norms.sum(axis=0) > 1e-12 if tree.n_q else np.zeros(6 * len(topo.bodies), bool)
+    dofs = []
+    for k, name in enumerate(topo.bodies):
+        if scene.body(name).hydro:
+            dofs += [f"{name}__{d}" for i, d in enumerate(DOF_NAMES) if moving[6 * k + i]]
+    return dofs
+
+
+def _selector(topo: Topology, dofs: list[str]) -> np.ndarray:
+    """Rows pick hydro DOFs out of the 6N body-twist vector."""
+    select = np.zeros((len(dofs), 6 * len(topo.bodies)))
+    for row, dof in enumerate(dofs):
+        body, name = dof.split("__")
+        select[row, 6 * topo.body_index(body) + DOF_NAMES.index(name)] = 1.0
+    return select
+
+
+def _outputs(scene, topo: Topology, q, s, pto_signals):
+    tree = topo.tree
+    q_rest = ca.DM.zeros(tree.n_q)
+    values, names = [q, s], list(tree.coordinate_names) + [f"{c}__vel" for c in
+                                                          tree.coordinate_names]
+    for k, body in enumerate(topo.bodies):
+        displacement = tree.cog(q, k) - tree.cog(q_rest, k)
+        values += [displacement, loads.euler_zyx(tree.rotation(q, k))]
+        names += [f"{body}__{dof}" for dof in DOF_NAMES]
+    for pto, (position, velocity, force) in pto_signals.items():
+        values += [position, velocity, force, -force * velocity]
+        names += [f"{pto}__position", f"{pto}__velocity", f"{pto}__force", f"{pto}__power"]
+    return ca.vertcat(*values), names

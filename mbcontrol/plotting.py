@@ -1,0 +1,91 @@
+"""Figures: Bode plots, time series, time-domain vs frequency-domain responses.
+
+Every function returns the matplotlib Figure and, given `path`, writes it (PNG) atomically.
+Axes carry units and the sign convention (NED: heave positive down).
+"""
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")          # files, never a window: this runs in CI and on servers
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+
+def save(fig, path) -> Path:
+    """Write a figure to a temporary file, then rename it into place."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=path.suffix)
+    os.close(fd)
+    fig.savefig(tmp, dpi=120, bbox_inches="tight")
+    os.replace(tmp, path)
+    return path
+
+
+def bode(sys, pairs, omega, *, title=None, path=None, fd=None):
+    """Magnitude and phase of sys from input to output for each (input, output) pair.
+
+    fd: optional {(input, output): complex response on omega} drawn as markers (e.g. the
+    BEM-direct frequency-domain solution) over the state-space lines.
+    """
+    fig, (ax_mag, ax_ph) = plt.subplots(2, 1, sharex=True, figsize=(7.5, 6))
+    A, B, C, D = (np.asarray(M) for M in (sys.A, sys.B, sys.C, sys.D))
+    eye = np.eye(A.shape[0])
+    for inp, out in pairs:
+        i, o = sys.input_labels.index(inp), sys.output_labels.index(out)
+        G = np.array([C[o] @ np.linalg.solve(1j * w * eye - A, B[:, i]) + D[o, i]
+                      for w in omega])
+        line, = ax_mag.loglog(omega, np.abs(G), label=f"{inp} → {out}")
+        ax_ph.semilogx(omega, np.degrees(np.unwrap(np.angle(G))), color=line.get_color())
+        if fd and (inp, out) in fd:
+            ref = fd[(inp, out)]
+            ax_mag.loglog(omega, np.abs(ref), "o", ms=3, color=line.get_color(), alpha=0.6)
+    ax_mag.set_ylabel("magnitude (SI units of output / input)")
+    ax_ph.set_ylabel("phase (deg)")
+    ax_ph.set_xlabel("ω (rad/s)")
+    ax_mag.legend(fontsize=8)
+    ax_mag.grid(True, which="both", alpha=0.3)
+    ax_ph.grid(True, which="both", alpha=0.3)
+    ax_mag.set_title(title or f"Bode: {sys.name}")
+    if path:
+        save(fig, path)
+    return fig
+
+
+def time_series(ds, names, *, title=None, path=None, units=None):
+    """Stacked time histories of named variables of a simulation result."""
+    fig, axes = plt.subplots(len(names), 1, sharex=True, figsize=(8, 1.9 * len(names) + 0.6))
+    axes = np.atleast_1d(axes)
+    for ax, name in zip(axes, names):
+        ax.plot(ds["time"].values, ds[name].values, lw=0.9)
+        unit = (units or {}).get(name, "")
+        ax.set_ylabel(f"{name}\n{unit}", fontsize=8)
+        ax.grid(alpha=0.3)
+    axes[-1].set_xlabel("time (s)")
+    axes[0].set_title(title or ds.attrs.get("model", ""))
+    if path:
+        save(fig, path)
+    return fig
+
+
+def response_comparison(omega, curves: dict, *, ylabel, title, path=None):
+    """Amplitude per unit wave amplitude against frequency, one line or marker set each.
+
+    curves: label -> (omega, values, style) with style a matplotlib format string.
+    """
+    fig, ax = plt.subplots(figsize=(7.5, 4.2))
+    for label, (w, values, style) in curves.items():
+        ax.plot(w, values, style, label=label, ms=5)
+    ax.set_xlabel("ω (rad/s)")
+    ax.set_ylabel(ylabel)
+    ax.set_title(title)
+    ax.grid(alpha=0.3)
+    ax.legend()
+    if path:
+        save(fig, path)
+    return fig

@@ -1,0 +1,311 @@
+"""Scene files: what a device is made of, read from TOML and validated once.
+
+A scene names its water, rigid bodies (mass, inertia about the CoG, CoG, BEM geometry), the
+joints of a tree (or forest) rooted at "ground", PTOs on joints and extra loads (hinge friction,
+linear moorings, quadratic drag). Every later stage trusts a loaded `Scene`.
+
+Coordinates are in the n-frame (north-east-down: x forward, y starboard, z down, origin on the
+undisturbed free surface) at the reference configuration q = 0, where every body frame is
+aligned with the n-frame. Numbers are SI; strings such as "60 mm" or "5 deg" are converted.
+See models/hinged_barge.toml for an annotated example.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import tomllib
+from dataclasses import asdict, dataclass, field
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+
+from .errors import SceneError
+from .scene_checks import Reader, check_topology
+
+DOF_NAMES = ("Surge", "Sway", "Heave", "Roll", "Pitch", "Yaw")
+JOINT_TYPES = ("revolute", "prismatic", "fixed", "free")
+
+
+@dataclass(frozen=True)
+class Water:
+    rho: float = 1025.0            # kg/m^3
+    g: float = 9.81                # m/s^2
+    depth: float = math.inf        # m; inf for deep water
+
+
+@dataclass(frozen=True)
+class Geometry:
+    """BEM geometry of a body in the n-frame at rest: a primitive or a mesh file."""
+    kind: str                              # "box" | "cylinder" | "sphere" | "mesh"
+    center: tuple[float, float, float] = (0.0, 0.0, 0.0)   # m, geometric centre (primitives)
+    size: tuple[float, float, float] | None = None         # m, box edge lengths (x, y, z)
+    radius: float | None = None                            # m, cylinder and sphere
+    length: float | None = None                            # m, cylinder
+    axis: str = "z"                                        # cylinder axis
+    file: str | None = None                                # mesh file, absolute path
+
+
+@dataclass(frozen=True)
+class Body:
+    name: str
+    mass: float                                            # kg
+    inertia: tuple[tuple[float, ...], ...]                 # kg m^2, 3x3 about the CoG, n axes
+    cog: tuple[float, float, float]                        # m, n-frame at rest
+    geometry: Geometry | None = None
+    hydro: bool = True                                     # False: no hydrodynamic loads
+
+
+@dataclass(frozen=True)
+class Joint:
+    name: str
+    type: str                                              # one of JOINT_TYPES
+    parent: str                                            # body name or "ground"
+    child: str
+    point: tuple[float, float, float]                      # m, joint point, n-frame at rest
+    axis: tuple[float, float, float] | None = None         # unit axis (revolute, prismatic)
+    dofs: tuple[str, ...] = ()                             # free joints: subset of DOF_NAMES
+
+    @property
+    def n_coordinates(self) -> int:
+        return {"revolute": 1, "prismatic": 1, "fixed": 0}.get(self.type, len(self.dofs))
+
+
+@dataclass(frozen=True)
+class Pto:
+    """Linear PTO on a one-coordinate joint: load on the child = -(damping*v + stiffness*x) + u."""
+    name: str
+    joint: str
+    damping: float = 0.0           # N s/m or N m s/rad
+    stiffness: float = 0.0         # N/m or N m/rad
+    force_max: float = math.inf    # N or N m; a limit controllers must respect
+
+
+@dataclass(frozen=True)
+class Friction:
+    """Joint friction -(viscous*v + coulomb*tanh(v/velocity_scale)); tanh smooths the sign."""
+    name: str
+    joint: str
+    viscous: float = 0.0           # N s/m or N m s/rad
+    coulomb: float = 0.0           # N or N m
+    velocity_scale: float = 1e-2   # m/s or rad/s
+
+
+@dataclass(frozen=True)
+class Mooring:
+    """Linear spring-damper between a body point and an anchor, per n-frame axis."""
+    name: str
+    body: str
+    point: tuple[float, float, float]          # m, fairlead on the body, n-frame at rest
+    stiffness: tuple[float, float, float]      # N/m along n-frame x, y, z
+    damping: tuple[float, float, float] = (0.0, 0.0, 0.0)  # N s/m
+
+
+@dataclass(frozen=True)
+class Drag:
+    """Quadratic drag per body DOF, -c|v|v on the CoG twist (body axes)."""
+    name: str
+    body: str
+    coefficients: dict[str, float] = field(default_factory=dict)  # DOF -> N s^2/m^2 or N m s^2
+
+
+@dataclass(frozen=True)
+class HydroSettings:
+    file: str | None = None                    # precomputed body-frame data (.nc), absolute path
+    panel_size: float = 0.1                    # m, BEM panel size
+    omega: tuple[float, ...] = ()              # rad/s, BEM frequencies
+    headings: tuple[float, ...] = (0.0,)       # rad, NED wave directions
+    lid: bool = True
+    radiation_tol: float = 0.01                # normalised RMS error of the radiation fit
+
+
+@dataclass(frozen=True)
+class Scene:
+    name: str
+    path: str
+    description: str
+    water: Water
+    bodies: tuple[Body, ...]
+    joints: tuple[Joint, ...]
+    ptos: tuple[Pto, ...] = ()
+    frictions: tuple[Friction, ...] = ()
+    moorings: tuple[Mooring, ...] = ()
+    drags: tuple[Drag, ...] = ()
+    hydro: HydroSettings = HydroSettings()
+
+    def body(self, name: str) -> Body:
+        return next(b for b in self.bodies if b.name == name)
+
+    def joint(self, name: str) -> Joint:
+        return next(j for j in self.joints if j.name == name)
+
+    def digest(self) -> str:
+        """sha256 of the scene's content (not its path): provenance and cache keys."""
+        data = asdict(self)
+        data.pop("path")
+        text = json.dumps(data, sort_keys=True, default=str)
+        return hashlib.sha256(text.encode()).hexdigest()
+
+
+# ---------------------------------------------------------------------------------- loading
+
+def catalogue_dir() -> Path:
+    return Path(str(resources.files("mbcontrol.models")))
+
+
+def list_models() -> list[str]:
+    """Names of the scene files shipped in the catalogue (models/*.toml)."""
+    return sorted(p.stem for p in catalogue_dir().glob("*.toml"))
+
+
+def resolve(path_or_name: str | Path) -> Path:
+    path = Path(path_or_name)
+    if path.suffix == ".toml" or path.exists():
+        if not path.exists():
+            raise SceneError(f"{path}: no such scene file")
+        return path
+    candidate = catalogue_dir() / f"{path_or_name}.toml"
+    if not candidate.exists():
+        raise SceneError(f"{path_or_name}: not a file and not a catalogue model; "
+                         f"the catalogue has {', '.join(list_models())}")
+    return candidate
+
+
+def load_scene(path_or_name: str | Path) -> Scene:
+    """Read and validate a scene file, or a catalogue model by name (see `list_models`)."""
+    path = resolve(path_or_name)
+    try:
+        data = tomllib.loads(path.read_text())
+    except tomllib.TOMLDecodeError as exc:
+        raise SceneError(f"{path}: not valid TOML: {exc}") from None
+    return parse_scene(data, path)
+
+
+def parse_scene(data: dict, path: Path) -> Scene:
+    """Build a Scene from the TOML dictionary; every problem raises SceneError."""
+    top = Reader(data, str(path), "")
+    top.allow("name", "description", "water", "body", "joint", "pto", "friction", "mooring",
+              "drag", "hydro")
+    water = _water(top.table("water", required=False))
+    bodies = tuple(_body(r, path) for r in top.tables("body", required=True))
+    joints = tuple(_joint(r) for r in top.tables("joint", required=True))
+    scene = Scene(
+        name=top.string("name", default=path.stem),
+        path=str(path),
+        description=top.string("description", default=""),
+        water=water, bodies=bodies, joints=joints,
+        ptos=tuple(_pto(r) for r in top.tables("pto")),
+        frictions=tuple(_friction(r) for r in top.tables("friction")),
+        moorings=tuple(_mooring(r) for r in top.tables("mooring")),
+        drags=tuple(_drag(r) for r in top.tables("drag")),
+        hydro=_hydro(top.table("hydro", required=False), path),
+    )
+    return check_topology(scene, top)
+
+
+def _water(r: Reader) -> Water:
+    r.allow("rho", "g", "depth")
+    return Water(rho=r.positive("rho", "density", default=1025.0),
+                 g=r.positive("g", "acceleration", default=9.81),
+                 depth=r.positive("depth", "length", default=math.inf))
+
+
+def _body(r: Reader, path: Path) -> Body:
+    r.allow("name", "mass", "inertia", "cog", "geometry", "hydro")
+    return Body(name=r.name(), mass=r.positive("mass", "mass"),
+                inertia=r.inertia("inertia"), cog=r.vector("cog", "length"),
+                geometry=_geometry(r.table("geometry", required=False), path),
+                hydro=r.boolean("hydro", default=True))
+
+
+def _geometry(r: Reader, path: Path) -> Geometry | None:
+    if r.empty:
+        return None
+    r.allow("type", "center", "size", "radius", "length", "axis", "file")
+    kind = r.choice("type", ("box", "cylinder", "sphere", "mesh"))
+    center = r.vector("center", "length", default=(0.0, 0.0, 0.0))
+    if kind == "box":
+        size = r.vector("size", "length")
+        if min(size) <= 0:
+            r.fail("size", f"expected three positive edge lengths (m), got {list(size)}")
+        return Geometry(kind, center, size=size)
+    if kind == "sphere":
+        return Geometry(kind, center, radius=r.positive("radius", "length"))
+    if kind == "cylinder":
+        return Geometry(kind, center, radius=r.positive("radius", "length"),
+                        length=r.positive("length", "length"),
+                        axis=r.choice("axis", ("x", "y", "z"), default="z"))
+    mesh = path.parent / r.string("file")
+    if not mesh.exists():
+        r.fail("file", f"expected an existing mesh file, {mesh} does not exist")
+    return Geometry(kind, center, file=str(mesh))
+
+
+def _joint(r: Reader) -> Joint:
+    r.allow("name", "type", "parent", "child", "point", "axis", "dofs")
+    kind = r.choice("type", JOINT_TYPES)
+    axis, dofs = None, ()
+    if kind in ("revolute", "prismatic"):
+        axis = r.vector("axis", None)
+        norm = float(np.linalg.norm(axis))
+        if norm < 1e-9:
+            r.fail("axis", f"expected a non-zero direction, got {list(axis)}")
+        axis = tuple(float(a) / norm for a in axis)
+    if kind == "free":
+        dofs = r.dof_list("dofs", default=DOF_NAMES)
+    child = r.string("child")
+    return Joint(name=r.name(), type=kind, parent=r.string("parent"), child=child,
+                 point=r.vector("point", "length", default=None), axis=axis, dofs=dofs)
+
+
+def _pto(r: Reader) -> Pto:
+    r.allow("name", "joint", "damping", "stiffness", "force_max")
+    return Pto(name=r.name(), joint=r.string("joint"),
+               damping=r.nonnegative("damping", default=0.0),
+               stiffness=r.number("stiffness", None, default=0.0),
+               force_max=r.positive("force_max", None, default=math.inf))
+
+
+def _friction(r: Reader) -> Friction:
+    r.allow("name", "joint", "viscous", "coulomb", "velocity_scale")
+    joint = r.string("joint")
+    return Friction(name=r.string("name", default=f"{joint}_friction"), joint=joint,
+                    viscous=r.nonnegative("viscous", default=0.0),
+                    coulomb=r.nonnegative("coulomb", default=0.0),
+                    velocity_scale=r.positive("velocity_scale", None, default=1e-2))
+
+
+def _mooring(r: Reader) -> Mooring:
+    r.allow("name", "body", "point", "stiffness", "damping")
+    stiffness = r.vector("stiffness", None)
+    damping = r.vector("damping", None, default=(0.0, 0.0, 0.0))
+    for key, values in (("stiffness", stiffness), ("damping", damping)):
+        if min(values) < 0:
+            r.fail(key, f"expected three non-negative numbers, got {list(values)}")
+    return Mooring(name=r.name(), body=r.string("body"), point=r.vector("point", "length"),
+                   stiffness=stiffness, damping=damping)
+
+
+def _drag(r: Reader) -> Drag:
+    r.allow("name", "body", "coefficients")
+    body = r.string("body")
+    coeffs = r.table("coefficients")
+    coeffs.allow(*DOF_NAMES)
+    values = {dof: coeffs.nonnegative(dof) for dof in DOF_NAMES if dof in coeffs.data}
+    return Drag(name=r.string("name", default=f"{body}_drag"), body=body, coefficients=values)
+
+
+def _hydro(r: Reader, path: Path) -> HydroSettings:
+    if r.empty:
+        return HydroSettings()
+    r.allow("file", "panel_size", "omega", "headings", "lid", "radiation_tol")
+    file = r.string("file", default=None)
+    omega = r.frequency_grid("omega")
+    return HydroSettings(
+        file=str(path.parent / file) if file else None,
+        panel_size=r.positive("panel_size", "length", default=0.1),
+        omega=omega,
+        headings=tuple(r.number_list("headings", "angle", default=(0.0,))),
+        lid=r.boolean("lid", default=True),
+        radiation_tol=r.positive("radiation_tol", None, default=0.01))

@@ -1,0 +1,52 @@
+"""State-space forms that make simulation cheap without changing the input-output map."""
+from __future__ import annotations
+
+import numpy as np
+
+
+def modal_form(A, B, C, tol: float = 1e-9):
+    """Real modal (block-diagonal) realisation (A_m, B_m, C_m) of (A, B, C).
+
+    Complex pole pairs sigma +- i w become 2x2 blocks [[sigma, w], [-w, sigma]], real poles 1x1,
+    so A_m has at most two non-zeros per row and a symbolic product A_m x costs O(n).
+    Raises ValueError when A is defective (not diagonalisable to working precision).
+    """
+    A, B, C = (np.asarray(M, dtype=float) for M in (A, B, C))
+    if A.size == 0:
+        return A, B, C
+    eigvals, vecs = np.linalg.eig(A)
+    if np.linalg.cond(vecs) > 1e10:
+        raise ValueError("modal_form: state matrix is (nearly) defective; keep the original form")
+    columns, blocks, used = [], [], np.zeros(eigvals.size, bool)
+    for i in np.argsort(eigvals.real, kind="stable"):
+        if used[i]:
+            continue
+        lam, v = eigvals[i], vecs[:, i]
+        used[i] = True
+        if abs(lam.imag) <= tol * max(1.0, abs(lam)):
+            columns.append(v.real / np.linalg.norm(v.real))
+            blocks.append(np.array([[lam.real]]))
+            continue
+        # the conjugate partner: mark it used; the pair spans [Re v, Im v]
+        partner = np.argmin(np.abs(eigvals - lam.conjugate()) + used * 1e300)
+        used[partner] = True
+        if lam.imag < 0:
+            lam, v = lam.conjugate(), v.conjugate()
+        columns += [v.real, v.imag]
+        blocks.append(np.array([[lam.real, lam.imag], [-lam.imag, lam.real]]))
+    T = np.column_stack(columns)
+    A_m = _block_diag(blocks)
+    B_m = np.linalg.solve(T, B)
+    C_m = C @ T
+    return A_m, B_m, C_m
+
+
+def _block_diag(blocks):
+    n = sum(b.shape[0] for b in blocks)
+    out = np.zeros((n, n))
+    i = 0
+    for b in blocks:
+        k = b.shape[0]
+        out[i:i + k, i:i + k] = b
+        i += k
+    return out

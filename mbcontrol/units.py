@@ -1,0 +1,60 @@
+"""Quantities in scene files: plain SI numbers, or strings such as "60 mm" or "5 deg".
+
+A string must carry a unit of the dimension the field expects; "3 kg" where a length is due is
+an error, never a silent conversion.
+"""
+from __future__ import annotations
+
+import math
+import re
+
+# dimension -> {unit: factor to SI}
+UNITS: dict[str, dict[str, float]] = {
+    "length": {"m": 1.0, "cm": 1e-2, "mm": 1e-3, "km": 1e3},
+    "mass": {"kg": 1.0, "g": 1e-3, "t": 1e3},
+    "angle": {"rad": 1.0, "deg": math.pi / 180.0},
+    "time": {"s": 1.0, "ms": 1e-3, "min": 60.0},
+    "frequency": {"rad/s": 1.0, "Hz": 2 * math.pi},
+    "density": {"kg/m^3": 1.0, "kg/m3": 1.0},
+    "acceleration": {"m/s^2": 1.0, "m/s2": 1.0},
+    "inertia": {"kg*m^2": 1.0, "kg m^2": 1.0, "kg*m2": 1.0},
+}
+
+SI_UNIT = {
+    "length": "m", "mass": "kg", "angle": "rad", "time": "s", "frequency": "rad/s",
+    "density": "kg/m^3", "acceleration": "m/s^2", "inertia": "kg*m^2",
+}
+
+_QUANTITY = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(\S.*?)?\s*$")
+
+
+class UnitError(ValueError):
+    """A value is not a number, or its unit is not of the expected dimension."""
+
+
+def to_si(value, dimension: str | None) -> float:
+    """Return `value` in SI units of `dimension`.
+
+    `value` is a number (taken as SI) or a string "<number> <unit>". `dimension` None means a
+    dimensionless number or one whose unit the scene format does not name (e.g. N*s/m):
+    then only plain numbers are accepted.
+    """
+    if isinstance(value, bool):
+        raise UnitError(f"expected a number, got the boolean {value!r}")
+    if isinstance(value, (int, float)):
+        return float(value)
+    if isinstance(value, str):
+        match = _QUANTITY.match(value)
+        if not match:
+            raise UnitError(f"expected a number or '<number> <unit>', got {value!r}")
+        number, unit = float(match.group(1)), match.group(2)
+        if unit is None:
+            return number
+        table = UNITS.get(dimension or "", {})
+        if unit not in table:
+            if dimension is None:
+                raise UnitError(f"expected a plain SI number here, got a unit in {value!r}")
+            raise UnitError(
+                f"expected a {dimension} in one of {sorted(table)}, got {value!r}")
+        return number * table[unit]
+    raise UnitError(f"expected a number, got {type(value).__name__} {value!r}")
