@@ -141,11 +141,26 @@ class Scene:
         return next(j for j in self.joints if j.name == name)
 
     def digest(self) -> str:
-        """sha256 of the scene's content (not its path): provenance and cache keys."""
+        """sha256 of the scene's content (not its path): provenance and cache keys.
+
+        Files the scene refers to (hydro data, meshes) enter by name and content, so a copy of
+        a model in another folder has the same digest.
+        """
         data = asdict(self)
         data.pop("path")
+        data["hydro"]["file"] = _file_digest(self.hydro.file)
+        for body in data["bodies"]:
+            if body["geometry"] and body["geometry"]["file"]:
+                body["geometry"]["file"] = _file_digest(body["geometry"]["file"])
         text = json.dumps(data, sort_keys=True, default=str)
         return hashlib.sha256(text.encode()).hexdigest()
+
+
+def _file_digest(path: str | None):
+    if path is None:
+        return None
+    content = Path(path).read_bytes() if Path(path).exists() else b"missing"
+    return [Path(path).name, hashlib.sha256(content).hexdigest()]
 
 
 # ---------------------------------------------------------------------------------- loading
@@ -208,7 +223,7 @@ def _water(r: Reader) -> Water:
     r.allow("rho", "g", "depth")
     return Water(rho=r.positive("rho", "density", default=1025.0),
                  g=r.positive("g", "acceleration", default=9.81),
-                 depth=r.positive("depth", "length", default=math.inf))
+                 depth=r.positive("depth", "length", default=math.inf, finite=False))
 
 
 def _body(r: Reader, path: Path) -> Body:
@@ -263,8 +278,8 @@ def _pto(r: Reader) -> Pto:
     r.allow("name", "joint", "damping", "stiffness", "force_max")
     return Pto(name=r.name(), joint=r.string("joint"),
                damping=r.nonnegative("damping", default=0.0),
-               stiffness=r.number("stiffness", None, default=0.0),
-               force_max=r.positive("force_max", None, default=math.inf))
+               stiffness=r.finite("stiffness", default=0.0),
+               force_max=r.positive("force_max", None, default=math.inf, finite=False))
 
 
 def _friction(r: Reader) -> Friction:
@@ -306,6 +321,6 @@ def _hydro(r: Reader, path: Path) -> HydroSettings:
         file=str(path.parent / file) if file else None,
         panel_size=r.positive("panel_size", "length", default=0.1),
         omega=omega,
-        headings=tuple(r.number_list("headings", "angle", default=(0.0,))),
+        headings=tuple(r.finite_list("headings", "angle", default=(0.0,))),
         lid=r.boolean("lid", default=True),
         radiation_tol=r.positive("radiation_tol", None, default=0.01))

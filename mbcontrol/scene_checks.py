@@ -113,11 +113,26 @@ class Reader:
             self.fail(key, "expected a number, got nan")
         return number
 
-    def positive(self, key: str, dimension: str | None = None, default=_REQUIRED) -> float:
+    def positive(self, key: str, dimension: str | None = None, default=_REQUIRED,
+                 finite: bool = True) -> float:
+        """A number > 0; also finite unless `finite` is False (e.g. depth = inf)."""
         value = self.number(key, dimension, default)
-        if not value > 0:
-            self.fail(key, f"expected a positive number, got {value}")
+        if not value > 0 or (finite and math.isinf(value)):
+            self.fail(key, f"expected a {'finite ' if finite else ''}positive number, "
+                           f"got {value}")
         return value
+
+    def finite(self, key: str, dimension: str | None = None, default=_REQUIRED) -> float:
+        value = self.number(key, dimension, default)
+        if not math.isfinite(value):
+            self.fail(key, f"expected a finite number, got {value}")
+        return value
+
+    def finite_list(self, key: str, dimension: str | None, default=_REQUIRED) -> list[float]:
+        values = self.number_list(key, dimension, default)
+        if not all(math.isfinite(v) for v in values):
+            self.fail(key, f"expected finite numbers, got {values}")
+        return values
 
     def nonnegative(self, key: str, default=_REQUIRED) -> float:
         value = self.number(key, None, default)
@@ -148,12 +163,15 @@ class Reader:
         value = self._get(key, _REQUIRED)
         rows = value if isinstance(value, list) else None
         if rows and all(isinstance(r, list) for r in rows):
-            matrix = np.array([[self._convert(key, v, "inertia") for v in r] for r in rows])
+            matrix = (np.array([[self._convert(key, v, "inertia") for v in r] for r in rows])
+                      if all(len(r) == 3 for r in rows) else np.zeros((0, 0)))  # ragged rows
         else:
             diagonal = self.number_list(key, "inertia")
             matrix = np.diag(diagonal) if len(diagonal) == 3 else np.zeros((0, 0))
         if matrix.shape != (3, 3):
             self.fail(key, f"expected [Ixx, Iyy, Izz] or a 3x3 matrix (kg m^2), got {value!r}")
+        if not np.all(np.isfinite(matrix)):
+            self.fail(key, f"expected finite numbers (kg m^2), got {value!r}")
         if not np.allclose(matrix, matrix.T, rtol=1e-9, atol=1e-12):
             self.fail(key, "expected a symmetric inertia matrix")
         if np.linalg.eigvalsh(matrix).min() <= 0:
@@ -176,7 +194,12 @@ class Reader:
             grid.allow("min", "max", "n")
             lo = grid.positive("min", "frequency")
             hi = grid.positive("max", "frequency")
-            n = int(grid.positive("n"))
+            n = grid.number("n", None)
+            if not (n >= 2 and float(n).is_integer()):
+                grid.fail("n", f"expected an integer number of frequencies >= 2, got {n}")
+            n = int(n)
+            if n > 100_000:
+                grid.fail("n", f"expected at most 100000 frequencies, got {n}")
             if hi <= lo or n < 2:
                 self.fail(key, f"expected min < max and n >= 2, got {value}")
             return tuple(np.linspace(lo, hi, n))
@@ -223,10 +246,10 @@ def check_topology(scene, top: Reader):
         parent_of[joint.child] = joint.parent
         joints.append(joint)
 
-    for name in bodies:
+    for i, name in enumerate(bodies):
         if name not in parent_of:
-            raise SceneError(f"{where}: body '{name}': no joint has it as child; give it a "
-                             f"'free' or 'fixed' joint to ground")
+            raise SceneError(f"{where}: body[{i}]: no joint has body '{name}' as child; give "
+                             f"it a 'free' or 'fixed' joint to ground")
         chain, node = [name], parent_of[name]
         while node != "ground":
             if node in chain:

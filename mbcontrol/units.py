@@ -55,6 +55,7 @@ def to_si(value, dimension: str | None) -> float:
             if dimension is None:
                 raise UnitError(f"expected a plain SI number here, got a unit in {value!r}")
             raise UnitError(
-                f"expected a {dimension} in one of {sorted(table)}, got {value!r}")
+                f"expected {'an' if dimension[0] in 'aeiou' else 'a'} {dimension} in one of "
+                f"{sorted(table)}, got {value!r}")
         return number * table[unit]
     raise UnitError(f"expected a number, got {type(value).__name__} {value!r}")
