@@ -46,3 +46,38 @@ class Passive:
 
     def describe(self) -> dict:
         return {"name": self.name, "damping": self.damping, "period_s": self.period}
+
+
+def optimal_damping(plant, wave, *, pto: str | None = None, params=None,
+                    bounds=(1e-4, 1e4)) -> tuple[float, float]:
+    """Controller damping that maximises the PTO's mean absorbed power in `wave`.
+
+    Evaluated on the frequency-domain solution built straight from the BEM data (linear
+    theory; Coulomb friction is left out, as linear theory cannot hold it). The PTO's own
+    scene damping stays in place; the returned damping adds to it. Returns (damping, mean
+    power in W) for a regular wave or an irregular sea (sum over its components).
+    bounds: search interval of the added damping (N s/m or N m s/rad).
+    """
+    from scipy.optimize import minimize_scalar
+
+    from mbcontrol.analysis import frequency_domain_response
+    name = pto or plant.scene.ptos[0].name
+    base = dict(params or {})
+    for friction in plant.scene.frictions:
+        base.setdefault(f"{friction.name}__coulomb", 0.0)
+    key = f"{name}__damping"
+    c_scene = base.get(key, plant.p0[plant.parameters.index(key)])
+
+    def power(extra: float) -> float:
+        total = c_scene + extra
+        v = frequency_domain_response(plant, wave.omega, direction=wave.direction,
+                                      params={**base, key: total},
+                                      outputs=[f"{name}__velocity"])[:, 0]
+        return float(np.sum(0.5 * total * np.abs(v * wave.amplitude) ** 2))
+
+    result = minimize_scalar(lambda z: -power(np.exp(z)), method="bounded",
+                             bounds=np.log(bounds), options={"xatol": 1e-4})
+    best = float(np.exp(result.x))
+    if power(0.0) >= -result.fun:      # adding damping does not help: the scene's is optimal
+        return 0.0, power(0.0)
+    return best, -float(result.fun)

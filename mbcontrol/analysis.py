@@ -111,3 +111,23 @@ def steady_amplitude(ds, name: str, period: float, n_periods: int = 10) -> float
     window = t >= t[-1] - n_periods * period
     values = ds[name].values[window]
     return 0.5 * float(values.max() - values.min())
+
+
+def steady_state_initial(sys, plant, wave) -> np.ndarray:
+    """State at t = 0 on the linear periodic response to a regular wave (no ramp needed).
+
+    x(t) = Re(X exp(i omega t)) with X = (i omega I - A)^-1 B_w conj(F) a; starting there
+    removes the start-up transient of lightly damped modes, leaving only what the nonlinear
+    terms add. Returns the full plant state (sys must be linearize(plant) with all states).
+    """
+    from .waves import interpolate_complex
+    if wave.omega.size != 1:
+        raise ValueError("steady_state_initial needs a regular wave")
+    w, a = float(wave.omega[0]), float(wave.amplitude[0]) * np.exp(-1j * wave.phase[0])
+    hyd = plant.hydro
+    F = np.conj(interpolate_complex(hyd.omega, hyd.excitation_coefficients(wave.direction),
+                                    np.array([w]))[0] * a)
+    w_idx = [sys.input_labels.index(f"w__{d}") for d in hyd.dofs]
+    A, B = np.asarray(sys.A), np.asarray(sys.B)[:, w_idx]
+    X = np.linalg.solve(1j * w * np.eye(A.shape[0]) - A, B @ F)
+    return plant.x0() + X.real

@@ -124,11 +124,7 @@ def load_hydro_model(scene: Scene, dofs, tol: float | None = None) -> HydroModel
     tol = scene.hydro.radiation_tol if tol is None else tol
     if scene.hydro.file:
         source = scene.hydro.file
-        try:
-            data = xr.load_dataset(source)
-        except (OSError, ValueError) as exc:
-            raise HydroError(f"{source}: cannot read hydro data: {exc}") from None
-        data = _decode_complex(data)
+        data = bem.read_netcdf(source)
     else:
         source, data = _run_bem(scene, dofs)
     _check_dofs(data, dofs, source)
@@ -163,15 +159,6 @@ def _geometry_dict(geometry) -> dict:
     return g
 
 
-def _decode_complex(data: xr.Dataset) -> xr.Dataset:
-    """Join real/imag pairs stored for netCDF (`<name>__re`, `<name>__im`) into complex."""
-    for name in [v for v in data.data_vars if str(v).endswith("__re")]:
-        base = name[:-4]
-        data[base] = data[name] + 1j * data[f"{base}__im"]
-        data = data.drop_vars([name, f"{base}__im"])
-    return data
-
-
 def _check_dofs(data: xr.Dataset, dofs, source: str) -> None:
     for var in ("added_mass", "radiation_damping", "added_mass_inf", "excitation_force",
                 "hydrostatic_stiffness"):
@@ -184,24 +171,55 @@ def _check_dofs(data: xr.Dataset, dofs, source: str) -> None:
                          f"has only {sorted(have)}")
 
 
+def fit_band_limit(data: xr.Dataset) -> float | None:
+    """Highest frequency the radiation fit uses: where the BEM mesh is still resolved.
+
+    Above `omega_max_mesh` (fewer than 8 panels per wavelength) panel-method damping loses
+    accuracy and even passivity, so fitting it would spend states on numerical artefacts.
+    """
+    limit = data.attrs.get("omega_max_mesh")
+    return float(limit) if limit is not None and np.isfinite(limit) else None
+
+
 def _fit_cached(data: xr.Dataset, dofs, tol, source: str):
     """fit_radiation with an on-disk cache keyed by the data, the DOFs and the tolerance."""
     tol = 0.01 if tol is None else tol
     digest = hashlib.sha256()
     for var in ("added_mass", "radiation_damping", "added_mass_inf"):
         digest.update(np.ascontiguousarray(data[var].values).tobytes())
-    digest.update(json.dumps([list(dofs), tol, bem.__name__]).encode())
+    # the fitting code is part of the key: a changed algorithm never serves an old fit
+    digest.update(Path(bem.radiation.__file__).read_bytes())
+    digest.update(json.dumps([list(dofs), tol, fit_band_limit(data)]).encode())
     path = cache_dir() / f"radiation_{digest.hexdigest()[:20]}.npz"
     if path.exists():
         try:
             with np.load(path, allow_pickle=False) as z:
-                return bem.RadiationModel.from_arrays(dict(z))
+                return _model_from_arrays(z)
         except (OSError, ValueError, KeyError):
             path.unlink(missing_ok=True)       # a stale or foreign file: refit
-    model = bem.fit_radiation(data, dofs=list(dofs), tol=tol)
+    model = bem.fit_radiation(data, dofs=list(dofs), tol=tol, omega_max=fit_band_limit(data))
     fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".npz.tmp")
     os.close(fd)
     with open(tmp, "wb") as fh:
-        np.savez(fh, **model.to_arrays())
+        np.savez(fh, A=model.A, B=model.B, C=model.C, D=model.D, dofs=np.array(model.dofs),
+                 order=model.order, fit_error=model.fit_error, entry_errors=model.entry_errors,
+                 report=json.dumps(model.report, default=_jsonable))
     os.replace(tmp, path)
     return model
+
+
+def _model_from_arrays(z) -> "bem.RadiationModel":
+    return bem.RadiationModel(A=z["A"], B=z["B"], C=z["C"], D=z["D"],
+                              dofs=tuple(str(d) for d in z["dofs"]), order=int(z["order"]),
+                              fit_error=float(z["fit_error"]), entry_errors=z["entry_errors"],
+                              report=json.loads(str(z["report"])))
+
+
+def _jsonable(obj):
+    if isinstance(obj, np.ndarray):
+        return obj.tolist() if obj.dtype.kind != "c" else [obj.real.tolist(), obj.imag.tolist()]
+    if isinstance(obj, np.generic):
+        return obj.item()
+    if isinstance(obj, complex):
+        return [obj.real, obj.imag]
+    return str(obj)

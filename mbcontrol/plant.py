@@ -101,12 +101,13 @@ def build_plant(scene: Scene | str, hydro: HydroModel | None = None, *,
     nu_h = ca.mtimes(select, ca.mtimes(P.T, s))
 
     tau = -tree.bias(q, s, added_mass)
-    chi_dot = ca.SX(0, 1)
+    chi_dot, power = ca.SX(0, 1), {"radiated_power": 0, "excitation_power": 0}
     if hydro:
         A_r, B_r, C_r, D_r = hydro.radiation_matrices()
         mu_h = ca.mtimes(C_r, chi) + ca.mtimes(D_r, nu_h)
         chi_dot = ca.mtimes(A_r, chi) + ca.mtimes(B_r, nu_h)
         tau += ca.mtimes(P, ca.mtimes(select.T, w - mu_h))
+        power = {"radiated_power": ca.dot(nu_h, mu_h), "excitation_power": ca.dot(nu_h, w)}
     restoring, potential = loads.restoring_forces(topo, q, hydro.stiffness_by_body() if hydro
                                                   else {})
     tau += restoring
@@ -120,14 +121,15 @@ def build_plant(scene: Scene | str, hydro: HydroModel | None = None, *,
     s_dot = ca.solve(M, tau)
     x = ca.vertcat(q, s, chi)
     x_dot = ca.vertcat(ca.mtimes(tree.K(q), s), s_dot, chi_dot)
-    y, output_names = _outputs(scene, topo, q, s, pto_signals)
+    kinetic = 0.5 * ca.mtimes([s.T, M, s])
+    power["energy"] = kinetic + potential
+    y, output_names = _outputs(scene, topo, q, s, pto_signals, power)
     p = params.vector
 
     coords = list(tree.coordinate_names)
     states = coords + [f"{c}__vel" for c in coords] + [f"radiation_{i}" for i in range(n_r)]
     inputs = [f"u__{pto.name}" for pto in scene.ptos]
     disturbances = [f"w__{d}" for d in hydro_dofs]
-    kinetic = 0.5 * ca.mtimes([s.T, M, s])
     f = ca.Function("f", [x, u, w, p], [x_dot], ["x", "u", "w", "p"], ["xdot"])
     h = ca.Function("h", [x, u, w, p], [y], ["x", "u", "w", "p"], ["y"])
     energy = ca.Function("energy", [x, p], [ca.vertcat(kinetic, potential)], ["x", "p"], ["E"])
@@ -164,7 +166,7 @@ def _selector(topo: Topology, dofs: list[str]) -> np.ndarray:
     return select
 
 
-def _outputs(scene, topo: Topology, q, s, pto_signals):
+def _outputs(scene, topo: Topology, q, s, pto_signals, power):
     tree = topo.tree
     q_rest = ca.DM.zeros(tree.n_q)
     values, names = [q, s], list(tree.coordinate_names) + [f"{c}__vel" for c in
@@ -176,4 +178,7 @@ def _outputs(scene, topo: Topology, q, s, pto_signals):
     for pto, (position, velocity, force) in pto_signals.items():
         values += [position, velocity, force, -force * velocity]
         names += [f"{pto}__position", f"{pto}__velocity", f"{pto}__force", f"{pto}__power"]
+    # energy audit: radiated (W, leaving the bodies), wave input (W), kinetic + restoring (J)
+    values += [power["radiated_power"], power["excitation_power"], power["energy"]]
+    names += ["radiated_power", "excitation_power", "energy"]
     return ca.vertcat(*values), names

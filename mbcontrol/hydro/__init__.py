@@ -1,0 +1,24 @@
+"""Hydrodynamics: Capytaine BEM runs, frame maps to NED body frames, radiation models.
+
+Dataset layout returned by :func:`compute` (SI units, NED body frames at each CoG,
+time convention e^{-iωt}, excitation per unit wave amplitude at the n-frame origin):
+
+- coords ``omega`` (rad/s), ``radiating_dof``/``influenced_dof`` (``<body>__<Dof>``),
+  ``wave_direction`` (rad, NED: direction waves travel to, +x towards +y starboard), ``body``, ``xyz``
+- ``added_mass``, ``radiation_damping`` (omega, radiating_dof, influenced_dof);
+  ``added_mass_inf``, ``added_mass_zero``, ``hydrostatic_stiffness`` (radiating_dof, influenced_dof)
+- ``excitation_force`` = ``froude_krylov_force`` + ``diffraction_force`` (wave_direction, omega, influenced_dof)
+- ``displaced_volume``, ``waterplane_area``, ``mass`` (body); ``center_of_buoyancy``, ``cog`` (body, xyz)
+"""
+from ._io import read_netcdf, write_netcdf_atomic
+from .bem import cache_key, compute, matrix
+from .frames import dof_map, shift_matrix, skew, to_body_frames, zup_to_ned
+from .geometry import RIGID_DOFS, BemBody, hull_mesh, lid_mesh, validate_body
+from .radiation import RadiationModel, convolution_force, fit_radiation, impulse_response, kernel_data
+
+__all__ = [
+    "read_netcdf", "write_netcdf_atomic",
+    "BemBody", "RIGID_DOFS", "compute", "cache_key", "matrix", "validate_body", "hull_mesh", "lid_mesh",
+    "to_body_frames", "dof_map", "shift_matrix", "skew", "zup_to_ned",
+    "RadiationModel", "fit_radiation", "impulse_response", "convolution_force", "kernel_data",
+]

@@ -1,0 +1,72 @@
+"""The `mbcontrol` command: help, the catalogue, the --json contracts, and clear errors."""
+import json
+
+import pytest
+
+from mbcontrol.cli import main
+
+
+def run(capsys, *argv):
+    code = main(list(argv))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_help_explains_commands(capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["--help"])
+    assert exc.value.code == 0
+    out = capsys.readouterr().out
+    for command in ("models", "hydro", "simulate", "linearize"):
+        assert command in out
+
+
+def test_models_lists_catalogue(capsys):
+    code, out, _ = run(capsys, "models")
+    assert code == 0 and "hinged_barge" in out and "hinged_raft" in out
+
+
+def test_simulate_json_contract(capsys, tmp_path):
+    nc = tmp_path / "run.nc"
+    code, out, _ = run(capsys, "simulate", "hinged_barge", "--wave", "regular", "--height",
+                       "0.02", "--period", "1.0", "--duration", "15", "--dt", "0.005",
+                       "--out", str(nc), "--json")
+    assert code == 0
+    result = json.loads(out)
+    assert set(result) >= {"model", "wave", "duration_s", "dt_s", "wall_time_s", "dofs",
+                           "bodies", "ptos"}
+    assert result["model"] == "hinged_barge" and result["wave"]["type"] == "regular"
+    assert set(result["dofs"]) == {"pivot", "hinge"}
+    assert set(result["dofs"]["hinge"]) == {"amplitude", "mean", "std", "max_abs"}
+    assert {"heave_amplitude_m", "pitch_amplitude_rad"} <= set(result["bodies"]["barge2"])
+    assert set(result["ptos"]["hinge_pto"]) == {"mean_power_W", "max_force", "max_stroke"}
+    assert result["ptos"]["hinge_pto"]["mean_power_W"] > 0       # a damper absorbs
+    assert nc.exists()
+
+
+def test_simulate_with_controller_and_irregular_sea(capsys):
+    code, out, _ = run(capsys, "simulate", "hinged_raft", "--wave", "jonswap", "--hs", "0.03",
+                       "--tp", "1.1", "--seed", "2", "--duration", "30", "--controller",
+                       "passive", "--set", "damping=1.0", "--json")
+    assert code == 0
+    result = json.loads(out)
+    assert result["wave"]["seed"] == 2 and result["wave"]["type"] == "jonswap"
+    assert {"raft__Surge", "raft__Heave", "raft__Pitch", "hinge"} == set(result["dofs"])
+
+
+def test_linearize_json_and_bode(capsys, tmp_path):
+    png = tmp_path / "bode.png"
+    code, out, _ = run(capsys, "linearize", "hinged_barge", "--bode", str(png), "--json")
+    assert code == 0 and png.stat().st_size > 10_000
+    info = json.loads(out)
+    assert info["stable"] and "u__hinge_pto" in info["inputs"]
+
+
+def test_errors_are_clear(capsys):
+    code, _, err = run(capsys, "simulate", "no_such_model", "--height", "1", "--period", "5")
+    assert code == 1 and "not a file and not a catalogue model" in err
+    code, _, err = run(capsys, "simulate", "hinged_barge", "--wave", "regular")
+    assert code == 1 and "--height and --period" in err
+    code, _, err = run(capsys, "simulate", "hinged_barge", "--height", "0.02", "--period", "1",
+                       "--controller", "passive", "--set", "damping")
+    assert code == 1 and "KEY=VALUE" in err
