@@ -3,7 +3,7 @@
 A controller is bound to a plant by `reset(plant)` (it looks up the signals it measures by
 name), then called as `controller(t, y) -> u` every `period` seconds with the plant's output
 vector y; u (one force or torque per PTO, N or N m) is held until the next call (zero-order
-hold). A controller whose law is a static CasADi expression of y may also return it from
+hold). In closed loop u is the PTO's whole force: the scene's PTO law is set aside. A controller whose law is a static CasADi expression of y may also return it from
 `casadi_law(plant)`; with period equal to the simulation step it then runs inside compiled code.
 """
 from __future__ import annotations

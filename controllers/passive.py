@@ -8,10 +8,10 @@ from .base import signal_indices
 
 
 class Passive:
-    """A damper on every PTO of the plant.
+    """A linear damper on every PTO: u = -damping * v, the PTO's whole force.
 
-    damping: N s/m (or N m s/rad) per PTO, one number for all, or a dict by PTO name. The
-    force is added to the PTO's own scene damping and stiffness.
+    damping: N s/m (or N m s/rad) per PTO, one number for all, or a dict by PTO name. In
+    closed loop the controller owns the PTO force (the scene's PTO law is set aside).
     """
     name = "passive"
 
@@ -50,13 +50,12 @@ class Passive:
 
 def optimal_damping(plant, wave, *, pto: str | None = None, params=None,
                     bounds=(1e-4, 1e4)) -> tuple[float, float]:
-    """Controller damping that maximises the PTO's mean absorbed power in `wave`.
+    """PTO damping that maximises the mean absorbed power in `wave`: (damping, power W).
 
     Evaluated on the frequency-domain solution built straight from the BEM data (linear
-    theory; Coulomb friction is left out, as linear theory cannot hold it). The PTO's own
-    scene damping stays in place; the returned damping adds to it. Returns (damping, mean
-    power in W) for a regular wave or an irregular sea (sum over its components).
-    bounds: search interval of the added damping (N s/m or N m s/rad).
+    theory: Coulomb friction is left out, as linear theory cannot hold it), with the PTO's
+    force -damping * v alone, as in closed loop. For a regular wave or an irregular sea (sum
+    over its components). bounds: search interval, N s/m or N m s/rad.
     """
     from scipy.optimize import minimize_scalar
 
@@ -65,19 +64,16 @@ def optimal_damping(plant, wave, *, pto: str | None = None, params=None,
     base = dict(params or {})
     for friction in plant.scene.frictions:
         base.setdefault(f"{friction.name}__coulomb", 0.0)
-    key = f"{name}__damping"
-    c_scene = base.get(key, plant.p0[plant.parameters.index(key)])
+    for other in plant.scene.ptos:
+        base.setdefault(f"{other.name}__damping", 0.0)
+        base.setdefault(f"{other.name}__stiffness", 0.0)
 
-    def power(extra: float) -> float:
-        total = c_scene + extra
+    def power(damping: float) -> float:
         v = frequency_domain_response(plant, wave.omega, direction=wave.direction,
-                                      params={**base, key: total},
+                                      params={**base, f"{name}__damping": damping},
                                       outputs=[f"{name}__velocity"])[:, 0]
-        return float(np.sum(0.5 * total * np.abs(v * wave.amplitude) ** 2))
+        return float(np.sum(0.5 * damping * np.abs(v * wave.amplitude) ** 2))
 
     result = minimize_scalar(lambda z: -power(np.exp(z)), method="bounded",
                              bounds=np.log(bounds), options={"xatol": 1e-4})
-    best = float(np.exp(result.x))
-    if power(0.0) >= -result.fun:      # adding damping does not help: the scene's is optimal
-        return 0.0, power(0.0)
-    return best, -float(result.fun)
+    return float(np.exp(result.x)), -float(result.fun)

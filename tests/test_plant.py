@@ -90,14 +90,16 @@ def test_rk4_agrees_with_cvodes(barge):
 def test_controller_paths_agree(barge):
     """Passive damping as a plant parameter, a compiled law, and a Python ZOH loop."""
     wave = waves.regular(0.02, 1.0)
-    extra = 1.5
-    c0 = barge.p0[barge.parameters.index("hinge_pto__damping")]
+    damping = 1.5
     as_param = simulate(barge, wave, duration=6.0, dt=0.005,
-                        params={"hinge_pto__damping": c0 + extra})
+                        params={"hinge_pto__damping": damping})
+    # in closed loop the controller owns the PTO force: the scene's 2.0 is set aside
     compiled = simulate(barge, wave, duration=6.0, dt=0.005,
-                        controller=make("passive", damping=extra))
+                        controller=make("passive", damping=damping))
     python_loop = simulate(barge, wave, duration=6.0, dt=0.005,
-                           controller=make("passive", damping=extra, period=0.005))
+                           controller=make("passive", damping=damping, period=0.005))
+    assert compiled.hinge_pto__force.values[100] == pytest.approx(
+        -damping * compiled.hinge_pto__velocity.values[99], rel=0.05)
     ref = as_param["hinge"].values
     scale = np.abs(ref).max()
     # the controller holds u over each step (ZOH), the parameter acts continuously: an
