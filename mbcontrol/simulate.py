@@ -60,10 +60,18 @@ def simulate(plant, wave=None, *, duration: float, dt: float = 0.01, controller=
         bar.close()
 
     W = W_half[::2]
-    U_full = np.vstack([U, U[-1:]]) if len(U) else np.zeros((n + 1, len(plant.inputs)))
+    U_full = np.vstack([U, _last_command(plant, controller, t[-1], X[-1], U, W[-1], p)])
     Y = integrators.outputs(plant, X, U_full, W, p, compiled=compiled)
     eta = wave.elevation(t) if wave is not None else np.zeros_like(t)
     return _dataset(plant, t, X, U_full, W, Y, eta, wave, controller, method, dt, p, wall)
+
+
+def _last_command(plant, controller, t, x, U, w, p) -> np.ndarray:
+    """The command at the final sample, as the controller would issue it next."""
+    if controller is None:
+        return np.zeros((1, len(plant.inputs)))
+    y = np.asarray(plant.h(x, U[-1], w, p)).ravel()
+    return np.asarray(controller(t, y), float).reshape(1, -1)
 
 
 def _parameters(plant, params, controller) -> np.ndarray:

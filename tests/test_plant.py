@@ -98,8 +98,10 @@ def test_controller_paths_agree(barge):
                         controller=make("passive", damping=damping))
     python_loop = simulate(barge, wave, duration=6.0, dt=0.005,
                            controller=make("passive", damping=damping, period=0.005))
-    assert compiled.hinge_pto__force.values[100] == pytest.approx(
-        -damping * compiled.hinge_pto__velocity.values[99], rel=0.05)
+    # the law reads the state at the start of each step: at every sample, F = -c v exactly
+    np.testing.assert_allclose(compiled.hinge_pto__force.values,
+                               -damping * compiled.hinge_pto__velocity.values, rtol=1e-12,
+                               atol=1e-15)
     ref = as_param["hinge"].values
     scale = np.abs(ref).max()
     # the controller holds u over each step (ZOH), the parameter acts continuously: an

@@ -153,7 +153,7 @@ def test_hinged_barge_values():
     assert [j.n_coordinates for j in s.joints] == [1, 1]
     (pto,) = s.ptos
     assert (pto.name, pto.joint, pto.damping, pto.stiffness, pto.force_max) == (
-        "hinge_pto", "hinge", 2.0, 0.0, 5.0)
+        "hinge_pto", "hinge", 0.5, 0.0, 5.0)
     (fr,) = s.frictions
     assert (fr.joint, fr.viscous, fr.coulomb, fr.velocity_scale) == ("hinge", 0.02, 0.01, 0.01)
     # hydro: "25 mm" -> 0.025 m (one multiplication 25 * 1e-3: <= 1 ulp of rounding)
@@ -178,7 +178,7 @@ def test_hinged_raft_values():
     assert raft.point == s.body("barge1").cog == (0.32, 0.0, 0.0)
     assert hinge.point == (0.64, 0.0, 0.0) and hinge.axis == (0.0, 1.0, 0.0)
     (pto,) = s.ptos
-    assert (pto.joint, pto.damping, pto.stiffness, pto.force_max) == ("hinge", 2.0, 0.0, 5.0)
+    assert (pto.joint, pto.damping, pto.stiffness, pto.force_max) == ("hinge", 0.5, 0.0, 5.0)
     (m,) = s.moorings
     assert (m.name, m.body, m.point) == ("bow_line", "barge1", (0.02, 0.0, 0.0))
     assert m.stiffness == (5.0, 0.0, 0.0) and m.damping == (1.0, 0.0, 0.0)
