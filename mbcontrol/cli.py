@@ -72,6 +72,9 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--bode", metavar="FILE.png", help="write a Bode plot")
     p.add_argument("--pair", action="append", default=[], metavar="INPUT:OUTPUT",
                    help="Bode channel, repeatable (default: each PTO command to its velocity)")
+    p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
+                   help="plant parameter override, repeatable; e.g. hinge_friction__coulomb=0\n"
+                        "(a smoothed Coulomb friction linearises to its slope at rest)")
     p.add_argument("--json", action="store_true", help="print signals and poles as JSON")
     p.set_defaults(run=_linearize)
     return parser
@@ -159,7 +162,8 @@ def _linearize(args) -> int:
     from .linearize import linearize
     from .plant import build_plant
     plant = build_plant(args.model)
-    sys_ = linearize(plant)
+    params = dict(_key_value(s, "--param") for s in args.param)
+    sys_ = linearize(plant, params=params or None)
     poles = np.linalg.eigvals(np.asarray(sys_.A))
     pairs = [tuple(p.split(":", 1)) for p in args.pair] or [
         (f"u__{p.name}", f"{p.name}__velocity") for p in plant.scene.ptos]

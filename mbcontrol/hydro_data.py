@@ -137,7 +137,9 @@ def _run_bem(scene: Scene, dofs):
                          f"hydrodynamics of the scene's geometry (or a hydro.file)")
     bodies = []
     for body in scene.bodies:
-        body_dofs = tuple(d.split("__")[1] for d in dofs if d.split("__")[0] == body.name)
+        # solve only what the joints can move (and the scene allows): no more than needed
+        body_dofs = tuple(d.split("__")[1] for d in dofs if d.split("__")[0] == body.name
+                          and d.split("__")[1] in scene.hydro.dofs)
         if body.hydro and body_dofs:
             bodies.append(bem.BemBody(name=body.name, geometry=_geometry_dict(body.geometry),
                                       cog=body.cog, mass=body.mass,

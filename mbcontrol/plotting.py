@@ -23,6 +23,7 @@ def save(fig, path) -> Path:
     fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=path.suffix)
     os.close(fd)
     fig.savefig(tmp, dpi=120, bbox_inches="tight")
+    os.chmod(tmp, 0o644)                 # mkstemp makes 0600; figures are for everyone
     os.replace(tmp, path)
     return path
 

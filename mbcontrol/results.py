@@ -20,6 +20,7 @@ def save_dataset(ds: xr.Dataset, path) -> Path:
     os.close(fd)
     try:
         out.to_netcdf(tmp)
+        os.chmod(tmp, 0o644)             # mkstemp makes 0600
         os.replace(tmp, path)
     finally:
         if os.path.exists(tmp):

@@ -118,6 +118,7 @@ class HydroSettings:
     headings: tuple[float, ...] = (0.0,)       # rad, NED wave directions
     lid: bool = True
     radiation_tol: float = 0.01                # normalised RMS error of the radiation fit
+    dofs: tuple[str, ...] = DOF_NAMES          # rigid DOFs the BEM solves for, per body
 
 
 @dataclass(frozen=True)
@@ -314,7 +315,7 @@ def _drag(r: Reader) -> Drag:
 def _hydro(r: Reader, path: Path) -> HydroSettings:
     if r.empty:
         return HydroSettings()
-    r.allow("file", "panel_size", "omega", "headings", "lid", "radiation_tol")
+    r.allow("file", "panel_size", "omega", "headings", "lid", "radiation_tol", "dofs")
     file = r.string("file", default=None)
     omega = r.frequency_grid("omega")
     return HydroSettings(
@@ -323,4 +324,5 @@ def _hydro(r: Reader, path: Path) -> HydroSettings:
         omega=omega,
         headings=tuple(r.finite_list("headings", "angle", default=(0.0,))),
         lid=r.boolean("lid", default=True),
-        radiation_tol=r.positive("radiation_tol", None, default=0.01))
+        radiation_tol=r.positive("radiation_tol", None, default=0.01),
+        dofs=r.dof_list("dofs", default=DOF_NAMES))

@@ -187,26 +187,38 @@ class Reader:
         return tuple(d for d in _DOFS if d in value)   # canonical order
 
     def frequency_grid(self, key: str) -> tuple[float, ...]:
-        """A list of frequencies, or a table {min, max, n} for a uniform grid (rad/s)."""
+        """Frequencies (rad/s): a list of numbers, a segment {min, max, n, spacing, endpoint}
+        or a list of segments (joined, duplicates removed). spacing is "linear" (default) or
+        "log"; endpoint (default true) says whether max belongs to the segment."""
         value = self._get(key, ())
-        if isinstance(value, dict):
-            grid = Reader(value, self.file, self.field(key))
-            grid.allow("min", "max", "n")
-            lo = grid.positive("min", "frequency")
-            hi = grid.positive("max", "frequency")
-            n = grid.number("n", None)
-            if not (n >= 2 and float(n).is_integer()):
-                grid.fail("n", f"expected an integer number of frequencies >= 2, got {n}")
-            n = int(n)
-            if n > 100_000:
-                grid.fail("n", f"expected at most 100000 frequencies, got {n}")
-            if hi <= lo or n < 2:
-                self.fail(key, f"expected min < max and n >= 2, got {value}")
-            return tuple(np.linspace(lo, hi, n))
+        if isinstance(value, dict) or (isinstance(value, list) and value
+                                       and all(isinstance(v, dict) for v in value)):
+            segments = [value] if isinstance(value, dict) else value
+            parts = [self._segment(key if len(segments) == 1 else f"{key}[{i}]", seg)
+                     for i, seg in enumerate(segments)]
+            return tuple(np.unique(np.concatenate(parts)))
         values = self.number_list(key, "frequency", default=())
         if any(v <= 0 for v in values) or list(values) != sorted(set(values)):
             self.fail(key, "expected positive, strictly increasing frequencies (rad/s)")
         return tuple(values)
+
+    def _segment(self, where: str, value: dict) -> np.ndarray:
+        grid = Reader(value, self.file, self.field(where))
+        grid.allow("min", "max", "n", "spacing", "endpoint")
+        lo = grid.positive("min", "frequency")
+        hi = grid.positive("max", "frequency")
+        n = grid.number("n", None)
+        if not (n >= 2 and float(n).is_integer()):
+            grid.fail("n", f"expected an integer number of frequencies >= 2, got {n}")
+        n = int(n)
+        if n > 100_000:
+            grid.fail("n", f"expected at most 100000 frequencies, got {n}")
+        if hi <= lo:
+            self.fail(where, f"expected min < max, got {value}")
+        spacing = grid.choice("spacing", ("linear", "log"), default="linear")
+        endpoint = grid.boolean("endpoint", default=True)
+        make = np.geomspace if spacing == "log" else np.linspace
+        return make(lo, hi, n, endpoint=endpoint)
 
 
 def check_topology(scene, top: Reader):

@@ -1,25 +1,17 @@
 #!/usr/bin/env python3
-"""Regenerate the cached BEM data of the catalogue models into models/<name>_hydro.nc.
+"""Regenerate the precomputed BEM data of catalogue models from their scene files.
 
-The body definitions live in CATALOGUE below (n-frame NED inputs, SI units); later they will
-be read from the scene files. Each run goes through mbcontrol.hydro.compute, so a result is
-taken from the cache when the inputs have not changed, and the final body-frame dataset is
-copied from the cache next to this script (written to a temporary file, then renamed).
-
-Frequency grid of hinged_barge (150 frequencies, rad/s):
-- 0.3–2: 12 log-spaced points. A and B vary slowly here; B → 0 at the low end.
-- 2–15: uniform, Δω = 0.1. The heave/pitch resonances of the barges are near 6–9 rad/s and the
-  4 cm gap between the barges has a lightly damped potential-flow resonance near 10.2 rad/s
-  (half-width ≈ 0.3 rad/s), which a log grid would under-sample. A uniform grid also makes the
-  cosine transform for K(t) reliable up to t ≈ π/Δω ≈ 30 s.
-- 15–30: 7 more log-spaced points for the high-frequency tail that the radiation fit needs. Above
-  the dataset attribute ``omega_max_mesh`` (8 panel sizes per wavelength) the values lose accuracy.
+For each scene named (default: every catalogue scene with a [hydro] file), the bodies'
+geometry, mass and CoG and the [hydro] table (panel_size, omega, headings, dofs, lid) go
+through mbcontrol.hydro.compute; the body-frame result is copied next to the scene as its
+hydro file (written to a temporary file, then renamed). Scenes sharing one hydro file are
+solved once. A result is taken from the BEM cache when its inputs have not changed.
 
 Examples
 --------
-    python models/generate_hydro.py --timing-only          # 3 frequencies, prints the estimate
-    nice -n 10 python models/generate_hydro.py             # full run (about 10 min on one core)
-    python models/generate_hydro.py --fit-report           # radiation fit of the saved dataset
+    python models/generate_hydro.py --timing-only hinged_barge   # 3 frequencies, an estimate
+    nice -n 10 python models/generate_hydro.py hinged_barge      # full run (~7 min, one core)
+    python models/generate_hydro.py --fit-report hinged_barge    # radiation fit of the saved file
 """
 from __future__ import annotations
 
@@ -34,25 +26,31 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 
 
-def _grid():
+def bem_inputs(scene, panel_size: float | None = None) -> dict:
+    """Keyword arguments of mbcontrol.hydro.compute for a scene (cache and progress aside)."""
     import numpy as np
-    return np.unique(np.concatenate([np.geomspace(0.3, 2.0, 12, endpoint=False),
-                                     np.round(np.arange(2.0, 15.0 + 1e-9, 0.1), 10),
-                                     np.geomspace(15.0, 30.0, 8)[1:]]))
 
-
-def catalogue(panel_size: float | None = None) -> dict:
-    """name -> keyword arguments of mbcontrol.hydro.compute (except cache/progress)."""
     from mbcontrol.hydro import BemBody
+    from mbcontrol.hydro_data import _geometry_dict
 
-    rho, draft = 1000.0, 0.1
-    h = 0.02 if panel_size is None else panel_size
-    mass = rho * 0.6 * 0.3 * draft  # 18 kg: floats level with 0.1 m draft
-    barges = [BemBody(name=name, geometry={"type": "box", "size": [0.6, 0.3, 0.2], "center": [x, 0.0, 0.0]},
-                      cog=(x, 0.0, 0.0), mass=mass, panel_size=h, dofs=("Surge", "Heave", "Pitch"))
-              for name, x in (("barge1", 0.32), ("barge2", 0.96))]
-    return {"hinged_barge": dict(bodies=barges, rho=rho, g=9.81, depth=float("inf"), omegas=_grid(),
-                                 headings=(0.0,))}
+    h = scene.hydro
+    bodies = [BemBody(name=b.name, geometry=_geometry_dict(b.geometry), cog=b.cog, mass=b.mass,
+                      panel_size=panel_size or h.panel_size, dofs=h.dofs)
+              for b in scene.bodies if b.hydro and b.geometry is not None]
+    return dict(bodies=bodies, rho=scene.water.rho, g=scene.water.g, depth=scene.water.depth,
+                omegas=np.array(h.omega), headings=h.headings, lid=h.lid)
+
+
+def catalogue(names=None) -> dict:
+    """hydro file path -> the first scene (by name) that uses it."""
+    from mbcontrol.scene import list_models, load_scene
+
+    chosen = {}
+    for name in names or list_models():
+        scene = load_scene(name)
+        if scene.hydro.file and scene.hydro.omega and scene.hydro.file not in chosen:
+            chosen[scene.hydro.file] = scene
+    return chosen
 
 
 def _copy_atomic(src: Path, dst: Path) -> None:
@@ -91,8 +89,7 @@ def fit_report(path: Path, tol: float, omega_max: str | None) -> None:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--models", nargs="+", default=["hinged_barge"], help="catalogue entries to regenerate")
-    ap.add_argument("--out-dir", type=Path, default=HERE, help="where <name>_hydro.nc is written (default: models/)")
+    ap.add_argument("models", nargs="*", help="catalogue scene names (default: all with a hydro file)")
     ap.add_argument("--cache-dir", type=Path, default=Path.home() / ".cache" / "mbcontrol" / "hydro",
                     help="BEM cache folder (default: ~/.cache/mbcontrol/hydro)")
     ap.add_argument("--panel-size", type=float, default=None, help="override the panel size (m)")
@@ -108,16 +105,13 @@ def main(argv=None) -> int:
     import numpy as np
     from mbcontrol.hydro import compute
 
-    cat = catalogue(args.panel_size)
-    unknown = [m for m in args.models if m not in cat]
-    if unknown:
-        ap.error(f"unknown model(s) {unknown}; known: {sorted(cat)}")
-    for name in args.models:
-        out = args.out_dir / f"{name}_hydro.nc"
+    for file, scene in catalogue(args.models).items():
+        out = Path(file)
         if args.fit_report:
             fit_report(out, args.tol, args.fit_omega_max)
             continue
-        kw = dict(cat[name])
+        kw = bem_inputs(scene, args.panel_size)
+        name = scene.name
         if args.timing_only:
             w = kw["omegas"]
             kw["omegas"] = np.array([w[0], w[len(w) // 2], w[-1]])
