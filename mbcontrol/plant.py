@@ -43,6 +43,10 @@ class ProcessPlant:
     def name(self) -> str:
         return self.scene.name
 
+    def units(self, signal: str) -> str:
+        """SI unit of a named state, input, disturbance or output."""
+        return _units(self, signal)
+
     @property
     def nx(self) -> int:
         return len(self.states)
@@ -182,3 +186,43 @@ def _outputs(scene, topo: Topology, q, s, pto_signals, power):
     values += [power["radiated_power"], power["excitation_power"], power["energy"]]
     names += ["radiated_power", "excitation_power", "energy"]
     return ca.vertcat(*values), names
+
+
+_BODY_UNITS = {"Surge": ("m", "N"), "Sway": ("m", "N"), "Heave": ("m", "N"),
+               "Roll": ("rad", "N m"), "Pitch": ("rad", "N m"), "Yaw": ("rad", "N m")}
+_ENERGY_UNITS = {"radiated_power": "W", "excitation_power": "W", "energy": "J"}
+
+
+def _coordinate_unit(plant, name: str) -> str:
+    """rad for rotations, m for translations, from the joint that owns the coordinate."""
+    for joint in plant.scene.joints:
+        if name == joint.name:
+            if joint.type == "free":
+                return _BODY_UNITS[joint.dofs[0]][0]
+            return "rad" if joint.type == "revolute" else "m"
+        if name.startswith(joint.name + "__"):
+            return _BODY_UNITS[name.split("__")[-1]][0]
+    return ""
+
+
+def _units(plant, signal: str) -> str:
+    if signal in _ENERGY_UNITS:
+        return _ENERGY_UNITS[signal]
+    if signal.startswith("radiation_"):
+        return "internal"
+    if signal.startswith("w__"):
+        return _BODY_UNITS[signal.split("__")[-1]][1]
+    base = signal[3:] if signal.startswith("u__") else signal
+    for pto in plant.scene.ptos:
+        if base == pto.name or base.startswith(pto.name + "__"):
+            coord = _coordinate_unit(plant, pto.joint)
+            force = "N m" if coord == "rad" else "N"
+            kind = "force" if base == pto.name else base.split("__")[-1]
+            return {"position": coord, "velocity": f"{coord}/s", "force": force,
+                    "power": "W"}[kind]
+    if signal.endswith("__vel"):
+        return f"{_coordinate_unit(plant, signal[:-5])}/s"
+    if "__" in signal and signal.split("__")[-1] in _BODY_UNITS and \
+            signal.split("__")[0] in plant.topology.bodies:
+        return _BODY_UNITS[signal.split("__")[-1]][0]
+    return _coordinate_unit(plant, signal)

@@ -183,9 +183,10 @@ def _progress_bar(progress: bool, n: int):
 
 
 def _dataset(plant, t, X, U, W, Y, eta, wave, controller, method, dt, p, wall):
-    data = {name: ("time", Y[:, i]) for i, name in enumerate(plant.outputs)}
-    data.update({name: ("time", U[:, i]) for i, name in enumerate(plant.inputs)})
-    data.update({name: ("time", W[:, i]) for i, name in enumerate(plant.disturbances)})
+    data = {}
+    for names, values in ((plant.outputs, Y), (plant.inputs, U), (plant.disturbances, W)):
+        data.update({name: ("time", values[:, i], {"units": plant.units(name)})
+                     for i, name in enumerate(names)})
     data["eta"] = ("time", eta, {"units": "m", "long_name": "wave elevation at the origin, up"})
     data["state"] = (("time", "state_name"), X)
     ds = xr.Dataset(data, coords={"time": ("time", t, {"units": "s"}),

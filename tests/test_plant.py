@@ -212,3 +212,19 @@ def test_hinged_raft_free_floating():
     # released at maximum offset, the first upward zero crossing comes after 3/4 of a period;
     # 5 % covers the mooring damping (zeta ~ 0.04) and the coupling with heave and pitch
     assert t_cross[0] == pytest.approx(0.75 * expected, rel=0.05)
+
+
+def test_results_carry_units_and_round_trip(barge, tmp_path):
+    import xarray as xr
+
+    from mbcontrol.results import save_dataset
+    ds = simulate(barge, waves.irregular(0.03, 1.1, seed=4, duration=20.0), duration=20.0,
+                  dt=0.01, controller=make("passive", damping=1.0))
+    expected = {"pivot": "rad", "hinge__vel": "rad/s", "barge2__Heave": "m", "barge2__Pitch":
+                "rad", "hinge_pto__force": "N m", "hinge_pto__power": "W", "u__hinge_pto":
+                "N m", "w__barge2__Heave": "N", "w__barge2__Pitch": "N m", "energy": "J"}
+    assert {k: ds[k].attrs["units"] for k in expected} == expected
+    path = save_dataset(ds, tmp_path / "run.nc")
+    back = xr.load_dataset(path)
+    xr.testing.assert_identical(back, ds)            # values, coordinates and attrs
+    assert "tmp" not in " ".join(p.name for p in tmp_path.iterdir())   # no leftovers
