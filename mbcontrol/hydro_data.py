@@ -90,6 +90,19 @@ class HydroModel:
                     block[DOF_NAMES.index(name_i), DOF_NAMES.index(name_j)] = G[i, j]
         return out
 
+    def buoyancy(self, water) -> dict:
+        """body -> (rho g V in N, centre of buoyancy at rest in the n-frame, m)."""
+        if "displaced_volume" not in self.data or "center_of_buoyancy" not in self.data:
+            return {}
+        bodies = {d.split("__")[0] for d in self.dofs}
+        out = {}
+        for body in self.data["body"].values.tolist():
+            if body in bodies:
+                volume = float(self.data["displaced_volume"].sel(body=body))
+                centre = self.data["center_of_buoyancy"].sel(body=body).transpose("xyz").values
+                out[body] = (water.rho * water.g * volume, centre)
+        return out
+
     def radiation_matrices(self):
         """(A_r, B_r, C_r, D_r) in real modal form: same input-output map, sparse A_r."""
         r = self.radiation

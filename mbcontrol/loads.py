@@ -36,17 +36,54 @@ class Parameters:
 
 
 def pto_forces(scene: Scene, topo: Topology, q, s, u, params: Parameters):
-    """Generalised PTO force and, per PTO, its (position, velocity, force) expressions."""
+    """Generalised PTO force and, per PTO, its (position, velocity, force, force map).
+
+    Joint PTOs act on their coordinate; point-to-point PTOs along the line between their two
+    points (x: change of distance, m; equal and opposite forces on the two bodies). The force
+    map takes a scalar PTO force to the generalised force (used for preloads).
+    """
     tau = ca.SX.zeros(topo.tree.n_s)
     signals = {}
     for i, pto in enumerate(scene.ptos):
-        j = topo.coordinate_of_joint[pto.joint]
         c = params.add(f"{pto.name}__damping", pto.damping)
         k = params.add(f"{pto.name}__stiffness", pto.stiffness)
-        force = -(c * s[j] + k * q[j]) + u[i]
-        tau[j] += force
-        signals[pto.name] = (q[j], s[j], force)
+        if pto.between_points:
+            x, v, direction = _line(topo, q, s, pto)
+        else:
+            j = topo.coordinate_of_joint[pto.joint]
+            x, v, direction = q[j], s[j], ca.SX.zeros(topo.tree.n_s)
+            direction[j] = 1.0
+        force = -(c * v + k * x) + u[i]
+        tau += direction * force
+        signals[pto.name] = (x, v, force, direction)
     return tau, signals
+
+
+def _line(topo: Topology, q, s, pto):
+    """Stroke (m), stroke rate (m/s) and generalised direction of a point-to-point PTO.
+
+    The direction d satisfies: generalised force = d * F for a tension-positive force F
+    pushing the follower away from the parent point, and stroke rate = d^T s.
+    """
+    tree = topo.tree
+    q_rest = ca.DM.zeros(tree.n_q)
+    ends = []
+    for body, point in ((pto.body, pto.point), (pto.parent, pto.parent_point)):
+        if body == "ground":
+            ends.append((None, ca.DM(point), None))
+        else:
+            k = topo.body_index(body)
+            local = np.asarray(point) - topo.origin(body)
+            ends.append((k, tree.point(q, k, local), local))
+    (k1, p1, local1), (k2, p2, local2) = ends
+    delta = p1 - p2
+    length = ca.norm_2(delta)
+    rest = float(np.linalg.norm(np.subtract(pto.point, pto.parent_point)))
+    e = delta / length
+    direction = tree.point_force(q, k1, local1, e)
+    if k2 is not None:
+        direction -= tree.point_force(q, k2, local2, e)
+    return length - rest, ca.dot(direction, s), direction
 
 
 def friction_forces(scene: Scene, topo: Topology, s, params: Parameters):
@@ -89,7 +126,11 @@ def drag_forces(scene: Scene, topo: Topology, q, s, params: Parameters):
             i = DOF_NAMES.index(dof)
             c = params.add(f"{d.name}__{dof}", value)
             v = nu[6 * k + i]
-            wrench[i] = -c * ca.fabs(v) * v
+            wrench[i] -= c * ca.fabs(v) * v
+        for dof, value in d.linear.items():
+            i = DOF_NAMES.index(dof)
+            b = params.add(f"{d.name}__{dof}_linear", value)
+            wrench[i] -= b * nu[6 * k + i]
         tau += tree.generalized_force(q, k, wrench)
     return tau
 
@@ -112,6 +153,33 @@ def restoring_forces(topo: Topology, q, stiffness_by_body: dict):
     if not stiffness_by_body:
         return ca.SX.zeros(tree.n_s), 0
     return -ca.mtimes(tree.K(q).T, ca.gradient(potential, q)), potential
+
+
+def static_loads(scene: Scene, topo: Topology, q, buoyancy: dict):
+    """Constant loads at rest that linear hydrostatics leave out (ERRATA section 3, F0).
+
+    A hydro body whose weight m g differs from its buoyancy rho g V, or whose CoG is not above
+    its centre of buoyancy, carries a net static load: (m g - rho g V) down through its CoG
+    and, at rest, the couple of buoyancy about the CoG. They enter as constant n-frame loads
+    at the body, so their geometric stiffness (d2 z_c / dq2 terms) is exact.
+    buoyancy: body -> (rho g V (N), centre of buoyancy at rest, n-frame, m).
+    """
+    tree, tau = topo.tree, ca.SX.zeros(topo.tree.n_s)
+    for body in scene.bodies:
+        if not body.hydro or body.name not in buoyancy:
+            continue
+        k = topo.body_index(body.name)
+        lift, centre = buoyancy[body.name]
+        net = body.mass * scene.water.g - lift
+        arm = np.asarray(centre) - np.asarray(body.cog)
+        couple = np.cross(arm, [0.0, 0.0, -lift])            # n axes, about the CoG
+        wrench_n = ca.vertcat(ca.DM([0.0, 0.0, net]), ca.DM(couple))
+        if abs(net) < 1e-9 * max(lift, 1.0) and np.linalg.norm(couple) < 1e-9 * max(lift, 1.0):
+            continue
+        R = tree.rotation(q, k)                             # body -> n
+        wrench_b = ca.vertcat(ca.mtimes(R.T, wrench_n[:3]), ca.mtimes(R.T, wrench_n[3:]))
+        tau += tree.generalized_force(q, k, wrench_b)
+    return tau
 
 
 def gravity_forces(scene: Scene, topo: Topology, q):

@@ -10,6 +10,7 @@ CoG); parameters p (PTO, friction, mooring, drag coefficients) stay symbolic.
 """
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field
 
 import casadi as ca
@@ -120,6 +121,8 @@ def build_plant(scene: Scene | str, hydro: HydroModel | None = None, *,
     tau += loads.mooring_forces(scene, topo, q, s, params)
     tau += loads.drag_forces(scene, topo, q, s, params)
     tau += loads.gravity_forces(scene, topo, q)
+    tau += loads.static_loads(scene, topo, q, hydro.buoyancy(scene.water) if hydro else {})
+    tau += _preloads(scene, topo, q, s, u, w, chi, tau, pto_signals, params)
 
     M = tree.mass_matrix(q, added_mass)
     s_dot = ca.solve(M, tau)
@@ -140,6 +143,44 @@ def build_plant(scene: Scene | str, hydro: HydroModel | None = None, *,
     return ProcessPlant(scene, topo, hydro, tuple(states), tuple(inputs), tuple(disturbances),
                         tuple(output_names), tuple(params.names), np.array(params.values),
                         f, h, energy)
+
+
+def _preloads(scene, topo, q, s, u, w, chi, tau, pto_signals, params):
+    """Constant PTO forces that make rest an equilibrium (PTOs with preload = "balance").
+
+    The static generalised load at rest does not depend on the parameters (every
+    parametrised load vanishes at rest), so the preloads are solved once, here, and kept as
+    parameters (<pto>__preload, N or N m) that identification may change. Warns, naming the
+    coordinates, when rest is still not an equilibrium.
+    """
+    tree = topo.tree
+    rest = ca.Function("rest", [q, s, u, w, chi, params.vector], [tau])
+    n_p = len(params.names)
+    args = [np.zeros(tree.n_q), np.zeros(tree.n_s), np.zeros(u.shape[0]), np.zeros(w.shape[0]),
+            np.zeros(chi.shape[0]), np.array(params.values) if n_p else np.zeros(0)]
+    residual = np.asarray(rest(*args)).ravel()
+    balancing = [p for p in scene.ptos if p.preload == "balance"]
+    extra = ca.SX.zeros(tree.n_s)
+    if balancing:
+        d_fun = ca.Function("d", [q], [ca.horzcat(*[pto_signals[p.name][3] for p in balancing])])
+        D = np.asarray(d_fun(np.zeros(tree.n_q)))
+        f0, *_ = np.linalg.lstsq(D, -residual, rcond=None)
+        for pto, value, column in zip(balancing, f0, range(len(balancing))):
+            sym = params.add(f"{pto.name}__preload", float(value))
+            extra += pto_signals[pto.name][3] * sym
+        residual = residual + D @ f0
+    scale = max(1.0, float(np.max(np.abs(np.asarray(args[0])))))
+    if np.max(np.abs(residual), initial=0.0) > 1e-9 * scale * max(1.0, _load_scale(scene)):
+        worst = np.argsort(-np.abs(residual))[:3]
+        listing = ", ".join(f"{tree.coordinate_names[i]}: {residual[i]:.4g}" for i in worst)
+        warnings.warn(f"{scene.path}: rest is not an equilibrium; static generalised loads "
+                      f"{listing} (N or N m). Give a PTO preload = \"balance\", or correct "
+                      f"masses, CoGs or the hydro data", RuntimeWarning, stacklevel=3)
+    return extra
+
+
+def _load_scale(scene) -> float:
+    return max(b.mass for b in scene.bodies) * scene.water.g
 
 
 def active_hydro_dofs(scene: Scene, topo: Topology) -> list[str]:
@@ -179,7 +220,7 @@ def _outputs(scene, topo: Topology, q, s, pto_signals, power):
         displacement = tree.cog(q, k) - tree.cog(q_rest, k)
         values += [displacement, loads.euler_zyx(tree.rotation(q, k))]
         names += [f"{body}__{dof}" for dof in DOF_NAMES]
-    for pto, (position, velocity, force) in pto_signals.items():
+    for pto, (position, velocity, force, _) in pto_signals.items():
         values += [position, velocity, force, -force * velocity]
         names += [f"{pto}__position", f"{pto}__velocity", f"{pto}__force", f"{pto}__power"]
     # energy audit: radiated (W, leaving the bodies), wave input (W), kinetic + restoring (J)

@@ -74,12 +74,30 @@ class Joint:
 
 @dataclass(frozen=True)
 class Pto:
-    """Linear PTO on a one-coordinate joint: load on the child = -(damping*v + stiffness*x) + u."""
+    """A linear PTO: load on its follower = -(damping*v + stiffness*x) + u (+ preload).
+
+    Either on a one-coordinate joint (`joint`; x is the joint coordinate) or between two
+    points (`body`/`point` the follower, `parent`/`parent_point` the other end, "ground" or a
+    body; x is the change of the distance between them, the force acts along their line).
+    preload "balance": a constant force chosen so that rest is an equilibrium (the static
+    load the PTO carries, e.g. a float's weight on a motor).
+    """
     name: str
-    joint: str
+    joint: str | None = None
     damping: float = 0.0           # N s/m or N m s/rad
     stiffness: float = 0.0         # N/m or N m/rad
     force_max: float = math.inf    # N or N m; a limit controllers must respect
+    stroke_max: float = math.inf   # m or rad; a limit controllers must respect
+    efficiency: float = 1.0        # mechanical to electrical conversion, 0..1
+    body: str | None = None
+    point: tuple[float, float, float] | None = None        # m, n-frame at rest
+    parent: str = "ground"
+    parent_point: tuple[float, float, float] | None = None  # m, n-frame at rest
+    preload: str = "none"          # "none" | "balance"
+
+    @property
+    def between_points(self) -> bool:
+        return self.joint is None
 
 
 @dataclass(frozen=True)
@@ -104,10 +122,11 @@ class Mooring:
 
 @dataclass(frozen=True)
 class Drag:
-    """Quadratic drag per body DOF, -c|v|v on the CoG twist (body axes)."""
+    """Viscous loads per body DOF on the CoG twist (body axes): -c|v|v - b v."""
     name: str
     body: str
-    coefficients: dict[str, float] = field(default_factory=dict)  # DOF -> N s^2/m^2 or N m s^2
+    coefficients: dict[str, float] = field(default_factory=dict)  # quadratic: N s^2/m^2, N m s^2
+    linear: dict[str, float] = field(default_factory=dict)        # linear: N s/m, N m s/rad
 
 
 @dataclass(frozen=True)
@@ -119,6 +138,9 @@ class HydroSettings:
     lid: bool = True
     radiation_tol: float = 0.01                # normalised RMS error of the radiation fit
     dofs: tuple[str, ...] = DOF_NAMES          # rigid DOFs the BEM solves for, per body
+    source: str | None = None                  # third-party data (WAMIT .out, BEMIO .h5,
+                                               # Capytaine .nc) that `file` is converted from
+    source_bodies: tuple[str, ...] = ()        # scene body per body of the source, in order
 
 
 @dataclass(frozen=True)
@@ -150,6 +172,7 @@ class Scene:
         data = asdict(self)
         data.pop("path")
         data["hydro"]["file"] = _file_digest(self.hydro.file)
+        data["hydro"]["source"] = Path(self.hydro.source).name if self.hydro.source else None
         for body in data["bodies"]:
             if body["geometry"] and body["geometry"]["file"]:
                 body["geometry"]["file"] = _file_digest(body["geometry"]["file"])
@@ -276,11 +299,30 @@ def _joint(r: Reader) -> Joint:
 
 
 def _pto(r: Reader) -> Pto:
-    r.allow("name", "joint", "damping", "stiffness", "force_max")
-    return Pto(name=r.name(), joint=r.string("joint"),
+    r.allow("name", "joint", "damping", "stiffness", "force_max", "stroke_max", "efficiency",
+            "body", "point", "parent", "parent_point", "preload")
+    joint = r.string("joint", default=None)
+    points = {k: k in r.data for k in ("body", "point", "parent_point")}
+    if joint is not None and any(points.values()):
+        r.fail("joint", "expected either a joint or body/point/parent_point, not both")
+    if joint is None and not all(points.values()):
+        missing = [k for k, given in points.items() if not given]
+        r.fail(missing[0] if any(points.values()) else "joint",
+               "expected a joint, or body, point and parent_point for a PTO between points")
+    efficiency = r.positive("efficiency", None, default=1.0)
+    if efficiency > 1:
+        r.fail("efficiency", f"expected a number in (0, 1], got {efficiency}")
+    return Pto(name=r.name(), joint=joint,
                damping=r.nonnegative("damping", default=0.0),
                stiffness=r.finite("stiffness", default=0.0),
-               force_max=r.positive("force_max", None, default=math.inf, finite=False))
+               force_max=r.positive("force_max", None, default=math.inf, finite=False),
+               stroke_max=r.positive("stroke_max", None, default=math.inf, finite=False),
+               efficiency=efficiency,
+               body=r.string("body", default=None),
+               point=r.vector("point", "length", default=None),
+               parent=r.string("parent", default="ground"),
+               parent_point=r.vector("parent_point", "length", default=None),
+               preload=r.choice("preload", ("none", "balance"), default="none"))
 
 
 def _friction(r: Reader) -> Friction:
@@ -304,18 +346,25 @@ def _mooring(r: Reader) -> Mooring:
 
 
 def _drag(r: Reader) -> Drag:
-    r.allow("name", "body", "coefficients")
+    r.allow("name", "body", "coefficients", "linear")
     body = r.string("body")
-    coeffs = r.table("coefficients")
-    coeffs.allow(*DOF_NAMES)
-    values = {dof: coeffs.nonnegative(dof) for dof in DOF_NAMES if dof in coeffs.data}
-    return Drag(name=r.string("name", default=f"{body}_drag"), body=body, coefficients=values)
+    tables = {}
+    for key in ("coefficients", "linear"):
+        table = r.table(key, required=False)
+        table.allow(*DOF_NAMES)
+        tables[key] = {dof: table.nonnegative(dof) for dof in DOF_NAMES if dof in table.data}
+    if not tables["coefficients"] and not tables["linear"]:
+        r.fail("coefficients", "expected quadratic 'coefficients' or 'linear' damping per DOF")
+    return Drag(name=r.string("name", default=f"{body}_drag"), body=body,
+                coefficients=tables["coefficients"], linear=tables["linear"])
 
 
 def _hydro(r: Reader, path: Path) -> HydroSettings:
     if r.empty:
         return HydroSettings()
-    r.allow("file", "panel_size", "omega", "headings", "lid", "radiation_tol", "dofs")
+    r.allow("file", "panel_size", "omega", "headings", "lid", "radiation_tol", "dofs",
+            "source", "source_bodies")
+    source = r.string("source", default=None)
     file = r.string("file", default=None)
     omega = r.frequency_grid("omega")
     return HydroSettings(
@@ -325,4 +374,6 @@ def _hydro(r: Reader, path: Path) -> HydroSettings:
         headings=tuple(r.finite_list("headings", "angle", default=(0.0,))),
         lid=r.boolean("lid", default=True),
         radiation_tol=r.positive("radiation_tol", None, default=0.01),
-        dofs=r.dof_list("dofs", default=DOF_NAMES))
+        dofs=r.dof_list("dofs", default=DOF_NAMES),
+        source=str((path.parent / source).resolve()) if source else None,
+        source_bodies=tuple(r.string_list("source_bodies", default=())))

@@ -179,6 +179,12 @@ class Reader:
                            f"moments > 0), got eigenvalues {np.linalg.eigvalsh(matrix)}")
         return tuple(tuple(float(v) for v in row) for row in matrix)
 
+    def string_list(self, key: str, default=_REQUIRED) -> list[str]:
+        value = self._get(key, default)
+        if not isinstance(value, (list, tuple)) or not all(isinstance(v, str) for v in value):
+            self.fail(key, f"expected a list of strings, got {value!r}")
+        return list(value)
+
     def dof_list(self, key: str, default=_REQUIRED) -> tuple[str, ...]:
         value = self._get(key, default)
         if (not isinstance(value, (list, tuple)) or not value
@@ -271,8 +277,20 @@ def check_topology(scene, top: Reader):
             node = parent_of[node]
 
     one_dof = {j.name: j for j in joints if j.n_coordinates == 1}
+    for i, pto in enumerate(scene.ptos):
+        if pto.between_points:
+            if pto.body not in bodies:
+                raise SceneError(f"{where}: pto[{i}].body: unknown body {pto.body!r}")
+            if pto.parent != "ground" and pto.parent not in bodies:
+                raise SceneError(f"{where}: pto[{i}].parent: unknown body {pto.parent!r}; "
+                                 f"expected 'ground' or a body")
+            if np.linalg.norm(np.subtract(pto.point, pto.parent_point)) < 1e-9:
+                raise SceneError(f"{where}: pto[{i}].point: expected a point apart from "
+                                 f"parent_point (the line of action needs a direction)")
     for kind, items in (("pto", scene.ptos), ("friction", scene.frictions)):
         for i, item in enumerate(items):
+            if getattr(item, "between_points", False):
+                continue
             if item.joint not in one_dof:
                 known = ", ".join(one_dof) or "none"
                 raise SceneError(f"{where}: {kind}[{i}].joint: expected a joint with one "

@@ -118,6 +118,55 @@ def from_args(kind: str, *, height=None, period=None, hs=None, tp=None, gamma=3.
     raise ValueError(f"unknown wave type {kind!r}; expected regular, jonswap or pm")
 
 
+def from_elevation(t, eta, *, band: tuple[float, float] | None = None,
+                   ramp_time: float = 0.0, direction: float = 0.0) -> Wave:
+    """A wave reproducing a measured elevation record eta(t) at the n-frame origin (m, up).
+
+    t must be uniform. The record is decomposed by FFT into components omega_k = 2 pi k / T
+    (T = record length): exactly the periodic extension of the record. Components outside
+    `band` (rad/s; e.g. the hydro data's) and the mean are dropped, and the fraction of the
+    variance dropped is recorded in settings["dropped_variance"]. Excitation from this wave
+    equals the (non-causal) convolution of the record with the excitation impulse response.
+    """
+    t, eta = np.asarray(t, float), np.asarray(eta, float)
+    if t.ndim != 1 or t.size != eta.size or t.size < 4:
+        raise ValueError("from_elevation: expected 1-D t and eta of equal length (>= 4)")
+    step = t[1] - t[0]
+    if not np.allclose(np.diff(t), step, rtol=1e-6, atol=0):
+        raise ValueError("from_elevation: t must be uniformly spaced")
+    n = t.size
+    spectrum = np.fft.rfft(eta - eta.mean())
+    k = np.arange(spectrum.size)
+    d_omega = 2 * np.pi / (n * step)
+    omega = k * d_omega
+    amplitude = 2 * np.abs(spectrum) / n
+    if n % 2 == 0:
+        amplitude[-1] /= 2                       # the Nyquist term is not doubled
+    phase = np.angle(spectrum) - omega * t[0]    # the record may start at t0 != 0
+    keep = k > 0
+    if band is not None:
+        keep &= (omega >= band[0]) & (omega <= band[1])
+    total = np.sum(amplitude[k > 0] ** 2)
+    dropped = 1 - np.sum(amplitude[keep] ** 2) / total if total > 0 else 0.0
+    settings = {"record_s": float(n * step), "samples": int(n), "mean_m": float(eta.mean()),
+                "dropped_variance": float(dropped)}
+    return Wave("elevation", omega[keep], amplitude[keep], phase[keep], direction, ramp_time,
+                settings, d_omega)
+
+
+def excitation_impulse_response(omega_data, force_data, t) -> np.ndarray:
+    """Non-causal excitation impulse response K_e(t) (N/m per s), shape (len(t), n_dof).
+
+    K_e(t) = (1/pi) Re int_0^inf F(omega) exp(-i omega t) d omega, so that the excitation is
+    the convolution F(t) = int K_e(tau) eta(t - tau) d tau (exp(-i omega t) convention).
+    Trapezoidal quadrature on the data's grid; t may be negative (the response is non-causal).
+    """
+    omega_data = np.asarray(omega_data, float)
+    phases = np.exp(-1j * np.multiply.outer(np.asarray(t, float), omega_data))
+    integrand = phases[:, :, None] * np.asarray(force_data)[None, :, :]
+    return np.trapezoid(integrand, omega_data, axis=1).real / np.pi
+
+
 def excitation_series(wave: Wave, omega_data, force_data, t) -> np.ndarray:
     """Excitation time series (len(t), n_dof) from per-unit-amplitude complex coefficients.
 

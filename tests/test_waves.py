@@ -414,3 +414,46 @@ def test_from_args_builds_each_kind():
 def test_from_args_errors(kind, kwargs, message):
     with pytest.raises(ValueError, match=message):
         from_args(kind, **kwargs)
+
+
+def test_from_elevation_recovers_a_regular_wave():
+    """A sampled cosine is one FFT component: amplitude and phase come back exactly."""
+    from mbcontrol.waves import from_elevation
+    dt, n = 0.05, 2000                                 # 100 s record
+    t = 3.0 + np.arange(n) * dt                        # a record need not start at 0
+    w0 = 2 * np.pi * 7 / (n * dt)                      # on the record's frequency grid
+    eta = 0.2 + 0.5 * np.cos(w0 * t + 0.7)
+    wave = from_elevation(t, eta)
+    i = int(np.argmax(wave.amplitude))
+    # an on-grid sinusoid is exact in the DFT: round-off only
+    assert wave.omega[i] == pytest.approx(w0, rel=1e-12)
+    assert wave.amplitude[i] == pytest.approx(0.5, rel=1e-12)
+    assert np.angle(np.exp(1j * (wave.phase[i] - 0.7))) == pytest.approx(0.0, abs=1e-10)
+    np.testing.assert_allclose(wave.elevation(t), eta - 0.2, atol=1e-12)
+    assert wave.settings["mean_m"] == pytest.approx(0.2, rel=1e-12)
+
+
+def test_from_elevation_excitation_equals_irf_convolution():
+    """FFT route (components x F) vs the non-causal impulse-response convolution."""
+    from mbcontrol.waves import excitation_impulse_response, from_elevation, irregular
+    # F decays smoothly at both ends of its band, so K_e(t) is negligible beyond 30 s (an F
+    # cut off sharply, as data at a band edge, would give a slow 1/t tail to window instead)
+    w_data = np.linspace(0.05, 8.0, 800)
+    F = ((1.0 + 0.3j * w_data) * w_data**2 * np.exp(-0.25 * w_data**2))[:, None]
+    sea = irregular(1.0, 6.0, gamma=1.0, seed=3, duration=400.0, band=(0.4, 3.0))
+    dt = 0.1
+    t = np.arange(0, 400.0, dt)
+    eta = sea.elevation(t)
+    eta -= eta.mean()                                  # a static offset is not a wave
+    wave = from_elevation(t, eta, band=(0.05, 8.0))
+    fft_route = excitation_series(wave, w_data, F, t)[:, 0]
+    tau = np.arange(-30.0, 30.0 + dt / 2, dt)
+    K = excitation_impulse_response(w_data, F, tau)[:, 0]
+    # circular convolution: the record is periodic, as the FFT route assumes
+    shifts = np.round(tau / dt).astype(int)
+    sample = np.arange(0, t.size, 50)
+    conv = np.array([dt * np.sum(K * eta[(i - shifts) % t.size]) for i in sample])
+    ref = fft_route[sample]
+    # measured 1e-5 of the peak (quadrature of K_e and the 0.1 s convolution sum); 1e-4
+    # leaves room for platform round-off while any phase or sign error would be O(1)
+    assert np.max(np.abs(conv - ref)) < 1e-4 * np.max(np.abs(ref))
