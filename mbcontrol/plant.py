@@ -78,11 +78,13 @@ class ProcessPlant:
 
 
 def build_plant(scene: Scene | str, hydro: HydroModel | None = None, *,
-                radiation_tol: float | None = None) -> ProcessPlant:
+                radiation_tol: float | None = None, radiation: bool = True) -> ProcessPlant:
     """Assemble the process plant of a scene (a Scene, a scene file or a catalogue name).
 
     Hydrodynamics come from `hydro` or the scene's hydro.file; the radiation model is fitted
-    to `radiation_tol` (default: the scene's) on the DOFs the joints can move.
+    to `radiation_tol` (default: the scene's) on the DOFs the joints can move. With
+    radiation=False the plant has no radiation states: w is then the whole wave load on the
+    hydro DOFs (excitation minus radiation memory), as a direct-convolution reference needs.
     """
     scene = load_scene(scene) if not isinstance(scene, Scene) else scene
     topo = build_topology(scene)
@@ -96,7 +98,7 @@ def build_plant(scene: Scene | str, hydro: HydroModel | None = None, *,
     elif hydro is not None:
         hydro = hydro.restricted(hydro_dofs)
     n_w = len(hydro_dofs)
-    n_r = hydro.radiation.A.shape[0] if hydro else 0
+    n_r = hydro.radiation.A.shape[0] if hydro and radiation else 0
     w, chi = ca.SX.sym("w", n_w), ca.SX.sym("chi", n_r)
 
     params = loads.Parameters()
@@ -107,7 +109,10 @@ def build_plant(scene: Scene | str, hydro: HydroModel | None = None, *,
 
     tau = -tree.bias(q, s, added_mass)
     chi_dot, power = ca.SX(0, 1), {"radiated_power": 0, "excitation_power": 0}
-    if hydro:
+    if hydro and not radiation:
+        tau += ca.mtimes(P, ca.mtimes(select.T, w))
+        power = {"radiated_power": 0, "excitation_power": ca.dot(nu_h, w)}
+    elif hydro:
         A_r, B_r, C_r, D_r = hydro.radiation_matrices()
         mu_h = ca.mtimes(C_r, chi) + ca.mtimes(D_r, nu_h)
         chi_dot = ca.mtimes(A_r, chi) + ca.mtimes(B_r, nu_h)

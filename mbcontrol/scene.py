@@ -141,6 +141,7 @@ class HydroSettings:
     source: str | None = None                  # third-party data (WAMIT .out, BEMIO .h5,
                                                # Capytaine .nc) that `file` is converted from
     source_bodies: tuple[str, ...] = ()        # scene body per body of the source, in order
+    source_options: dict = field(default_factory=dict)   # reader/cleaning options, see below
 
 
 @dataclass(frozen=True)
@@ -363,7 +364,7 @@ def _hydro(r: Reader, path: Path) -> HydroSettings:
     if r.empty:
         return HydroSettings()
     r.allow("file", "panel_size", "omega", "headings", "lid", "radiation_tol", "dofs",
-            "source", "source_bodies")
+            "source", "source_bodies", "source_options")
     source = r.string("source", default=None)
     file = r.string("file", default=None)
     omega = r.frequency_grid("omega")
@@ -376,4 +377,21 @@ def _hydro(r: Reader, path: Path) -> HydroSettings:
         radiation_tol=r.positive("radiation_tol", None, default=0.01),
         dofs=r.dof_list("dofs", default=DOF_NAMES),
         source=str((path.parent / source).resolve()) if source else None,
-        source_bodies=tuple(r.string_list("source_bodies", default=())))
+        source_bodies=tuple(r.string_list("source_bodies", default=())),
+        source_options=_source_options(r.table("source_options", required=False)))
+
+
+def _source_options(r: Reader) -> dict:
+    """Options for reading and cleaning third-party hydro data (mbcontrol.hydro.readers)."""
+    r.allow("force_symmetric", "negative_damping", "omega_range", "asym_tol")
+    out = {}
+    if "force_symmetric" in r.data:
+        out["force_symmetric"] = r.boolean("force_symmetric")
+    if "negative_damping" in r.data:
+        out["negative_damping"] = r.choice("negative_damping", ("repair", "project", "error"))
+    if "omega_range" in r.data:
+        lo, hi = r.number_list("omega_range", "frequency")
+        out["omega_range"] = (lo, hi)
+    if "asym_tol" in r.data:
+        out["asym_tol"] = r.positive("asym_tol")
+    return out

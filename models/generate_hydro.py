@@ -1,11 +1,13 @@
 #!/usr/bin/env python3
-"""Regenerate the precomputed BEM data of catalogue models from their scene files.
+"""Regenerate the precomputed hydro data of catalogue models from their scene files.
 
-For each scene named (default: every catalogue scene with a [hydro] file), the bodies'
-geometry, mass and CoG and the [hydro] table (panel_size, omega, headings, dofs, lid) go
-through mbcontrol.hydro.compute; the body-frame result is copied next to the scene as its
-hydro file (written to a temporary file, then renamed). Scenes sharing one hydro file are
-solved once. A result is taken from the BEM cache when its inputs have not changed.
+For each scene named (default: every catalogue scene with a [hydro] file): if [hydro] names a
+`source` (WAMIT .out, BEMIO .h5, Capytaine .nc), it is read, cleaned and mapped to body frames
+at the scene's CoGs; otherwise the bodies' geometry, mass and CoG and the [hydro] table
+(panel_size, omega, headings, dofs, lid) go through mbcontrol.hydro.compute (Capytaine). The
+body-frame result is written next to the scene as its hydro file (to a temporary file, then
+renamed). Scenes sharing one hydro file are made once; BEM results come from the cache when
+their inputs have not changed.
 
 Examples
 --------
@@ -42,15 +44,40 @@ def bem_inputs(scene, panel_size: float | None = None) -> dict:
 
 
 def catalogue(names=None) -> dict:
-    """hydro file path -> the first scene (by name) that uses it."""
+    """hydro file path -> the first scene (by name) that makes it (a BEM grid or a source)."""
     from mbcontrol.scene import list_models, load_scene
 
     chosen = {}
     for name in names or list_models():
         scene = load_scene(name)
-        if scene.hydro.file and scene.hydro.omega and scene.hydro.file not in chosen:
-            chosen[scene.hydro.file] = scene
+        h = scene.hydro
+        if h.file and (h.omega or h.source) and h.file not in chosen:
+            chosen[h.file] = scene
     return chosen
+
+
+def convert(scene, out: Path) -> None:
+    """Third-party data (scene.hydro.source) -> body-frame dataset at the scene's CoGs."""
+    from mbcontrol.hydro import write_netcdf_atomic
+    from mbcontrol.hydro.readers import read_hydro, to_scene_frames
+
+    h = scene.hydro
+    if not Path(h.source).exists():
+        raise SystemExit(f"{scene.path}: hydro.source {h.source} does not exist")
+    t0 = time.perf_counter()
+    # only the DOFs the scene declares (e.g. heave for sliders): asymmetric or non-passive
+    # data in DOFs the scene never moves must not block it
+    bodies = list(h.source_bodies) or [b.name for b in scene.bodies if b.hydro]
+    dofs = [f"{b}__{d}" for b in bodies for d in h.dofs]
+    data = read_hydro(h.source, body_names=bodies, dofs=dofs, **h.source_options)
+    cogs = {b.name: b.cog for b in scene.bodies if b.hydro}
+    body_frames = to_scene_frames(data, cogs)
+    for note in data.attrs.get("notes", []) if isinstance(data.attrs.get("notes"), list) else []:
+        print(f"  note: {note}")
+    body_frames.attrs["converted_from"] = Path(h.source).name
+    write_netcdf_atomic(body_frames, out)
+    print(f"{scene.name}: wrote {out} from {Path(h.source).name} "
+          f"({body_frames.sizes['omega']} frequencies, {time.perf_counter() - t0:.1f} s)")
 
 
 def _copy_atomic(src: Path, dst: Path) -> None:
@@ -109,6 +136,9 @@ def main(argv=None) -> int:
         out = Path(file)
         if args.fit_report:
             fit_report(out, args.tol, args.fit_omega_max)
+            continue
+        if scene.hydro.source:
+            convert(scene, out)
             continue
         kw = bem_inputs(scene, args.panel_size)
         name = scene.name

@@ -1,5 +1,7 @@
 """Every catalogue model loads, builds and rests in equilibrium, and its precomputed hydro
 data were made from what its scene file says (so regenerating reproduces them)."""
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -18,8 +20,12 @@ def test_hydro_file_matches_scene(name):
     assert data.attrs["depth"] == scene.water.depth
     if scene.hydro.omega:       # the grid the scene asks for is the grid in the file
         np.testing.assert_allclose(data["omega"].values, scene.hydro.omega, rtol=1e-12)
+    if scene.hydro.source:      # converted from third-party data: which file, mapped how
+        assert data.attrs["converted_from"] == Path(scene.hydro.source).name
     for body in (b for b in scene.bodies if b.hydro):
-        np.testing.assert_allclose(data["mass"].sel(body=body.name).values, body.mass)
+        if "mass" in data:      # a BEM run of ours records the mass it used
+            np.testing.assert_allclose(data["mass"].sel(body=body.name).values, body.mass)
+        # the body frames are at the scene's CoGs
         np.testing.assert_allclose(data["cog"].sel(body=body.name).values, body.cog)
         dofs = {d.split("__")[1] for d in data["radiating_dof"].values.tolist()
                 if d.startswith(body.name + "__")}
@@ -30,5 +36,7 @@ def test_hydro_file_matches_scene(name):
 def test_model_builds_at_rest(name):
     plant = build_plant(name)
     xdot = np.asarray(plant.f(plant.x0(), 0, 0, plant.p0)).ravel()
-    assert np.max(np.abs(xdot)) < 1e-12          # rest is an equilibrium, exactly
+    # rest is an equilibrium: masses are given to ~10 digits (rho V), so the drift left is
+    # below 1e-9 g, nothing a simulation could show
+    assert np.max(np.abs(xdot)) < 1e-9 * plant.scene.water.g
     assert plant.hydro.radiation.fit_error <= load_scene(name).hydro.radiation_tol
