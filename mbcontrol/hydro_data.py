@@ -36,6 +36,7 @@ class HydroModel:
     data: xr.Dataset                   # body-frame BEM data on `dofs`
     radiation: "bem.RadiationModel"
     source: str
+    fit_omega_max: float = np.inf      # rad/s, the scene's radiation fit band limit
 
     def _matrix(self, name: str) -> np.ndarray:
         """(..., influenced, radiating) array: rows are the DOFs the force acts on."""
@@ -122,8 +123,9 @@ class HydroModel:
         if missing:
             raise HydroError(f"{self.source}: the plant moves {missing} but the hydro model "
                              f"only has {list(self.dofs)}")
-        return HydroModel(dofs, self.data, _fit_cached(self.data, dofs, None, self.source),
-                          self.source)
+        return HydroModel(dofs, self.data, _fit_cached(self.data, dofs, None, self.source,
+                                                       self.fit_omega_max),
+                          self.source, self.fit_omega_max)
 
     def frequency_domain_matrices(self, omega):
         """A(omega), B(omega) interpolated to omega (n, n_dof, n_dof), for FD solutions."""
@@ -141,7 +143,8 @@ def load_hydro_model(scene: Scene, dofs, tol: float | None = None) -> HydroModel
     else:
         source, data = _run_bem(scene, dofs)
     _check_dofs(data, dofs, source)
-    return HydroModel(tuple(dofs), data, _fit_cached(data, tuple(dofs), tol, source), source)
+    fit = _fit_cached(data, tuple(dofs), tol, source, scene.hydro.fit_omega_max)
+    return HydroModel(tuple(dofs), data, fit, source, scene.hydro.fit_omega_max)
 
 
 def _run_bem(scene: Scene, dofs):
@@ -186,25 +189,29 @@ def _check_dofs(data: xr.Dataset, dofs, source: str) -> None:
                          f"has only {sorted(have)}")
 
 
-def fit_band_limit(data: xr.Dataset) -> float | None:
-    """Highest frequency the radiation fit uses: where the BEM mesh is still resolved.
+def fit_band_limit(data: xr.Dataset, scene_limit: float = np.inf) -> float | None:
+    """Highest frequency the radiation fit uses: the scene's fit_omega_max, and for our own
+    BEM runs no higher than where the mesh is still resolved.
 
     Above `omega_max_mesh` (fewer than 8 panels per wavelength) panel-method damping loses
-    accuracy and even passivity, so fitting it would spend states on numerical artefacts.
+    accuracy and even passivity; third-party files carry irregular-frequency spikes the scene
+    can exclude. Fitting either would spend states on numerical artefacts.
     """
-    limit = data.attrs.get("omega_max_mesh")
-    return float(limit) if limit is not None and np.isfinite(limit) else None
+    limit = min(float(data.attrs.get("omega_max_mesh", np.inf)), float(scene_limit))
+    return limit if np.isfinite(limit) else None
 
 
-def _fit_cached(data: xr.Dataset, dofs, tol, source: str):
+def _fit_cached(data: xr.Dataset, dofs, tol, source: str, omega_max: float = np.inf):
     """fit_radiation with an on-disk cache keyed by the data, the DOFs and the tolerance."""
     tol = 0.01 if tol is None else tol
     digest = hashlib.sha256()
     for var in ("added_mass", "radiation_damping", "added_mass_inf"):
         digest.update(np.ascontiguousarray(data[var].values).tobytes())
     # the fitting code is part of the key: a changed algorithm never serves an old fit
-    digest.update(Path(bem.radiation.__file__).read_bytes())
-    digest.update(json.dumps([list(dofs), tol, fit_band_limit(data)]).encode())
+    for module in (bem.radiation, bem.passivity):
+        digest.update(Path(module.__file__).read_bytes())
+    band = fit_band_limit(data, omega_max)
+    digest.update(json.dumps([list(dofs), tol, band]).encode())
     path = cache_dir() / f"radiation_{digest.hexdigest()[:20]}.npz"
     if path.exists():
         try:
@@ -212,7 +219,7 @@ def _fit_cached(data: xr.Dataset, dofs, tol, source: str):
                 return _model_from_arrays(z)
         except (OSError, ValueError, KeyError):
             path.unlink(missing_ok=True)       # a stale or foreign file: refit
-    model = bem.fit_radiation(data, dofs=list(dofs), tol=tol, omega_max=fit_band_limit(data))
+    model = bem.fit_radiation(data, dofs=list(dofs), tol=tol, omega_max=band)
     fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".npz.tmp")
     os.close(fd)
     with open(tmp, "wb") as fh:

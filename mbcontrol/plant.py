@@ -261,7 +261,7 @@ def _units(plant, signal: str) -> str:
     base = signal[3:] if signal.startswith("u__") else signal
     for pto in plant.scene.ptos:
         if base == pto.name or base.startswith(pto.name + "__"):
-            coord = _coordinate_unit(plant, pto.joint)
+            coord = "m" if pto.between_points else _coordinate_unit(plant, pto.joint)
             force = "N m" if coord == "rad" else "N"
             kind = "force" if base == pto.name else base.split("__")[-1]
             return {"position": coord, "velocity": f"{coord}/s", "force": force,

@@ -137,6 +137,7 @@ class HydroSettings:
     headings: tuple[float, ...] = (0.0,)       # rad, NED wave directions
     lid: bool = True
     radiation_tol: float = 0.01                # normalised RMS error of the radiation fit
+    fit_omega_max: float = math.inf            # rad/s: fit the radiation model below this
     dofs: tuple[str, ...] = DOF_NAMES          # rigid DOFs the BEM solves for, per body
     source: str | None = None                  # third-party data (WAMIT .out, BEMIO .h5,
                                                # Capytaine .nc) that `file` is converted from
@@ -364,7 +365,7 @@ def _hydro(r: Reader, path: Path) -> HydroSettings:
     if r.empty:
         return HydroSettings()
     r.allow("file", "panel_size", "omega", "headings", "lid", "radiation_tol", "dofs",
-            "source", "source_bodies", "source_options")
+            "source", "source_bodies", "source_options", "fit_omega_max")
     source = r.string("source", default=None)
     file = r.string("file", default=None)
     omega = r.frequency_grid("omega")
@@ -376,6 +377,7 @@ def _hydro(r: Reader, path: Path) -> HydroSettings:
         lid=r.boolean("lid", default=True),
         radiation_tol=r.positive("radiation_tol", None, default=0.01),
         dofs=r.dof_list("dofs", default=DOF_NAMES),
+        fit_omega_max=r.positive("fit_omega_max", "frequency", default=math.inf, finite=False),
         source=str((path.parent / source).resolve()) if source else None,
         source_bodies=tuple(r.string_list("source_bodies", default=())),
         source_options=_source_options(r.table("source_options", required=False)))

@@ -70,3 +70,16 @@ def test_errors_are_clear(capsys):
     code, _, err = run(capsys, "simulate", "hinged_barge", "--height", "0.02", "--period", "1",
                        "--controller", "passive", "--set", "damping")
     assert code == 1 and "KEY=VALUE" in err
+
+
+@pytest.mark.parametrize("model", ["rm3", "sphere", "wavestar"])
+def test_simulate_issue3_models(capsys, model):
+    """Issue 3: `mbcontrol simulate MODEL --wave regular --height 2.5 --period 8 --json`
+    (the tank-scale wavestar in a proportionate wave of its own band)."""
+    height, period = ("0.0625", "1.412") if model == "wavestar" else ("2.5", "8")
+    code, out, _ = run(capsys, "simulate", model, "--wave", "regular", "--height", height,
+                       "--period", period, "--duration", "40", "--json")
+    assert code == 0
+    result = json.loads(out)
+    pto = next(iter(result["ptos"].values()))
+    assert pto["mean_power_W"] > 0 and pto["max_stroke"] > 0       # a damper absorbs

@@ -15,10 +15,13 @@ from .bem import cache_key, compute, matrix
 from .frames import dof_map, shift_matrix, skew, to_body_frames, zup_to_ned
 from .geometry import RIGID_DOFS, BemBody, hull_mesh, lid_mesh, validate_body
 from .radiation import RadiationModel, convolution_force, fit_radiation, impulse_response, kernel_data
+from .passivity import PassivityReport, absorbed_energy, enforce_passivity, passivity_test
+from .baseline import fit_radiation_hankel
 
 __all__ = [
     "read_netcdf", "write_netcdf_atomic",
     "BemBody", "RIGID_DOFS", "compute", "cache_key", "matrix", "validate_body", "hull_mesh", "lid_mesh",
     "to_body_frames", "dof_map", "shift_matrix", "skew", "zup_to_ned",
     "RadiationModel", "fit_radiation", "impulse_response", "convolution_force", "kernel_data",
+    "PassivityReport", "passivity_test", "enforce_passivity", "absorbed_energy", "fit_radiation_hankel",
 ]
