@@ -31,6 +31,9 @@ test: $(VENV)/.installed-test
 
 bench: $(VENV)/.installed-test
 	$(PY) benchmarks/run.py --out $(OUT)/bench
+	$(PY) benchmarks/radiation_fit.py --tols 0.1 0.05 0.02 0.01 --out $(OUT)/bench/radiation_barge
+	$(PY) benchmarks/radiation_fit.py --file models/rm3_hydro.nc --omega-max 3.0 \
+	    --tols 0.1 0.05 0.02 0.01 --out $(OUT)/bench/radiation_rm3
 
 clean:
 	rm -rf $(OUT) .pytest_cache

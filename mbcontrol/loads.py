@@ -66,7 +66,6 @@ def _line(topo: Topology, q, s, pto):
     pushing the follower away from the parent point, and stroke rate = d^T s.
     """
     tree = topo.tree
-    q_rest = ca.DM.zeros(tree.n_q)
     ends = []
     for body, point in ((pto.body, pto.point), (pto.parent, pto.parent_point)):
         if body == "ground":

@@ -15,10 +15,8 @@ from dataclasses import dataclass, field
 
 import casadi as ca
 import numpy as np
-import xarray as xr
 
 from . import loads
-from .errors import HydroError
 from .hydro_data import HydroModel, load_hydro_model
 from .scene import DOF_NAMES, Scene, load_scene
 from .topology import Topology, build_topology

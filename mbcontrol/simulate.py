@@ -11,7 +11,6 @@ import platform
 import time
 from importlib import metadata
 
-import casadi as ca
 import numpy as np
 import xarray as xr
 

@@ -221,7 +221,7 @@ def _lyap_map(A, N, L, R):
 
     Modal formula P = V⁻ᵀ[(VᵀNQ̃NᵀV) ⊘ S]V⁻¹, S_ij = -(λ_i + λ_j), when A's eigenvectors are
     well conditioned; otherwise one Lyapunov solve per basis matrix of Q̃."""
-    n, r = A.shape[0], N.shape[1]
+    r = N.shape[1]
     lam, V = np.linalg.eig(A)
     if np.linalg.cond(V) < 1e8:
         Vi = np.linalg.inv(V)

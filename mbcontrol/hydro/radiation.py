@@ -313,7 +313,6 @@ def _densify(w, K, max_step=DENSE_STEP):
 
 def _groups(K):
     """Connected components of the coupling graph of K (nω, n, n)."""
-    n = K.shape[1]
     mag = np.max(np.abs(K), axis=0)
     d = np.sqrt(np.diag(mag))
     link = mag > ZERO_COUPLING * np.outer(d, d)
@@ -384,7 +383,6 @@ def _fit_group(w, Kg, pattern, tol, max_order, n_iter, dc_zero, refit, M1=None, 
     sc = 1.0 / np.sqrt(np.max(np.abs(np.einsum("kii->ki", Kg)), axis=0))
     G = Kg * sc[None, :, None] * sc[None, None, :]
     ent = [(i, j) for i in range(m) for j in range(m) if pattern[i, j]]
-    H = np.stack([G[:, i, j] for i, j in ent], axis=1)
     M1s = None if M1 is None else M1 * sc[:, None] * sc[None, :]  # scaled like G
     nd = w.size
     # Above the band the data say nothing. Lightly weighted points of an extrapolation keep the

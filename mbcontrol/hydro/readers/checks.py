@@ -18,6 +18,7 @@ import numpy as np
 import xarray as xr
 
 from mbcontrol.errors import HydroError
+from mbcontrol.hydro.bem import _UNITS as BODY_FRAME_UNITS
 from mbcontrol.hydro.frames import split_dof
 from mbcontrol.hydro.geometry import RIGID_DOFS
 
@@ -26,19 +27,10 @@ WRENCH = ("wave_direction", "omega", "influenced_dof")
 MATRIX_LAYOUT = "X[radiating_dof, influenced_dof]; force_i = -sum_j X[j, i] * motion_j"
 TIME_CONVENTION = "exp(-i omega t)"
 DATA_FRAME = "BEM data frame: z up, x forward, y port, origin on the undisturbed free surface"
-UNITS = {
-    "added_mass": "kg, kg m, kg m^2 (translation/rotation DOF pairs)",
-    "added_mass_inf": "kg, kg m, kg m^2 (translation/rotation DOF pairs)",
-    "added_mass_zero": "kg, kg m, kg m^2 (translation/rotation DOF pairs)",
-    "radiation_damping": "kg/s, kg m/s, kg m^2/s (translation/rotation DOF pairs)",
-    "excitation_force": "N/m, N m/m (per m of wave amplitude)",
-    "froude_krylov_force": "N/m, N m/m (per m of wave amplitude)",
-    "diffraction_force": "N/m, N m/m (per m of wave amplitude)",
-    "hydrostatic_stiffness": "N/m, N, N m (translation/rotation DOF pairs; rotations in rad)",
-    "displaced_volume": "m^3", "waterplane_area": "m^2",
-    "center_of_buoyancy": "m (data frame, z up)", "cog": "m (data frame, z up)",
-    "reference_point": "m (data frame, z up)",
-}
+# the body-frame units of bem.py, with positions in the data frame (before to_body_frames)
+UNITS = {**{k: v for k, v in BODY_FRAME_UNITS.items() if k != "mass"},
+         "center_of_buoyancy": "m (data frame, z up)", "cog": "m (data frame, z up)",
+         "reference_point": "m (data frame, z up)"}
 # Defaults of clean(); documented there.
 ASYM_TOL = 1e-3
 DIAG_TOL = 1e-6
