@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from . import plotting, waves
-from .analysis import frequency_domain_response, statespace_response, steady_state_initial
+from .analysis import frequency_domain_response, regular_wave_amplitudes, statespace_response
 from .linearize import linearize
 from .metrics import summary
 from .plant import build_plant
@@ -101,15 +101,7 @@ def validate(plant, sys, out: Path) -> dict:
     names = ["hinge", "barge2__Heave"]
     fd = np.abs(frequency_domain_response(plant, omegas, params=NO_COULOMB, outputs=names))
     ss = np.abs(statespace_response(sys, plant, omegas, outputs=names))
-    td = np.empty_like(fd)
-    height = 0.01
-    for i, w in enumerate(omegas):
-        period = 2 * np.pi / w
-        wave = waves.regular(height, period, ramp_time=0.0)
-        ds = simulate(plant, wave, duration=14 * period, dt=period / 200, params=NO_COULOMB,
-                      x0=steady_state_initial(sys, plant, wave))
-        last = ds["time"].values >= ds["time"].values[-1] - 10 * period
-        td[i] = [0.5 * np.ptp(ds[n].values[last]) / (height / 2) for n in names]
+    td = regular_wave_amplitudes(plant, sys, omegas, names, height=0.01, params=NO_COULOMB)
     dense = np.geomspace(2.0, 20.0, 200)
     fd_dense = np.abs(frequency_domain_response(plant, dense, params=NO_COULOMB, outputs=names))
     plotting.response_comparison(dense, {
