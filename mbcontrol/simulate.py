@@ -25,9 +25,9 @@ def simulate(plant, wave=None, *, duration: float, dt: float = 0.01, controller=
 
     params: a dict of parameter overrides or a full vector. With a controller, the PTO force
     is the controller's command alone: the scene's PTO damping and stiffness are zeroed
-    unless params sets them. Returns a Dataset over time with
-    every plant output, the applied inputs u, the excitation w, the wave elevation `eta` and
-    the states, plus provenance in attrs (wall_time_s is the time-stepping alone).
+    unless params sets them. Returns a Dataset over time with every plant output, the
+    applied inputs u, the excitation w, the wave elevation `eta` and the states, plus
+    provenance in attrs (wall_time_s is the time-stepping alone).
     """
     if duration <= 0 or dt <= 0 or dt > duration:
         raise ValueError(f"expected 0 < dt <= duration, got dt={dt}, duration={duration}")
@@ -42,14 +42,16 @@ def simulate(plant, wave=None, *, duration: float, dt: float = 0.01, controller=
     bar = _progress_bar(progress, n)
     check = _divergence_check(plant, dt, bar)
 
+    # a controller with a CasADi law held for one step runs inside the compiled code
+    law = controller.casadi_law(plant) if controller is not None and method == "rk4" else None
+    embedded = controller is None or (law is not None and _period(controller, dt) == dt)
     if method == "rk4":                  # compile first: wall_time_s is the stepping alone
-        law = controller.casadi_law(plant) if controller is not None else None
-        steps = n if controller is None or (law is not None and _period(controller, dt) == dt) \
-            else _steps_per_period(_period(controller, dt), dt)
-        integrators.prepare_rk4(plant, steps, law if steps == n else None, compiled)
+        steps = n if embedded else _steps_per_period(_period(controller, dt), dt)
+        integrators.prepare_rk4(plant, steps, law if embedded else None, compiled)
     start = time.perf_counter()
     if method == "rk4":
-        X, U = _run_rk4(plant, controller, x0, W_half, p, dt, n, compiled, check)
+        X, U = _run_rk4(plant, controller, law if embedded else None, embedded, x0, W_half, p,
+                        dt, n, compiled, check)
     elif method == "cvodes":
         X, U = _run_cvodes(plant, wave, controller, x0, p, dt, n, rtol, check)
     else:
@@ -86,10 +88,9 @@ def _parameters(plant, params, controller) -> np.ndarray:
     return plant.params(**overrides)
 
 
-def _run_rk4(plant, controller, x0, W_half, p, dt, n, compiled, check):
+def _run_rk4(plant, controller, law, embedded, x0, W_half, p, dt, n, compiled, check):
     nu = len(plant.inputs)
-    law = controller.casadi_law(plant) if controller is not None else None
-    if controller is None or (law is not None and _period(controller, dt) == dt):
+    if embedded:
         return integrators.run_rk4(plant, x0, np.zeros((n, nu)), W_half, p, dt, law=law,
                                    compiled=compiled, on_chunk=check)
     m = _steps_per_period(_period(controller, dt), dt)
