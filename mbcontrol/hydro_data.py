@@ -2,7 +2,8 @@
 
 `HydroModel` holds body-frame BEM data (NED, at each CoG, exp(-i omega t); see mbcontrol.hydro)
 for the active DOFs and the radiation state-space model fitted to them. Fits are cached on disk
-(keyed by the data, the DOFs and the tolerance), written to a temporary file and renamed.
+(keyed by the data, the DOFs, the tolerance, the fit band and the fitting code), written to a
+temporary file and renamed.
 """
 from __future__ import annotations
 
