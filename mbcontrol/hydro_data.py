@@ -158,7 +158,7 @@ def _run_bem(scene: Scene, dofs):
         body_dofs = tuple(d.split("__")[1] for d in dofs if d.split("__")[0] == body.name
                           and d.split("__")[1] in scene.hydro.dofs)
         if body.hydro and body_dofs:
-            bodies.append(bem.BemBody(name=body.name, geometry=_geometry_dict(body.geometry),
+            bodies.append(bem.BemBody(name=body.name, geometry=geometry_dict(body.geometry),
                                       cog=body.cog, mass=body.mass,
                                       panel_size=scene.hydro.panel_size, dofs=body_dofs))
     data = bem.compute(bodies, rho=scene.water.rho, g=scene.water.g, depth=scene.water.depth,
@@ -167,7 +167,7 @@ def _run_bem(scene: Scene, dofs):
     return f"BEM of {scene.path}", data
 
 
-def _geometry_dict(geometry) -> dict:
+def geometry_dict(geometry) -> dict:
     g = {"type": geometry.kind, "center": list(geometry.center)}
     for key in ("size", "radius", "length", "file"):
         value = getattr(geometry, key)

@@ -36,7 +36,6 @@ class ProcessPlant:
     p0: np.ndarray
     f: ca.Function = field(repr=False)
     h: ca.Function = field(repr=False)
-    energy: ca.Function = field(repr=False)   # (x, p) -> [kinetic, restoring potential] (J)
 
     @property
     def name(self) -> str:
@@ -142,10 +141,9 @@ def build_plant(scene: Scene | str, hydro: HydroModel | None = None, *,
     disturbances = [f"w__{d}" for d in hydro_dofs]
     f = ca.Function("f", [x, u, w, p], [x_dot], ["x", "u", "w", "p"], ["xdot"])
     h = ca.Function("h", [x, u, w, p], [y], ["x", "u", "w", "p"], ["y"])
-    energy = ca.Function("energy", [x, p], [ca.vertcat(kinetic, potential)], ["x", "p"], ["E"])
     return ProcessPlant(scene, topo, hydro, tuple(states), tuple(inputs), tuple(disturbances),
                         tuple(output_names), tuple(params.names), np.array(params.values),
-                        f, h, energy)
+                        f, h)
 
 
 def _preloads(scene, topo, q, s, u, w, chi, tau, pto_signals, params):

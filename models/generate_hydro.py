@@ -33,10 +33,10 @@ def bem_inputs(scene, panel_size: float | None = None) -> dict:
     import numpy as np
 
     from mbcontrol.hydro import BemBody
-    from mbcontrol.hydro_data import _geometry_dict
+    from mbcontrol.hydro_data import geometry_dict
 
     h = scene.hydro
-    bodies = [BemBody(name=b.name, geometry=_geometry_dict(b.geometry), cog=b.cog, mass=b.mass,
+    bodies = [BemBody(name=b.name, geometry=geometry_dict(b.geometry), cog=b.cog, mass=b.mass,
                       panel_size=panel_size or h.panel_size, dofs=h.dofs)
               for b in scene.bodies if b.hydro and b.geometry is not None]
     return dict(bodies=bodies, rho=scene.water.rho, g=scene.water.g, depth=scene.water.depth,
