@@ -44,9 +44,7 @@ def test_model_builds_at_rest(name):
     assert rad.report["passivity"]["passive"]                              # passive (exact test)
 
 
-@pytest.mark.parametrize("name", [n if n != "rm3" else pytest.param(n, marks=pytest.mark.xfail(
-    strict=True, reason="rm3.out heave pair: passive fit 2.35 % > scene tol 2 %"))
-    for n in list_models()])
+@pytest.mark.parametrize("name", list_models())
 def test_radiation_fit_meets_scene_tolerance(name):
     plant = build_plant(name)
     assert plant.hydro.radiation.fit_error <= load_scene(name).hydro.radiation_tol

@@ -208,8 +208,10 @@ def test_enforced_barge_model_is_passive(barge):
     # meet tol again. Bounds: tol, and at most +0.25 points over the unconstrained fit
     assert m.fit_error <= 0.01
     assert m.fit_error - raw.fit_error <= 0.0025
-    # the unconstrained fit's own numbers are the report's "before"
-    assert rep["before"]["fit_error"] == pytest.approx(raw.fit_error, rel=1e-12)
+    # "before" is the unconstrained fit under the scaling the passive fit kept (raw, fitted
+    # alone, may keep the other one: fewer states when passivity is not asked for)
+    assert rep["before"]["fit_error"] <= 0.01
+    assert m.report["groups"][0]["scaling"] in {"unit class", "per DOF"}
     # constraints kept through the enforcement: K(0) = 0 (measured 2e-14 of max|K|; 1e-9 is
     # rounding with margin) and C B = K(0+): a passive C B = BᵀPB is symmetric, so only the
     # symmetric part of the (1 %-asymmetric) data value is matched: ratios measured 6e-5 apart
@@ -316,3 +318,27 @@ def test_hankel_baseline_on_the_barge(barge):
     assert hb.fit_error == pytest.approx(np.sqrt(np.sum(np.abs(fit - K) ** 2) / np.sum(np.abs(K) ** 2)), rel=1e-10)
     assert hb.fit_error > barge["passive"].fit_error
     assert r["stable"] and "passive" in r["passivity"]
+
+
+# ------------------------------------------------------------------ congruence scaling
+def test_congruence_scale_per_unit_class():
+    from mbcontrol.hydro.radiation import _congruence_scale, _unit_class
+    dofs = ["a__Heave", "b__Surge", "a__Pitch", "b__Roll"]
+    K = np.diag([4.0, 1.0, 9.0, 16.0])[None] * (1 + 0.5j)
+    sc = _congruence_scale(K, [_unit_class(d) for d in dofs])
+    # one scale per unit: 1/sqrt(max |K_ii|) over the translations (4) and the rotations (16)
+    np.testing.assert_allclose(sc, [0.5, 0.5, 0.25, 0.25] / np.sqrt(abs(1 + 0.5j)))
+    np.testing.assert_allclose(_congruence_scale(K, dofs), 1 / np.sqrt(np.abs(np.diag(K[0]))))
+
+
+def test_rm3_fit_keeps_the_scaling_that_meets_tol():
+    """rm3.out's plate-heave entry is 2 % of the float's and carries BEM noise (13 % of it by
+    the Kramers-Kronig check): scaled up per DOF, it draws the passive fit away from the float."""
+    from mbcontrol.plant import build_plant
+    rep = build_plant("rm3").hydro.radiation.report
+    (group,) = rep["groups"]
+    tried = {t["scaling"]: t for t in group["scalings_tried"]}
+    # measured (densified grid): per DOF 2.35 % at 46 states, per unit class 1.89 % at 32 states
+    assert tried["per DOF"]["error"] > 0.02 >= tried["unit class"]["error"]
+    assert group["scaling"] == "unit class" and rep["n_states"] == tried["unit class"]["n_states"]
+    assert rep["fit_error"] <= 0.02 and rep["passivity"]["passive"]

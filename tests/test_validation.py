@@ -21,17 +21,9 @@ CASES = {
 }
 
 
-# rm3.out is not reciprocal (WAMIT's float/plate damping asymmetric by up to 24 %), and its
-# plate-heave added mass turns noisy above 3 rad/s. Symmetrised and made passive, the fit
-# of the heave pair reaches 2.35 % (46 states, band 0.02-3 rad/s), the plate-heave entry
-# 10 %; with it the steady amplitudes miss the FD solution by 1.27 % and the plate's
-# time history misses the convolution by 1.7 % of its (small) amplitude. Known, open
-# (issue 3): strict, so these turn into failures the day they pass.
-RM3_OPEN = pytest.mark.xfail(strict=True, reason="rm3.out heave pair: passive fit 2.35 % > 2 %")
 
 
-@pytest.fixture(scope="module", params=[
-    "sphere", pytest.param("rm3", marks=RM3_OPEN)])
+@pytest.fixture(scope="module", params=["sphere", "rm3"])
 def case(request):
     plant = build_plant(request.param)
     return request.param, plant, linearize(plant)

@@ -7,7 +7,9 @@ whose transfer function is K(jω) = B(ω) + jω(A(ω) - A∞) (ERRATA §4 "Radia
 1. DOFs split into groups that are exactly uncoupled in the data; zero couplings stay exactly 0.
 2. Per group, relaxed vector fitting (Gustavsen 2006; fast QR form of Deschrijver et al. 2008) of
    all entries with one common set of stable poles (unstable ones flipped), after the congruence
-   scaling K̃ = S K S, S = diag(1/√max|K_ii|), that makes DOFs of different units comparable.
+   scaling K̃ = S K S, S = diag(1/√max|K_ii|) with the max over each unit class (translations,
+   rotations), that makes DOFs of different units comparable and leaves those of one unit as
+   they are.
    Residues obey K(0) = 0 (B(0) = 0, A(0) finite) and C B = K(t=0+) = (2/π)∫B dω. The data are
    refined by interpolation where the BEM grid is sparse, and extended above the band by a few
    lightly weighted points of the asymptotic form, so the model cannot hide resonances between
@@ -376,11 +378,30 @@ def _refit_output(A, B, s, G, wt, pattern, dc_zero, markov=None):
     return _constrained_lstsq(M, Y, Gc, np.vstack(vals) if rows else None).T
 
 
-def _fit_group(w, Kg, pattern, tol, max_order, n_iter, dc_zero, refit, M1=None, p_tail=3.0, passive_states=0,
-               vf_frac=0.7):
+def _congruence_scale(Kg, unit_class):
+    """S of K̃ = S K S: 1/√max|K_ii| taken over all DOFs of one unit class (translations, rotations).
+
+    Entries of one class share units, so their sizes are commensurable and stay as they are: a
+    small entry (the deep RM3 plate's heave damping, 2 % of the float's) is not inflated to the
+    size of the large one, where its BEM noise (13 % there, by the Kramers-Kronig check) would
+    draw the fit away from the entries that carry the force. Between classes the scale makes
+    N s/m and N m s/rad comparable."""
+    diag = np.max(np.abs(np.einsum("kii->ki", Kg)), axis=0)
+    classes = np.asarray(unit_class)
+    peak = np.array([diag[classes == c].max() for c in classes])
+    return 1.0 / np.sqrt(peak)
+
+
+def _unit_class(dof: str) -> str:
+    kind = dof.rsplit("__", 1)[-1]
+    return {"Surge": "m", "Sway": "m", "Heave": "m", "Roll": "rad", "Pitch": "rad", "Yaw": "rad"}.get(kind, dof)
+
+
+def _fit_group(w, Kg, pattern, unit_class, tol, max_order, n_iter, dc_zero, refit, M1=None, p_tail=3.0,
+               passive_states=0, vf_frac=0.7):
     """VF of one coupled group (scaled) to vf_frac·tol, column realisation, balanced truncation to tol."""
     m = Kg.shape[1]
-    sc = 1.0 / np.sqrt(np.max(np.abs(np.einsum("kii->ki", Kg)), axis=0))
+    sc = _congruence_scale(Kg, unit_class)
     G = Kg * sc[None, :, None] * sc[None, None, :]
     ent = [(i, j) for i in range(m) for j in range(m) if pattern[i, j]]
     M1s = None if M1 is None else M1 * sc[:, None] * sc[None, :]  # scaled like G
@@ -447,6 +468,37 @@ def _fit_group(w, Kg, pattern, tol, max_order, n_iter, dc_zero, refit, M1=None, 
     return Ar, Br / sc[None, :], Cr_ / sc[:, None], info, before
 
 
+def _best_scaled_fit(common, rest, dofs, passive):
+    """Fit one group under each distinct congruence scaling (per unit class, per DOF) and keep the
+    model that meets tol, then one whose passivity enforcement kept C B = K(0+), then the fewest
+    states, then the most accurate (error on the group's data).
+
+    Which weighting lets the fit reach the tolerance soonest depends on the data: per-DOF scaling
+    helps a small, clean entry; per-class scaling keeps the fit off a small, noisy one."""
+    w, Kg, _ = common
+    tol = rest[0]
+    options = {"unit class": [_unit_class(d) for d in dofs], "per DOF": list(dofs)}
+    if np.allclose(_congruence_scale(Kg, options["unit class"]), _congruence_scale(Kg, options["per DOF"])):
+        options.pop("per DOF")
+    best, tried = None, []
+    for label, classes in options.items():
+        args = (*common, classes, *rest)
+        *abc, rep, before = _fit_group(*args)
+        if passive and not rep["passivity"]["met"]:  # passive fits may need more poles: fit deeper, retry
+            *abc2, rep2, _ = _fit_group(*args, vf_frac=0.15)
+            if rep2["passivity"]["error_after"] < rep["passivity"]["error_after"]:
+                abc, rep = abc2, {**rep2, "deeper_vector_fit": True}
+        err = _nerr(_response(*abc, None, w, 1e10), Kg)
+        markov_dropped = rep.get("passivity", {}).get("markov_kept") is False
+        tried.append({"scaling": label, "n_states": int(abc[0].shape[0]), "error": float(err),
+                      "markov_dropped": markov_dropped})
+        key = (err > tol, markov_dropped, abc[0].shape[0], err)
+        if best is None or key < best[0]:
+            best = (key, abc, {**rep, "scaling": label}, before)
+    _, abc, rep, before = best
+    return abc, {**rep, "scalings_tried": tried}, before
+
+
 def fit_radiation(ds, dofs=None, *, tol: float = 0.02, max_order: int = 30, omega_max=None,
                   n_iter: int = 20, dc_zero: bool = True, refit: bool = True,
                   markov: bool = True, passive: bool = True,
@@ -486,13 +538,11 @@ def fit_radiation(ds, dofs=None, *, tol: float = 0.02, max_order: int = 30, omeg
     wf, Kf = _densify(w, Ks)
     parts, pre, info = [], [], []  # pre: the unconstrained fits (what passive=False returns)
     for gidx in groups:
-        args = (wf, Kf[:, gidx][:, :, gidx], link[np.ix_(gidx, gidx)], tol, max_order, n_iter, dc_zero, refit,
-                None if M1 is None else M1[np.ix_(gidx, gidx)], p_tail, passive_max_states if passive else 0)
-        *abc, rep, before = _fit_group(*args)
-        if passive and not rep["passivity"]["met"]:  # passive fits may need more poles: fit deeper, retry
-            *abc2, rep2, _ = _fit_group(*args, vf_frac=0.15)
-            if rep2["passivity"]["error_after"] < rep["passivity"]["error_after"]:
-                abc, rep = abc2, {**rep2, "deeper_vector_fit": True}
+        Kg = Kf[:, gidx][:, :, gidx]
+        common = (wf, Kg, link[np.ix_(gidx, gidx)])
+        rest = (tol, max_order, n_iter, dc_zero, refit, None if M1 is None else M1[np.ix_(gidx, gidx)], p_tail,
+                passive_max_states if passive else 0)
+        abc, rep, before = _best_scaled_fit(common, rest, [dofs[i] for i in gidx], passive)
         parts.append((gidx, *abc))
         pre.append((gidx, *before))
         info.append({"dofs": [dofs[i] for i in gidx], **rep})
