@@ -43,14 +43,14 @@ def _parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("hydro", help="load or compute a model's BEM data and fit its radiation "
                                      "model; print the fit report")
-    p.add_argument("model", help="catalogue name or path to a scene .toml")
+    _model_options(p)
     p.add_argument("--tol", type=float, help="radiation fit tolerance (normalised RMS error)")
     p.add_argument("--json", action="store_true", help="print the report as JSON")
     p.set_defaults(run=_hydro)
 
     p = sub.add_parser("simulate", help="simulate a model in waves (nonlinear process plant)",
                        formatter_class=argparse.RawTextHelpFormatter)
-    p.add_argument("model", help="catalogue name or path to a scene .toml")
+    _model_options(p)
     _wave_options(p)
     p.add_argument("--duration", type=float, default=None,
                    help="simulated time, s (default: 30 periods, or 600 s for irregular seas)")
@@ -68,7 +68,7 @@ def _parser() -> argparse.ArgumentParser:
     p.set_defaults(run=_simulate)
 
     p = sub.add_parser("linearize", help="linearise about rest; poles, Bode plot")
-    p.add_argument("model", help="catalogue name or path to a scene .toml")
+    _model_options(p)
     p.add_argument("--bode", metavar="FILE.png", help="write a Bode plot")
     p.add_argument("--pair", action="append", default=[], metavar="INPUT:OUTPUT",
                    help="Bode channel, repeatable (default: each PTO command to its velocity)")
@@ -78,6 +78,19 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="print signals and poles as JSON")
     p.set_defaults(run=_linearize)
     return parser
+
+
+def _model_options(p) -> None:
+    p.add_argument("model", help="catalogue name or path to a scene .toml")
+    p.add_argument("--scene-param", action="append", default=[], metavar="NAME=VALUE",
+                   help="a value for the scene's [parameters], e.g. N=8 for barge_chain (repeatable)")
+
+
+def _plant(args, **kwargs):
+    from .plant import build_plant
+    from .scene import load_scene
+    values = dict(_key_value(item, "--scene-param") for item in args.scene_param)
+    return build_plant(load_scene(args.model, values or None), **kwargs)
 
 
 def _wave_options(p) -> None:
@@ -99,8 +112,7 @@ def _models(args) -> int:
 
 
 def _hydro(args) -> int:
-    from .plant import build_plant
-    plant = build_plant(args.model, radiation_tol=args.tol)
+    plant = _plant(args, radiation_tol=args.tol)
     if plant.hydro is None:
         print(f"{plant.name}: no hydrodynamic bodies")
         return 0
@@ -125,10 +137,9 @@ def _hydro(args) -> int:
 
 def _simulate(args) -> int:
     from .metrics import summary
-    from .plant import build_plant
     from .simulate import simulate
     from .waves import from_args
-    plant = build_plant(args.model)
+    plant = _plant(args)
     wave = None
     duration = args.duration
     if args.wave != "none":
@@ -160,8 +171,7 @@ def _simulate(args) -> int:
 
 def _linearize(args) -> int:
     from .linearize import linearize
-    from .plant import build_plant
-    plant = build_plant(args.model)
+    plant = _plant(args)
     params = dict(_key_value(s, "--param") for s in args.param)
     sys_ = linearize(plant, params=params or None)
     poles = np.linalg.eigvals(np.asarray(sys_.A))

@@ -19,6 +19,7 @@ import xarray as xr
 
 from . import hydro as bem
 from .errors import HydroError
+from .hydro.isolated import compute_isolated
 from .scene import DOF_NAMES, Scene
 from .ssforms import modal_form
 from .waves import Wave, excitation_series, interpolate_complex
@@ -138,7 +139,9 @@ class HydroModel:
 def load_hydro_model(scene: Scene, dofs, tol: float | None = None) -> HydroModel:
     """Body-frame data for `dofs` (from scene.hydro.file, or a cached BEM run) and its fit."""
     tol = scene.hydro.radiation_tol if tol is None else tol
-    if scene.hydro.file:
+    # a precomputed file wins; a scene that also gives BEM frequencies falls back to a (cached)
+    # BEM run when the file is absent, e.g. for a parameter value nobody precomputed
+    if scene.hydro.file and (Path(scene.hydro.file).exists() or not scene.hydro.omega):
         source = scene.hydro.file
         data = bem.read_netcdf(source)
     else:
@@ -161,10 +164,12 @@ def _run_bem(scene: Scene, dofs):
             bodies.append(bem.BemBody(name=body.name, geometry=geometry_dict(body.geometry),
                                       cog=body.cog, mass=body.mass,
                                       panel_size=scene.hydro.panel_size, dofs=body_dofs))
-    data = bem.compute(bodies, rho=scene.water.rho, g=scene.water.g, depth=scene.water.depth,
+    solve = bem.compute if scene.hydro.interaction else compute_isolated
+    data = solve(bodies, rho=scene.water.rho, g=scene.water.g, depth=scene.water.depth,
                        omegas=np.array(scene.hydro.omega), headings=scene.hydro.headings,
                        lid=scene.hydro.lid, cache_dir=cache_dir())
-    return f"BEM of {scene.path}", data
+    what = "BEM" if scene.hydro.interaction else "BEM, bodies solved alone,"
+    return f"{what} of {scene.path}", data
 
 
 def geometry_dict(geometry) -> dict:

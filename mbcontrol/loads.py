@@ -96,6 +96,23 @@ def friction_forces(scene: Scene, topo: Topology, s, params: Parameters):
     return tau
 
 
+def end_stop_forces(scene: Scene, topo: Topology, q, s, params: Parameters):
+    """One-sided spring-dampers at joint travel limits: beyond a stop by d > 0 the joint feels
+    max(k d + c v_in, 0) pushing it back (v_in: speed into the stop), never a pull."""
+    tau = ca.SX.zeros(topo.tree.n_s)
+    for stop in scene.end_stops:
+        j = topo.coordinate_of_joint[stop.joint]
+        k = params.add(f"{stop.name}__stiffness", stop.stiffness)
+        c = params.add(f"{stop.name}__damping", stop.damping)
+        if np.isfinite(stop.upper):
+            d = q[j] - stop.upper
+            tau[j] -= ca.if_else(d > 0, ca.fmax(k * d + c * s[j], 0), 0)
+        if np.isfinite(stop.lower):
+            d = stop.lower - q[j]
+            tau[j] += ca.if_else(d > 0, ca.fmax(k * d - c * s[j], 0), 0)
+    return tau
+
+
 def mooring_forces(scene: Scene, topo: Topology, q, s, params: Parameters):
     """Linear spring-dampers from each fairlead's rest position, along the n-frame axes."""
     tree, tau = topo.tree, ca.SX.zeros(topo.tree.n_s)

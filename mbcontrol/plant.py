@@ -17,6 +17,7 @@ import casadi as ca
 import numpy as np
 
 from . import loads
+from . import plant_checks as checks
 from .hydro_data import HydroModel, load_hydro_model
 from .scene import DOF_NAMES, Scene, load_scene
 from .topology import Topology, build_topology
@@ -36,6 +37,7 @@ class ProcessPlant:
     p0: np.ndarray
     f: ca.Function = field(repr=False)
     h: ca.Function = field(repr=False)
+    notes: dict = field(default_factory=dict)   # build-time findings (plant_checks.rest_checks)
 
     @property
     def name(self) -> str:
@@ -122,11 +124,13 @@ def build_plant(scene: Scene | str, hydro: HydroModel | None = None, *,
     tau += tau_pto + loads.friction_forces(scene, topo, s, params)
     tau += loads.mooring_forces(scene, topo, q, s, params)
     tau += loads.drag_forces(scene, topo, q, s, params)
+    tau += loads.end_stop_forces(scene, topo, q, s, params)
     tau += loads.gravity_forces(scene, topo, q)
     tau += loads.static_loads(scene, topo, q, hydro.buoyancy(scene.water) if hydro else {})
     tau += _preloads(scene, topo, q, s, u, w, chi, tau, pto_signals, params)
 
     M = tree.mass_matrix(q, added_mass)
+    notes = checks.rest_checks(scene, topo, q, s, u, w, chi, tau, M, params)
     s_dot = ca.solve(M, tau)
     x = ca.vertcat(q, s, chi)
     x_dot = ca.vertcat(ca.mtimes(tree.K(q), s), s_dot, chi_dot)
@@ -143,7 +147,7 @@ def build_plant(scene: Scene | str, hydro: HydroModel | None = None, *,
     h = ca.Function("h", [x, u, w, p], [y], ["x", "u", "w", "p"], ["y"])
     return ProcessPlant(scene, topo, hydro, tuple(states), tuple(inputs), tuple(disturbances),
                         tuple(output_names), tuple(params.names), np.array(params.values),
-                        f, h)
+                        f, h, notes)
 
 
 def _preloads(scene, topo, q, s, u, w, chi, tau, pto_signals, params):

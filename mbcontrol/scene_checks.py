@@ -237,7 +237,8 @@ def check_topology(scene, top: Reader):
     _unique(where, "body", [b.name for b in scene.bodies])
     _unique(where, "joint", [j.name for j in scene.joints])
     for kind, items in (("pto", scene.ptos), ("friction", scene.frictions),
-                        ("mooring", scene.moorings), ("drag", scene.drags)):
+                        ("mooring", scene.moorings), ("drag", scene.drags),
+                        ("end_stop", scene.end_stops)):
         _unique(where, kind, [x.name for x in items])
 
     parent_of: dict[str, str] = {}
@@ -287,7 +288,8 @@ def check_topology(scene, top: Reader):
             if np.linalg.norm(np.subtract(pto.point, pto.parent_point)) < 1e-9:
                 raise SceneError(f"{where}: pto[{i}].point: expected a point apart from "
                                  f"parent_point (the line of action needs a direction)")
-    for kind, items in (("pto", scene.ptos), ("friction", scene.frictions)):
+    for kind, items in (("pto", scene.ptos), ("friction", scene.frictions),
+                        ("end_stop", scene.end_stops)):
         for i, item in enumerate(items):
             if getattr(item, "between_points", False):
                 continue
@@ -300,12 +302,13 @@ def check_topology(scene, top: Reader):
         for i, item in enumerate(items):
             if item.body not in bodies:
                 raise SceneError(f"{where}: {kind}[{i}].body: unknown body {item.body!r}")
-    if scene.hydro.file is None:
+    if scene.hydro.file is None or scene.hydro.hydrostatics == "large_angle":
         for i, body in enumerate(scene.bodies):
             if body.hydro and body.geometry is None:
                 raise SceneError(f"{where}: body[{i}].geometry: body '{body.name}' takes "
                                  f"hydrodynamic loads but has no geometry and the scene has no "
-                                 f"hydro.file; give one, or set hydro = false")
+                                 f"hydro.file (or asks for large-angle hydrostatics); give one, "
+                                 f"or set hydro = false")
     return replace(scene, joints=tuple(joints))
 
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 import json
 import platform
 import time
+import warnings
 from importlib import metadata
 
 import numpy as np
@@ -39,6 +40,8 @@ def simulate(plant, wave=None, *, duration: float, dt: float = 0.01, controller=
         else np.zeros((2 * n + 1, len(plant.disturbances)))
     if controller is not None:
         controller.reset(plant)
+    if method == "rk4":
+        _warn_stiff(plant, dt)
     bar = _progress_bar(progress, n)
     check = _divergence_check(plant, dt, bar)
 
@@ -155,12 +158,43 @@ def _steps_per_period(period: float, dt: float) -> int:
     return m
 
 
+EULER_MARGIN = float(np.cos(np.radians(85.0)))  # stop at |pitch| > 85 deg
+
+
+def _warn_stiff(plant, dt):
+    for name, stop in plant.notes.get("end_stops", {}).items():
+        if dt > stop["rk4_max_dt_s"]:
+            warnings.warn(f"{plant.name}: end stop '{name}' rings at {stop['omega_rad_s']:.4g} rad/s "
+                          f"while engaged; RK4 is stable there only for dt <= {stop['rk4_max_dt_s']:.3g} s "
+                          f"(dt = {dt} s). Use a smaller dt, method='cvodes', or a softer stop",
+                          RuntimeWarning, stacklevel=3)
+
+
+def _euler_pitch_states(plant) -> dict:
+    """State index -> body, for the pitch angle of each 6-DOF free joint (ZYX Euler angles)."""
+    return {plant.states.index(f"{j.name}__Pitch"): j.child for j in plant.scene.joints
+            if j.type == "free" and len(j.dofs) == 6}
+
+
 def _divergence_check(plant, dt, bar):
-    """Stop with a clear SimulationError on the first non-finite or absurd state."""
-    def check(i_end, X):
+    """Stop with a clear SimulationError on the first non-finite or absurd state, or when a free
+    body's Euler pitch nears ±90°, where its kinematics q' = K(q) s are singular."""
+    pitch, checked = _euler_pitch_states(plant), [0]
+
+    def check(i_end, X):           # X: the states from t = 0 up to step i_end
         last = X[-1]
         if bar is not None:
             bar.update(i_end - bar.n)
+        start, checked[0] = checked[0], X.shape[0]
+        for idx, body in pitch.items():
+            near = np.flatnonzero(np.abs(np.cos(X[start:, idx])) < EULER_MARGIN)
+            if near.size:
+                i = start + int(near[0])
+                raise SimulationError(
+                    f"{plant.name}: body '{body}' reached a pitch of {np.degrees(X[i, idx]):.1f} deg "
+                    f"at t = {i * dt:.4g} s (step {i}): its free joint's ZYX Euler angles are singular at "
+                    f"±90 deg. Remedy: a model whose motions stay away from it (check the loads and "
+                    f"restoring in pitch), or a revolute/composite joint for large pitch")
         if np.all(np.isfinite(last)) and np.max(np.abs(last)) < 1e8:
             return
         bad = np.flatnonzero(~np.isfinite(X).all(axis=1) | (np.abs(X).max(axis=1) >= 1e8))

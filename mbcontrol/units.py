@@ -19,10 +19,12 @@ UNITS: dict[str, dict[str, float]] = {
     "acceleration": {"m/s^2": 1.0, "m/s2": 1.0},
     "inertia": {"kg*m^2": 1.0, "kg m^2": 1.0, "kg*m2": 1.0},
 }
+# a joint coordinate: a length (prismatic) or an angle (revolute)
+UNITS["coordinate"] = {**UNITS["length"], **UNITS["angle"]}
 
 SI_UNIT = {
     "length": "m", "mass": "kg", "angle": "rad", "time": "s", "frequency": "rad/s",
-    "density": "kg/m^3", "acceleration": "m/s^2", "inertia": "kg*m^2",
+    "density": "kg/m^3", "acceleration": "m/s^2", "inertia": "kg*m^2", "coordinate": "m or rad",
 }
 
 _QUANTITY = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(\S.*?)?\s*$")

@@ -18,10 +18,7 @@ Examples
 from __future__ import annotations
 
 import argparse
-import os
-import shutil
 import sys
-import tempfile
 import time
 from pathlib import Path
 
@@ -80,19 +77,6 @@ def convert(scene, out: Path) -> None:
           f"({body_frames.sizes['omega']} frequencies, {time.perf_counter() - t0:.1f} s)")
 
 
-def _copy_atomic(src: Path, dst: Path) -> None:
-    fd, tmp = tempfile.mkstemp(prefix=f".{dst.name}.", suffix=".tmp", dir=dst.parent)
-    os.close(fd)
-    try:
-        shutil.copyfile(src, tmp)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, dst)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.remove(tmp)
-        raise
-
-
 def fit_report(path: Path, tol: float, omega_max: str | None) -> None:
     from mbcontrol.hydro import fit_radiation
     from mbcontrol.hydro._io import read_netcdf
@@ -130,7 +114,8 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
 
     import numpy as np
-    from mbcontrol.hydro import compute
+    from mbcontrol.hydro import compute, write_netcdf_atomic
+    from mbcontrol.hydro.isolated import compute_isolated
 
     for file, scene in catalogue(args.models).items():
         out = Path(file)
@@ -153,9 +138,9 @@ def main(argv=None) -> int:
                   f"{dt / 5 * (len(w) + 2) / 60:.1f} min")
             continue
         t0 = time.perf_counter()
-        ds = compute(**kw, cache_dir=args.cache_dir, progress=not args.no_progress, n_jobs=args.n_jobs)
-        key = ds.attrs["cache_key"]
-        _copy_atomic(args.cache_dir / f"bem_{key[:16]}.nc", out)
+        solve = compute if scene.hydro.interaction else compute_isolated
+        ds = solve(**kw, cache_dir=args.cache_dir, progress=not args.no_progress, n_jobs=args.n_jobs)
+        write_netcdf_atomic(ds, out)
         print(f"{name}: wrote {out} ({time.perf_counter() - t0:.1f} s, BEM solve {ds.attrs['solve_seconds']:.1f} s; "
               f"{ds.sizes['omega']} frequencies; panels hull {ds.attrs['hull_panels']}, lid {ds.attrs['lid_panels']}; "
               f"omega_max_mesh {ds.attrs['omega_max_mesh']:.1f} rad/s)")
