@@ -45,6 +45,7 @@ from scipy.optimize import brentq
 
 from .errors import SceneError
 
+_FLOOR = 0.1
 STATUSES = ("seabed contact", "suspended", "slack", "taut", "taut-out")
 
 
@@ -460,7 +461,7 @@ class CatenaryLine:
             dh = -(ZV * (x - XF) - XV * (z - ZF)) / det
             dv = -(XH * (z - ZF) - ZH * (x - XF)) / det
             # keep H and V positive, as in the exact solver (inactive near convergence)
-            h, v = ca.fmax(h + dh, 0.1 * h), ca.fmax(v + dv, 0.1 * v)
+            h, v = ca.fmax(h + dh, _FLOOR * h), ca.fmax(v + dv, _FLOOR * v)
         hanging = 2.0 * ZF / (1.0 + ca.sqrt(1.0 + 2.0 * w * ZF / EA))
         slack = XF <= L - hanging
         h, v = ca.if_else(slack, 0.0, h), ca.if_else(slack, w * hanging, v)

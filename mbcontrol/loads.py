@@ -98,8 +98,9 @@ def friction_forces(scene: Scene, topo: Topology, s, params: Parameters):
 
 def end_stop_forces(scene: Scene, topo: Topology, q, s, params: Parameters):
     """One-sided spring-dampers at joint travel limits: beyond a stop by d > 0 the joint feels
-    max(k d + c v_in, 0) pushing it back (v_in: speed into the stop), never a pull."""
-    tau = ca.SX.zeros(topo.tree.n_s)
+    max(k d + c v_in, 0) pushing it back (v_in: speed into the stop), never a pull.
+    Returns (generalised force, spring energy 1/2 k d² stored in engaged stops, J)."""
+    tau, energy = ca.SX.zeros(topo.tree.n_s), 0
     for stop in scene.end_stops:
         j = topo.coordinate_of_joint[stop.joint]
         k = params.add(f"{stop.name}__stiffness", stop.stiffness)
@@ -107,15 +108,18 @@ def end_stop_forces(scene: Scene, topo: Topology, q, s, params: Parameters):
         if np.isfinite(stop.upper):
             d = q[j] - stop.upper
             tau[j] -= ca.if_else(d > 0, ca.fmax(k * d + c * s[j], 0), 0)
+            energy += ca.if_else(d > 0, 0.5 * k * d**2, 0)
         if np.isfinite(stop.lower):
             d = stop.lower - q[j]
             tau[j] += ca.if_else(d > 0, ca.fmax(k * d - c * s[j], 0), 0)
-    return tau
+            energy += ca.if_else(d > 0, 0.5 * k * d**2, 0)
+    return tau, energy
 
 
 def mooring_forces(scene: Scene, topo: Topology, q, s, params: Parameters):
-    """Linear spring-dampers from each fairlead's rest position, along the n-frame axes."""
-    tree, tau = topo.tree, ca.SX.zeros(topo.tree.n_s)
+    """Linear spring-dampers from each fairlead's rest position, along the n-frame axes.
+    Returns (generalised force, spring energy 1/2 Σ k_a d_a², J)."""
+    tree, tau, energy = topo.tree, ca.SX.zeros(topo.tree.n_s), 0
     q_rest = ca.DM.zeros(tree.n_q)
     for m in scene.moorings:
         k = topo.body_index(m.body)
@@ -128,7 +132,8 @@ def mooring_forces(scene: Scene, topo: Topology, q, s, params: Parameters):
         velocity = tree.point_velocity(q, s, k, local)
         force = -(stiffness * displacement + damping * velocity)
         tau += tree.point_force(q, k, local, force)
-    return tau
+        energy += 0.5 * ca.dot(stiffness, displacement**2)
+    return tau, energy
 
 
 def drag_forces(scene: Scene, topo: Topology, q, s, params: Parameters):
@@ -199,14 +204,17 @@ def static_loads(scene: Scene, topo: Topology, q, buoyancy: dict):
 
 
 def gravity_forces(scene: Scene, topo: Topology, q):
-    """Weight of the bodies whose buoyancy is not modelled (hydro = false)."""
-    tree, tau = topo.tree, ca.SX.zeros(topo.tree.n_s)
+    """Weight of the bodies whose buoyancy is not modelled (hydro = false).
+    Returns (generalised force, potential -Σ m g (z_c - z_c,rest), J; z down)."""
+    tree, tau, energy = topo.tree, ca.SX.zeros(topo.tree.n_s), 0
+    q_rest = ca.DM.zeros(tree.n_q)
     for body in scene.bodies:
         if not body.hydro:
             k = topo.body_index(body.name)
             tau += tree.point_force(q, k, tree.links[k].cog,
                                     ca.DM([0, 0, body.mass * scene.water.g]))
-    return tau
+            energy -= body.mass * scene.water.g * (tree.cog(q, k)[2] - tree.cog(q_rest, k)[2])
+    return tau, energy
 
 
 def euler_zyx(R):

@@ -122,10 +122,12 @@ def build_plant(scene: Scene | str, hydro: HydroModel | None = None, *,
     tau += restoring
     tau_pto, pto_signals = loads.pto_forces(scene, topo, q, s, u, params)
     tau += tau_pto + loads.friction_forces(scene, topo, s, params)
-    tau += loads.mooring_forces(scene, topo, q, s, params)
     tau += loads.drag_forces(scene, topo, q, s, params)
-    tau += loads.end_stop_forces(scene, topo, q, s, params)
-    tau += loads.gravity_forces(scene, topo, q)
+    for conservative in (loads.mooring_forces(scene, topo, q, s, params),
+                         loads.end_stop_forces(scene, topo, q, s, params),
+                         loads.gravity_forces(scene, topo, q)):
+        tau += conservative[0]
+        potential += conservative[1]
     tau += loads.static_loads(scene, topo, q, hydro.buoyancy(scene.water) if hydro else {})
     tau += _preloads(scene, topo, q, s, u, w, chi, tau, pto_signals, params)
 
@@ -228,7 +230,9 @@ def _outputs(scene, topo: Topology, q, s, pto_signals, power):
     for pto, (position, velocity, force, _) in pto_signals.items():
         values += [position, velocity, force, -force * velocity]
         names += [f"{pto}__position", f"{pto}__velocity", f"{pto}__force", f"{pto}__power"]
-    # energy audit: radiated (W, leaving the bodies), wave input (W), kinetic + restoring (J)
+    # energy audit: radiated (W, leaving the bodies), wave input (W), and the mechanical energy
+    # (J): kinetic + hydrostatic, gravity (dry bodies), mooring and end-stop potentials; PTO
+    # forces, springs included, are external: their power is <pto>__power
     values += [power["radiated_power"], power["excitation_power"], power["energy"]]
     names += ["radiated_power", "excitation_power", "energy"]
     return ca.vertcat(*values), names
