@@ -1,41 +1,33 @@
-"""Quasi-static elastic catenary mooring line: exact solve, stiffness, and a CasADi force table.
+"""Quasi-static elastic catenary mooring line: exact solve, stiffness, CasADi force Function.
 
-Derivation. Let s be the unstretched arc length from the anchor (s = 0) to the fairlead
-(s = L), and z point up from the anchor (this module's 2-D frame only). Only the submerged
-weight w (N/m) loads the line, so the horizontal tension H is uniform and the vertical tension
-grows linearly, V(s) = V_A + w s with V_A = V - w L. Hooke's law stretches ds into
-(1 + T/EA) ds, T = sqrt(H^2 + V(s)^2), along the tangent (H, V(s))/T, so
+Derivation. Unstretched arc length s runs from the anchor (s = 0) to the fairlead (s = L), z
+up from the anchor (this 2-D frame only). Only the submerged weight w (N/m) loads the line, so
+the horizontal tension H is uniform and the vertical one grows linearly, V(s) = V_A + w s,
+V_A = V - w L. Hooke stretches ds into (1 + T/EA) ds, T = sqrt(H^2 + V(s)^2), along the
+tangent (H, V(s))/T: dx/ds = H/T + H/EA, dz/ds = V(s)/T + V(s)/EA. Integrated over a line
+clear of the seabed (V_A >= 0), with T_F, T_A the end tensions:
+    XF = (H/w) [asinh(V/H) - asinh(V_A/H)] + H L/EA,   ZF = (T_F - T_A)/w + (V L - w L^2/2)/EA.
+When V < w L, L_B = L - V/w lies on the flat seabed, which carries its weight, and the rest
+leaves it horizontally (V_A = 0 at touchdown):
+    XF = L_B + (H/w) asinh(V/H) + H L/EA + C,          ZF = (T_F - H)/w + V^2/(2 EA w).
+C is the seabed friction correction (coefficient cb, at its limit): tension along the lying
+part falls by cb w per metre toward the anchor, down to 0, taking stretch away; with
+a = H/(cb w), C = -cb w L_B^2/(2 EA) if L_B <= a, else (H^2/(2 cb w) - H L_B)/EA. Both
+cases and their Jacobians agree at V = w L, so Newton crosses touchdown smoothly.
 
-    dx/ds = H/T + H/EA,        dz/ds = V(s)/T + V(s)/EA.
-
-Integrating over the whole line when it hangs clear of the seabed (V_A >= 0):
-
-    XF = (H/w) [asinh(V/H) - asinh(V_A/H)] + H L/EA
-    ZF = (T_F - T_A)/w + (V L - w L^2/2)/EA,      T_F = sqrt(H^2+V^2), T_A = sqrt(H^2+V_A^2).
-
-When V < w L a length L_B = L - V/w lies on the (flat) seabed, which carries its weight; the
-hanging part starts horizontal at the touchdown point (V_A = 0 there), so
-
-    XF = L_B + (H/w) asinh(V/H) + H L/EA + C,      ZF = (T_F - H)/w + V^2/(2 EA w).
-
-C is the seabed-friction correction (coefficient cb, friction at its limit, pointing toward the
-anchor): the tension along the lying part falls by cb w per metre, to zero at most, which takes
-stretch away. With a = H/(cb w): C = -cb w L_B^2/(2 EA) if L_B <= a, else (H^2/(2 cb w) -
-H L_B)/EA. Both branches and their Jacobians agree at V = w L, so Newton can cross touchdown.
-
-The flexibility d(XF, ZF)/d(H, V) is symmetric positive definite (without friction), so ZF
-grows with V at fixed H and, along ZF = const, XF grows with H. That makes a nested bracketing
-solve (V from ZF inside, H from XF outside) a guaranteed fallback for damped Newton.
-
-Limits. H -> 0: the line hangs vertically over a hanging length L_h (ZF = L_h + w L_h^2/(2EA))
-and the rest lies slack, so any XF <= L - L_h is "slack" with H = 0, V = w L_h. A chord
-sqrt(XF^2 + ZF^2) longer than L holds only by stretching: "taut", and past the strain limit
-"taut-out" (still solved; the caller decides).
+Without friction the flexibility d(XF, ZF)/d(H, V) is symmetric positive definite: ZF grows
+with V at fixed H, and XF with H along ZF = const, so a nested bracketing solve (V from ZF
+inside, H from XF outside) is a guaranteed fallback for damped Newton. H -> 0: the line hangs
+vertically over L_h (ZF = L_h + w L_h^2/(2 EA)), the rest lies slack, so XF <= L - L_h is
+"slack" (H = 0, V = w L_h). A chord longer than L holds only by stretching: "taut", and past
+the strain limit "taut-out" (still solved; the caller decides).
 """
 from __future__ import annotations
 
 import math
+import numbers
 import re
+import warnings
 from dataclasses import dataclass, field
 from types import SimpleNamespace
 
@@ -45,7 +37,6 @@ from scipy.optimize import brentq
 
 from .errors import SceneError
 
-_FLOOR = 0.1
 STATUSES = ("seabed contact", "suspended", "slack", "taut", "taut-out")
 
 
@@ -53,9 +44,9 @@ STATUSES = ("seabed contact", "suspended", "slack", "taut", "taut-out")
 class CatenarySolution:
     """Tensions and state of one line. Forces in N, lengths in m, strains dimensionless.
 
-    H, V: horizontal and vertical tension at the fairlead (the line pulls the fairlead toward
-    the anchor by H and down by V). H_anchor, V_anchor: at the anchor (pulled toward the
-    fairlead by H_anchor and up by V_anchor). lying_length: length on the seabed.
+    H, V: tension components at the fairlead (the line pulls it toward the anchor by H and
+    down by V); H_anchor, V_anchor: at the anchor (pulled toward the fairlead and up).
+    lying_length: length on the seabed.
     strain: peak axial strain T_F/EA (at the fairlead, where tension is largest).
     chord_strain: chord/L - 1, > 0 iff "taut". stiffness: d(H, V)/d(XF, ZF) (N/m), 2x2.
     iterations: Newton iterations, or function evaluations if the bracketing fallback ran.
@@ -77,11 +68,11 @@ class CatenarySolution:
         return math.hypot(self.H, self.V)
 
 
-# The shape equations are written once for floats and for CasADi SX: `ops` supplies sqrt, log
-# and a two-way select (both branches are evaluated, so each must stay finite in the other's
-# domain; that is why the suspended branch's VA + TA has a cancellation-free form for VA < 0).
-_NUM = SimpleNamespace(sqrt=math.sqrt, log=math.log, select=lambda c, a, b: a if c else b)
-_SYM = SimpleNamespace(sqrt=ca.sqrt, log=ca.log, select=ca.if_else)
+# The shape equations serve floats and CasADi SX alike: `ops` gives sqrt, log1p, abs and a
+# select that evaluates both branches, so each must stay finite in the other's domain.
+_NUM = SimpleNamespace(sqrt=math.sqrt, log1p=math.log1p, abs=abs,
+                       select=lambda c, a, b: a if c else b)
+_SYM = SimpleNamespace(sqrt=ca.sqrt, log1p=ca.log1p, abs=ca.fabs, select=ca.if_else)
 
 
 def _shape_terms(H, V, L, EA, w, cb, ops=_NUM):
@@ -91,10 +82,11 @@ def _shape_terms(H, V, L, EA, w, cb, ops=_NUM):
     VA = V - w * L
     TA = ops.sqrt(H * H + VA * VA)
     clear = VA >= 0.0
-    # clear of the seabed: asinh(V/H) - asinh(VA/H) in log form, T - TA as
-    # (V^2 - VA^2)/(T + TA); both stay accurate as H -> 0 (nearly vertical line)
-    lift = ops.select(clear, VA + TA, H * H / (TA - VA))
-    dasinh = ops.log((V + T) / lift)
+    # clear of the seabed: asinh(V/H) - asinh(VA/H) = log1p((V - VA + T - TA)/(VA + TA)), with
+    # T - TA = (V^2 - VA^2)/(T + TA): no cancellation for nearly vertical (H -> 0) or nearly
+    # straight (T >> w L) lines; VA + TA = H^2/(TA - VA) stays positive when VA < 0
+    lift = ops.select(clear, VA + TA, H * H / (TA + ops.abs(VA)))
+    dasinh = ops.log1p(w * L * (1.0 + (V + VA) / (T + TA)) / lift)
     s_XF = H / w * dasinh + H * L / EA
     s_ZF = L * (V + VA) / (T + TA) + (V * L - 0.5 * w * L * L) / EA
     s_cross = H / w * (1.0 / T - 1.0 / TA)
@@ -102,7 +94,7 @@ def _shape_terms(H, V, L, EA, w, cb, ops=_NUM):
     s_ZV = (V / T - VA / TA) / w + L / EA
     # part of the line on the seabed, L_B = L - V/w of it
     LB = L - V / w
-    asn = ops.log((V + T) / H)
+    asn = ops.log1p((V + V * V / (T + H)) / H)              # asinh(V/H) = log((V + T)/H)
     b_XF = LB + H / w * asn + H * L / EA
     b_ZF = V * V / (w * (T + H)) + V * V / (2.0 * EA * w)    # (T - H)/w without cancellation
     b_cross = -V * V / (w * T * (T + H))                     # (H/T - 1)/w likewise
@@ -121,54 +113,42 @@ def _shape_terms(H, V, L, EA, w, cb, ops=_NUM):
             pick(clear, s_cross, b_XV), pick(clear, s_cross, b_cross), pick(clear, s_ZV, b_ZV))
 
 
-def _shape(H, V, L, EA, w, cb):
-    """Numeric XF, ZF (m) and the 2x2 flexibility d(XF, ZF)/d(H, V) (m/N)."""
-    XF, ZF, XH, XV, ZH, ZV = _shape_terms(H, V, L, EA, w, cb)
-    return XF, ZF, np.array([[XH, XV], [ZH, ZV]])
-
-
-def _initial_guess(XF, ZF, L, w):
-    """Peyrot & Goulois' guess: an inextensible catenary whose sag matches the chord."""
-    if XF <= 0.0:
-        lam = 1e6
-    elif XF * XF + ZF * ZF >= L * L:
-        lam = 0.2
-    else:
-        lam = math.sqrt(3.0 * ((L * L - ZF * ZF) / (XF * XF) - 1.0))
-    H = max(abs(w * XF / (2.0 * lam)), 1e-6 * w * L)
-    V = 0.5 * w * (ZF / math.tanh(lam) + L)
-    return H, V
+def _initial_guess(XF, ZF, L, EA, w):
+    """Peyrot & Goulois' guess (an inextensible catenary whose sag matches the chord) or, for
+    a chord longer than L, a straight elastic bar with half the weight hung at each end."""
+    chord = math.hypot(XF, ZF)
+    if chord >= L:
+        T = EA * (chord / L - 1.0)
+        return max(T * XF / chord, 1e-6 * w * L), T * ZF / chord + 0.5 * w * L
+    lam = 1e6 if XF <= 0.0 else math.sqrt(3.0 * ((L * L - ZF * ZF) / (XF * XF) - 1.0))
+    return max(w * XF / (2.0 * lam), 1e-6 * w * L), 0.5 * w * (ZF / math.tanh(lam) + L)
 
 
 def _newton(XF, ZF, L, EA, w, cb, tol, max_iter):
     """Damped Newton on (H, V); returns (H, V, J, iterations) or None if it stalls."""
-    H, V = _initial_guess(XF, ZF, L, w)
-    x, z, J = _shape(H, V, L, EA, w, cb)
-    res = np.array([x - XF, z - ZF])
-    norm = float(np.hypot(*res))
+    H, V = _initial_guess(XF, ZF, L, EA, w)
+    x, z, XH, XV, ZH, ZV = _shape_terms(H, V, L, EA, w, cb)
+    norm = math.hypot(x - XF, z - ZF)
     for it in range(max_iter + 1):
         if norm <= tol:
-            return H, V, J, it
-        try:
-            dH, dV = -np.linalg.solve(J, res)
-        except np.linalg.LinAlgError:
+            return H, V, np.array([[XH, XV], [ZH, ZV]]), it
+        det = XH * ZV - XV * ZH
+        if not det > 0.0:                           # the flexibility is positive definite
             return None
+        dH = -(ZV * (x - XF) - XV * (z - ZF)) / det
+        dV = -(XH * (z - ZF) - ZH * (x - XF)) / det
         # H and V must stay positive: never let a step take away more than 90 % of either
-        t = 1.0
-        for value, step in ((H, dH), (V, dV)):
-            if value + t * step < 0.1 * value:
-                t = 0.9 * value / -step
+        t = min([1.0] + [0.9 * u / -du for u, du in ((H, dH), (V, dV)) if u + du < 0.1 * u])
         while t > 1e-10:                            # backtrack until |residual| decreases
-            Ht, Vt = H + t * dH, V + t * dV
-            x, z, Jt = _shape(Ht, Vt, L, EA, w, cb)
-            rt = np.array([x - XF, z - ZF])
-            nt = float(np.hypot(*rt))
-            if nt < (1.0 - 1e-4 * t) * norm or nt <= tol:
+            trial = _shape_terms(H + t * dH, V + t * dV, L, EA, w, cb)
+            trial_norm = math.hypot(trial[0] - XF, trial[1] - ZF)
+            if trial_norm < (1.0 - 1e-4 * t) * norm or trial_norm <= tol:
                 break
             t *= 0.5
         else:
             return None
-        H, V, J, res, norm = Ht, Vt, Jt, rt, nt
+        H, V, norm = H + t * dH, V + t * dV, trial_norm
+        x, z, XH, XV, ZH, ZV = trial
     return None
 
 
@@ -178,7 +158,7 @@ def _bracketed(XF, ZF, L, EA, w, cb):
 
     def height(H, V):
         count[0] += 1
-        return _shape(H, V, L, EA, w, cb)[1] - ZF
+        return _shape_terms(H, V, L, EA, w, cb)[1] - ZF
 
     def v_for(H):
         hi = w * L + H + 1.0
@@ -187,19 +167,18 @@ def _bracketed(XF, ZF, L, EA, w, cb):
         return brentq(lambda V: height(H, V), 0.0, hi, xtol=1e-300, rtol=1e-15)
 
     def reach(H):
-        V = v_for(H)
-        return _shape(H, max(V, 1e-300), L, EA, w, cb)[0] - XF
+        return _shape_terms(H, v_for(H), L, EA, w, cb)[0] - XF
 
     lo = 1e-12 * w * L
     if reach(lo) >= 0.0:
         H = lo
     else:
-        hi = max(_initial_guess(XF, ZF, L, w)[0], w * L)
+        hi = max(_initial_guess(XF, ZF, L, EA, w)[0], w * L)
         while reach(hi) < 0.0:
             hi *= 4.0
         H = brentq(reach, lo, hi, xtol=1e-300, rtol=1e-15)
     V = v_for(H)
-    return H, V, _shape(H, V, L, EA, w, cb)[2], count[0]
+    return H, V, np.reshape(_shape_terms(H, V, L, EA, w, cb)[2:], (2, 2)), count[0]
 
 
 def solve_catenary(XF: float, ZF: float, length: float, EA: float, weight: float, *,
@@ -215,18 +194,14 @@ def solve_catenary(XF: float, ZF: float, length: float, EA: float, weight: float
     Raises SceneError naming `name` on bad input or if no solution is found.
     """
     where = f"mooring '{name}'"
-    values = dict(XF=XF, ZF=ZF, length=length, EA=EA, weight=weight, friction=friction)
+    values = {"XF": XF, "ZF": ZF, "length": length, "EA": EA, "weight": weight,
+              "friction": friction}
     for key, value in values.items():
-        if not math.isfinite(value):
-            raise SceneError(f"{where}: {key} is {value}; expected a finite number")
-    for key in ("length", "EA", "weight"):
-        if values[key] <= 0.0:
-            raise SceneError(f"{where}: {key} is {values[key]:g}; expected a positive number")
-    if XF < 0.0 or ZF < 0.0 or friction < 0.0:
-        raise SceneError(f"{where}: XF = {XF:g} m, ZF = {ZF:g} m, friction = {friction:g}; "
-                         f"expected all >= 0 (fairlead not below the anchor)")
-    L, w, cb = float(length), float(weight), float(friction)
-    XF, ZF = float(XF), float(ZF)
+        positive = key in ("length", "EA", "weight")
+        if not (math.isfinite(value) and (value > 0.0 if positive else value >= 0.0)):
+            raise SceneError(f"{where}: {key} is {value:g}; expected a finite number "
+                             f"{'> 0' if positive else '>= 0 (fairlead not below the anchor)'}")
+    XF, ZF, L, w, cb = (float(values[k]) for k in ("XF", "ZF", "length", "weight", "friction"))
     chord_strain = math.hypot(XF, ZF) / L - 1.0
     # hanging length of a vertical line reaching ZF, in a form without cancellation
     hanging = 2.0 * ZF / (1.0 + math.sqrt(1.0 + 2.0 * w * ZF / EA))
@@ -239,7 +214,7 @@ def solve_catenary(XF: float, ZF: float, length: float, EA: float, weight: float
             H = EA * stretch / L + 0.5 * cb * w * L
         else:                                       # friction holds the tension off the anchor
             H = math.sqrt(2.0 * cb * w * EA * stretch)
-        stiffness = np.array([[EA / L if H > 0 else 0.0, 0.0], [0.0, w]])
+        stiffness = np.array([[EA / L if H > 0 else 0.0, 0.0], [0.0, w]])   # dV/dZF: as slack
     elif hanging <= L and XF <= L - hanging:        # slack: vertical hang, the rest lying
         H, V = 0.0, w * hanging
         stiffness = np.array([[0.0, 0.0], [0.0, w / (1.0 + w * hanging / EA)]])
@@ -257,22 +232,15 @@ def solve_catenary(XF: float, ZF: float, length: float, EA: float, weight: float
                 raise SceneError(f"{where}: no catenary solution for XF = {XF:g} m, "
                                  f"ZF = {ZF:g} m ({err})") from err
         H, V, J, iterations = found
-        x, z, _ = _shape(H, V, L, EA, w, cb)
-        if not (math.isfinite(H) and math.isfinite(V)) or math.hypot(x - XF, z - ZF) > 1e3 * tol:
+        x, z = _shape_terms(H, V, L, EA, w, cb)[:2]
+        miss = math.hypot(x - XF, z - ZF)
+        if not miss <= 1e3 * tol:                   # also catches NaN
             raise SceneError(f"{where}: no catenary solution for XF = {XF:g} m, ZF = {ZF:g} m "
-                             f"(residual {math.hypot(x - XF, z - ZF):.3g} m)")
+                             f"(residual {miss:.3g} m)")
         stiffness = np.linalg.inv(J)
     lying = max(L - V / w, 0.0)
-    if chord_strain > strain_limit:
-        status = "taut-out"
-    elif chord_strain > 0.0:
-        status = "taut"
-    elif H == 0.0:
-        status = "slack"
-    elif lying > 0.0:
-        status = "seabed contact"
-    else:
-        status = "suspended"
+    status = ("taut-out" if chord_strain > strain_limit else "taut" if chord_strain > 0.0
+              else "slack" if H == 0.0 else "seabed contact" if lying > 0.0 else "suspended")
     return CatenarySolution(H=H, V=V, H_anchor=max(H - cb * w * lying, 0.0),
                             V_anchor=max(V - w * L, 0.0), lying_length=lying, status=status,
                             strain=math.hypot(H, V) / EA, chord_strain=chord_strain,
@@ -296,20 +264,39 @@ def _fmt(p) -> str:
 
 
 @dataclass(frozen=True)
+class ForceTable:
+    """A line's CasADi force Function, the table size (points per axis) and Newton steps it
+    settled on, and its max force error at 4 points in each cell / rest tension."""
+    function: ca.Function
+    n_grid: int
+    newton_steps: int
+    error: float
+
+
+@dataclass(frozen=True)
 class CatenaryLine:
-    """One mooring line from a seabed anchor to a fairlead, with a CasADi force table.
+    """One mooring line from a seabed anchor to a fairlead, with a CasADi force Function.
 
-    anchor, fairlead: positions at rest, n-frame (NED, z down), m; fairlead is the rest
-    position the table is centred on. length: unstretched length, m. EA: axial stiffness, N.
-    weight: submerged weight per metre, N/m (> 0). excursion: the table covers fairlead
-    displacements up to this much horizontally (any direction) and vertically from rest, m;
-    None means 20 % of the rest fairlead height above the anchor. n_grid: table points per
-    axis. friction: seabed friction coefficient (quasi-static, at its limit).
-    strain_limit: chord strain that makes the line "taut-out".
+    anchor, fairlead: rest positions, n-frame (z down), m. length: unstretched, m. EA: N.
+    weight: submerged, N/m (> 0). excursion: the force table covers fairlead displacements
+    from rest up to this, m, horizontally (any direction) and vertically; None: 20 % of the
+    rest fairlead height above the anchor. n_grid, newton_steps: the smallest table (points
+    per axis) and number of Newton steps `force_table` tries. friction: seabed friction
+    coefficient. strain_limit: chord strain beyond which the line is "taut-out".
 
-    Table accuracy and cost (measured with `table_error` and a compiled `force_function`, on
-    the OC3-Hywind line: L = 902.2 m, EA = 384.243 MN, w = 698.094 N/m, XF = 848.67 m,
-    ZF = 250 m, excursion 20 m, default n_grid): see TABLE_NOTE below this class.
+    Measured with force_table(1e-4); error: max |F - F_exact| / rest tension at 4 points per
+    cell, then at 300 random points in the envelope; cost: gcc -O3 C, 2e6 calls, ranges over
+    runs on a shared machine; ~45-90 ns for the lookup plus ~40-100 ns per Newton step:
+      OC3-Hywind line (L 902.2 m, EA 384 MN, w 698 N/m, XF 848.67 m, ZF 250 m, seabed
+        contact), excursion 20 m: 21 x 21, 3 steps, 1.1e-9 / 3.8e-10, 200-350 ns per call.
+      WEC chain (L 140 m, EA 500 MN, w 1 kN/m, XF 120 m, ZF 45 m), 10 m, reaching taut:
+        41 x 41, 3 steps, 3.7e-6 / 2.7e-9. At XF 90 m, 15 m, crossing the slack boundary:
+        21 x 21, 3 steps, 5e-11 / 8e-9.
+      Vertical tether snapping between slack and taut (L 44.7 m, ZF 45 m, EA 20 MN), 3 m:
+        21 x 21, 8 steps, 4.3e-5 / 1.9e-8, 520-840 ns per call.
+    The table alone (no Newton step) errs 2e-2 (21 x 21) and 4e-3 (41 x 41) on OC3; a cubic
+    "bspline" interpolant (which also works in SX graphs and codegen; ~380 ns) still errs
+    8e-5 at 41 x 41, from the curvature jump at touchdown: hence bilinear + Newton.
     """
     name: str
     anchor: tuple
@@ -319,30 +306,24 @@ class CatenaryLine:
     weight: float
     excursion: float | None = None
     n_grid: int = 21
-    interpolation: str = "linear"
-    newton_steps: int = 2
+    newton_steps: int = 3
     friction: float = 0.0
     strain_limit: float = 0.1
 
     def __post_init__(self):
         where = f"mooring '{self.name}'"
-        anchor = _point(self.anchor, where, "anchor")
-        fairlead = _point(self.fairlead, where, "fairlead")
-        object.__setattr__(self, "anchor", anchor)
+        anchor, fairlead = (_point(getattr(self, k), where, k) for k in ("anchor", "fairlead"))
+        object.__setattr__(self, "anchor", anchor)      # frozen: normalise to float tuples
         object.__setattr__(self, "fairlead", fairlead)
-        units = {"length": "m", "EA": "N", "weight": "N/m", "strain_limit": "",
+        units = {"length": " m", "EA": " N", "weight": " N/m", "strain_limit": "",
                  "friction": ""}
         for key, unit in units.items():
             value = getattr(self, key)
-            if not isinstance(value, (int, float)) or not math.isfinite(value):
+            if not isinstance(value, numbers.Real) or not math.isfinite(value):
                 raise SceneError(f"{where}: {key} is {value!r}; expected a finite number")
-        for key in ("length", "EA", "weight", "strain_limit"):
-            if getattr(self, key) <= 0.0:
-                unit = f" {units[key]}" if units[key] else ""
-                raise SceneError(f"{where}: {key} is {getattr(self, key):g}{unit}; expected a "
-                                 f"positive number")
-        if self.friction < 0.0:
-            raise SceneError(f"{where}: friction is {self.friction:g}; expected >= 0")
+            if value <= 0.0 and key != "friction" or value < 0.0:
+                raise SceneError(f"{where}: {key} is {value:g}{unit}; expected a positive "
+                                 f"number" + (" or 0" if key == "friction" else ""))
         height = anchor[2] - fairlead[2]
         if height <= 0.0:
             raise SceneError(f"{where}: anchor {_fmt(anchor)} is not below the fairlead "
@@ -354,17 +335,13 @@ class CatenaryLine:
                              f"(1 + {self.strain_limit:g} strain limit)")
         if self.excursion is None:
             object.__setattr__(self, "excursion", 0.2 * height)
-        if not (isinstance(self.excursion, (int, float)) and 0.0 < self.excursion < height):
+        if not (isinstance(self.excursion, numbers.Real) and 0.0 < self.excursion < height):
             raise SceneError(f"{where}: excursion is {self.excursion!r} m; expected a number "
                              f"between 0 and the fairlead height above the anchor {height:g} m")
-        if not (isinstance(self.n_grid, int) and self.n_grid >= 6):
-            raise SceneError(f"{where}: n_grid is {self.n_grid!r}; expected an integer >= 6")
-        if self.interpolation not in ("linear", "bspline"):
-            raise SceneError(f"{where}: interpolation is {self.interpolation!r}; expected "
-                             f"'linear' or 'bspline'")
-        if not (isinstance(self.newton_steps, int) and self.newton_steps >= 0):
-            raise SceneError(f"{where}: newton_steps is {self.newton_steps!r}; expected an "
-                             f"integer >= 0")
+        for key, low in (("n_grid", 6), ("newton_steps", 0)):
+            value = getattr(self, key)
+            if not (isinstance(value, numbers.Integral) and value >= low):
+                raise SceneError(f"{where}: {key} is {value!r}; expected an integer >= {low}")
 
     # ------------------------------------------------------------------ exact quasi-statics
     def offsets(self, r) -> tuple[float, float, np.ndarray]:
@@ -393,75 +370,66 @@ class CatenaryLine:
         XF, _, d = self.offsets(self.fairlead if r is None else r)
         sol = self.solve(r)
         (H_X, H_Z), (V_X, V_Z) = sol.stiffness
-        e = d / XF if XF > 1e-9 * self.length else np.array([1.0, 0.0])
-        # sideways, the line swings about the anchor: tension H over the lever arm XF
-        lateral = sol.H / XF if XF > 1e-9 * self.length else H_X
+        vertical = XF <= 1e-9 * self.length
+        e = np.array([1.0, 0.0]) if vertical else d / XF
+        # sideways the line swings about the anchor: tension H over the lever arm XF (for a
+        # vertical line H/XF -> dH/dXF)
+        lateral = H_X if vertical else sol.H / XF
         K = np.zeros((3, 3))
         K[:2, :2] = H_X * np.outer(e, e) + lateral * (np.eye(2) - np.outer(e, e))
-        K[:2, 2] = -H_Z * e                 # dZF = -dz: raising the fairlead pulls harder
+        K[:2, 2] = -H_Z * e                 # dZF = -dz (z is down)
         K[2, :2] = -V_X * e
         K[2, 2] = V_Z
         return K
 
     # ------------------------------------------------------------------ CasADi table
-    def grid(self) -> tuple[np.ndarray, np.ndarray]:
-        """Table nodes (uniform) in XF and ZF, m: the rest offsets +- excursion, padded by
-        one cell so that the envelope's edge cells have neighbours on both sides."""
+    def grid(self, n: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Table nodes (uniform, n per axis, default n_grid) in XF and ZF, m: the rest offsets
+        +- excursion, padded by one cell so that the envelope's edge cells have neighbours."""
         XF0, ZF0, _ = self.offsets(self.fairlead)
-        n, e = self.n_grid, self.excursion
+        n, e = n or self.n_grid, self.excursion
         pad = 2.0 * e / (n - 3)
         xs = np.linspace(max(XF0 - e - pad, 0.0), XF0 + e + pad, n)
         zs = np.linspace(max(ZF0 - e - pad, 1e-3 * ZF0), ZF0 + e + pad, n)
         return xs, zs
 
-    def _tables(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        xs, zs = self.grid()
-        H = np.empty((xs.size, zs.size))
-        V = np.empty_like(H)
+    def _table(self, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Grid (see `grid`) and exact H, V on it, N, shape (2, n, n)."""
+        xs, zs = self.grid(n)
+        HV = np.empty((2, n, n))
         for i, x in enumerate(xs):
             for j, z in enumerate(zs):
-                sol = solve_catenary(x, z, self.length, self.EA, self.weight,
-                                     friction=self.friction, strain_limit=self.strain_limit,
-                                     name=self.name)
-                H[i, j], V[i, j] = sol.H, sol.V
-        return xs, zs, H, V
+                sol = self.solve(np.array(self.anchor) + (x, 0.0, -z))
+                HV[:, i, j] = sol.H, sol.V
+        return xs, zs, HV
 
-    def force_function(self) -> ca.Function:
-        """CasADi Function r (3x1, fairlead position, n-frame, m) -> (F (3x1, N, force of the
-        line on the fairlead, n-frame), T (1x1, fairlead tension, N)).
-
-        Inside the slack zone (XF <= L - L_h(ZF)) H = 0 and V = w L_h exactly. Elsewhere a
-        table of the exact H, V over `grid()` (casadi.interpolant, `interpolation` kind)
-        gives the start of `newton_steps` undamped Newton steps on the shape equations,
-        which remove the table's error and make the derivative that of the exact solution
-        (up to the residual). Callable on SX or MX (the table enters as a call node) and
-        C-generated by CodeGenerator. Outside the envelope the table extrapolates and Newton
-        corrects it, but convergence is not guaranteed: keep the motion inside.
-        """
+    def _function(self, table: tuple, steps: int) -> ca.Function:
+        """The force Function from a `_table` and `steps` Newton steps (see `force_table`)."""
         L, EA, w, cb, a = self.length, self.EA, self.weight, self.friction, self.anchor
-        ident = re.sub(r"\W", "_", self.name)
-        xs, zs, H, V = self._tables()
-        # uniform grids: "exact" lookup finds the cell arithmetically (bspline has no such mode)
-        opts = {"lookup_mode": ["exact", "exact"]} if self.interpolation == "linear" else {}
-        # CasADi orders values with the output index fastest, then the first grid axis
-        table = ca.interpolant(f"mooring_{ident}_HV", self.interpolation, [xs, zs],
-                               np.stack([H, V]).ravel(order="F"), opts)
+        ident = re.sub(r"[\W_]+", "_", self.name).strip("_") or "line"   # valid CasADi name
+        xs, zs, HV = table
+        # CasADi orders values with the output index fastest, then the first grid axis;
+        # "exact" lookup finds the cell of a uniform grid arithmetically, but accepts only
+        # grids spaced equally to 1e-14 of their span: offsets from the first node are
+        local = [np.linspace(0.0, g[-1] - g[0], g.size) for g in (xs, zs)]
+        lookup = ca.interpolant(f"mooring_{ident}_HV", "linear", local, HV.ravel(order="F"),
+                                {"lookup_mode": ["exact", "exact"]})
         r = ca.SX.sym("r", 3)
         dx, dy, ZF = r[0] - a[0], r[1] - a[1], a[2] - r[2]
         # smoothed horizontal distance: a finite direction when the line is vertical (XF -> 0),
         # biased by delta^2/(2 XF) elsewhere, i.e. 5e-13 L at XF = L
         delta = 1e-6 * L
         XF = ca.sqrt(dx * dx + dy * dy + delta * delta)
-        guess = table(ca.vertcat(XF, ZF))
+        guess = lookup(ca.vertcat(XF - xs[0], ZF - zs[0]))
         # the shape equations need H > 0: start no lower than a millionth of the line weight
         h, v = ca.fmax(guess[0], 1e-6 * w * L), ca.fmax(guess[1], 1e-6 * w * L)
-        for _ in range(self.newton_steps):
+        for _ in range(steps):
             x, z, XH, XV, ZH, ZV = _shape_terms(h, v, L, EA, w, cb, _SYM)
             det = XH * ZV - XV * ZH
             dh = -(ZV * (x - XF) - XV * (z - ZF)) / det
             dv = -(XH * (z - ZF) - ZH * (x - XF)) / det
-            # keep H and V positive, as in the exact solver (inactive near convergence)
-            h, v = ca.fmax(h + dh, _FLOOR * h), ca.fmax(v + dv, _FLOOR * v)
+            # keep H and V positive, as the exact solver does (inactive near convergence)
+            h, v = ca.fmax(h + dh, 0.1 * h), ca.fmax(v + dv, 0.1 * v)
         hanging = 2.0 * ZF / (1.0 + ca.sqrt(1.0 + 2.0 * w * ZF / EA))
         slack = XF <= L - hanging
         h, v = ca.if_else(slack, 0.0, h), ca.if_else(slack, w * hanging, v)
@@ -469,19 +437,63 @@ class CatenaryLine:
         return ca.Function(f"mooring_{ident}", [r], [F, ca.sqrt(h * h + v * v)], ["r"],
                            ["F", "T"])
 
-    def table_error(self, fun: ca.Function | None = None, n: int = 400, seed: int = 0) -> float:
+    def force_table(self, tolerance: float = 1e-4, max_grid: int = 41,
+                    max_steps: int = 8) -> ForceTable:
+        """The force Function with the cheapest table (n_grid, doubled up to max_grid points
+        per axis) and Newton steps (newton_steps up to max_steps) whose force error at 4 points
+        in every cell is below `tolerance` x the rest tension; if none, warns and returns the
+        most accurate.
+
+        The Function maps r (3x1, fairlead position, n-frame, m) to F (3x1, force of the line
+        on the fairlead, n-frame, N) and T (1x1, fairlead tension, N). In the slack zone
+        (XF <= L - L_h(ZF)) H = 0 and V = w L_h exactly; elsewhere a bilinear table of the
+        exact H, V starts Newton steps on the exact shape equations, which remove the table's
+        error and give the derivative of the exact solution (up to the residual). It takes SX
+        or MX (the table is a call node in SX graphs) and generates C with CodeGenerator.
+        Outside the envelope the table extrapolates and Newton may not converge.
+        """
+        sizes = [self.n_grid]
+        while sizes[-1] < max_grid:
+            sizes.append(min(2 * sizes[-1] - 1, max_grid))
+        tables, checks, best = {}, {}, None
+        # runtime cost grows with the steps, not the grid: try every grid before a new step
+        for steps in range(self.newton_steps, max(max_steps, self.newton_steps) + 1):
+            for n in sizes:
+                if n not in tables:
+                    tables[n] = self._table(n)
+                    # interpolation errs most inside cells: check 4 points in every cell
+                    xs, zs, _ = tables[n]
+                    X, Z = np.meshgrid(*[np.r_[0.75 * g[:-1] + 0.25 * g[1:],
+                                                 0.25 * g[:-1] + 0.75 * g[1:]] for g in (xs, zs)])
+                    points = np.array(self.anchor) + np.c_[X.ravel(), 0 * X.ravel(), -Z.ravel()]
+                    checks[n] = points, np.array([self.force(p)[0] for p in points])
+                fun = self._function(tables[n], steps)
+                error = self._error(fun, *checks[n])
+                if best is None or error < best.error:
+                    best = ForceTable(fun, n, steps, error)
+                if error <= tolerance:
+                    return best
+        warnings.warn(f"mooring '{self.name}': force table error {best.error:.2g} of the rest "
+                      f"tension ({best.n_grid} x {best.n_grid} grid, {best.newton_steps} Newton "
+                      f"steps) exceeds {tolerance:g}; reduce the excursion, or raise max_grid "
+                      f"or max_steps", RuntimeWarning, stacklevel=2)
+        return best
+
+    def force_function(self, tolerance: float = 1e-4) -> ca.Function:
+        """`force_table(tolerance).function`: r (3x1, m) -> (F (3x1, N), T (1x1, N))."""
+        return self.force_table(tolerance).function
+
+    def table_error(self, fun: ca.Function, n: int = 300, seed: int = 0) -> float:
         """Max |F_fun - F_exact| over n random fairlead positions in the envelope (a cylinder:
-        up to `excursion` horizontally and vertically), relative to the rest tension; `fun`
-        defaults to a new `force_function()`."""
-        fun = self.force_function() if fun is None else fun
+        up to `excursion` horizontally and vertically), relative to the rest tension."""
         rng = np.random.default_rng(seed)
-        worst = 0.0
-        for _ in range(n):
-            angle = rng.uniform(0.0, 2.0 * np.pi)
-            radius = self.excursion * math.sqrt(rng.uniform())
-            r = np.array(self.fairlead) + np.array([radius * math.cos(angle),
-                                                    radius * math.sin(angle),
-                                                    rng.uniform(-1.0, 1.0) * self.excursion])
-            exact, _ = self.force(r)
-            worst = max(worst, float(np.max(np.abs(np.array(fun(r)[0]).ravel() - exact))))
-        return worst / self.solve().tension
+        angle = rng.uniform(0.0, 2.0 * np.pi, n)
+        radius = self.excursion * np.sqrt(rng.uniform(size=n))
+        points = np.array(self.fairlead) + np.c_[radius * np.cos(angle), radius * np.sin(angle),
+                                                 rng.uniform(-1.0, 1.0, n) * self.excursion]
+        return self._error(fun, points, np.array([self.force(p)[0] for p in points]))
+
+    def _error(self, fun: ca.Function, points: np.ndarray, exact: np.ndarray) -> float:
+        """Max |F_fun - exact| at fairlead positions `points` (m, (k, 3)) / rest tension."""
+        table = np.array(fun.map(len(points))(points.T)[0]).T
+        return float(np.max(np.abs(table - exact))) / self.solve().tension

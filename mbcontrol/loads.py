@@ -117,13 +117,26 @@ def end_stop_forces(scene: Scene, topo: Topology, q, s, params: Parameters):
 
 
 def mooring_forces(scene: Scene, topo: Topology, q, s, params: Parameters):
-    """Linear spring-dampers from each fairlead's rest position, along the n-frame axes.
-    Returns (generalised force, spring energy 1/2 Σ k_a d_a², J)."""
-    tree, tau, energy = topo.tree, ca.SX.zeros(topo.tree.n_s), 0
+    """Mooring loads mapped through P(q) at each fairlead.
+
+    Linear moorings: spring-dampers from the fairlead's rest position along the n-frame axes.
+    Catenary lines: the quasi-static line tension at the fairlead's current position
+    (mbcontrol.catenary: a table of the exact solution refined by Newton steps, compiled
+    with the plant). Returns (generalised force, spring energy 1/2 Σ k_a d_a² of the linear
+    moorings (J; a catenary's elastic and gravity energy is not included), {line: tension (N)}).
+    """
+    from .scene_parse import catenary_line
+
+    tree, tau, energy, tensions = topo.tree, ca.SX.zeros(topo.tree.n_s), 0, {}
     q_rest = ca.DM.zeros(tree.n_q)
     for m in scene.moorings:
         k = topo.body_index(m.body)
         local = np.asarray(m.point) - topo.origin(m.body)      # body axes = n axes at rest
+        if m.kind == "catenary":
+            force, tension = catenary_line(m).force_function()(tree.point(q, k, local))
+            tau += tree.point_force(q, k, local, force)
+            tensions[m.name] = tension
+            continue
         stiffness = ca.vertcat(*[params.add(f"{m.name}__stiffness_{a}", v)
                                  for a, v in zip("xyz", m.stiffness)])
         damping = ca.vertcat(*[params.add(f"{m.name}__damping_{a}", v)
@@ -133,7 +146,7 @@ def mooring_forces(scene: Scene, topo: Topology, q, s, params: Parameters):
         force = -(stiffness * displacement + damping * velocity)
         tau += tree.point_force(q, k, local, force)
         energy += 0.5 * ca.dot(stiffness, displacement**2)
-    return tau, energy
+    return tau, energy, tensions
 
 
 def drag_forces(scene: Scene, topo: Topology, q, s, params: Parameters):
@@ -174,6 +187,32 @@ def restoring_forces(topo: Topology, q, stiffness_by_body: dict):
     if not stiffness_by_body:
         return ca.SX.zeros(tree.n_s), 0
     return -ca.mtimes(tree.K(q).T, ca.gradient(potential, q)), potential
+
+
+def large_angle_hydrostatics(scene: Scene, topo: Topology, q):
+    """Weight and buoyancy of each hydro body from its immersed part at the current pose.
+
+    Buoyancy comes from the body's primitive (box, cylinder, sphere; mbcontrol.hydro.large_angle)
+    cut by the calm free surface, so restoring stays right at large heel, heave and pitch
+    where the linear stiffness G^b does not. It replaces the linear restoring and the static
+    loads. Returns (generalised force, potential energy relative to rest, J).
+    """
+    from .hydro.large_angle import buoyancy
+    from .hydro_data import geometry_dict
+
+    tree, tau, energy = topo.tree, ca.SX.zeros(topo.tree.n_s), 0
+    rho, g = scene.water.rho, scene.water.g
+    for body in scene.bodies:
+        if not body.hydro:
+            continue
+        k = topo.body_index(body.name)
+        R, r_cog = tree.rotation(q, k), tree.cog(q, k)
+        b = buoyancy(geometry_dict(body.geometry), body.cog, R, r_cog, rho, g)
+        force_n = b["force"] + ca.DM([0.0, 0.0, body.mass * g])     # weight acts at the CoG
+        tau += tree.generalized_force(q, k, ca.vertcat(R.T @ force_n, R.T @ b["moment"]))
+        rest = buoyancy(geometry_dict(body.geometry), body.cog, np.eye(3), np.asarray(body.cog), rho, g)
+        energy += b["potential"] - float(rest["potential"]) - body.mass * g * (r_cog[2] - body.cog[2])
+    return tau, energy
 
 
 def static_loads(scene: Scene, topo: Topology, q, buoyancy: dict):

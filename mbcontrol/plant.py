@@ -117,18 +117,24 @@ def build_plant(scene: Scene | str, hydro: HydroModel | None = None, *,
         chi_dot = ca.mtimes(A_r, chi) + ca.mtimes(B_r, nu_h)
         tau += ca.mtimes(P, ca.mtimes(select.T, w - mu_h))
         power = {"radiated_power": ca.dot(nu_h, mu_h), "excitation_power": ca.dot(nu_h, w)}
-    restoring, potential = loads.restoring_forces(topo, q, hydro.stiffness_by_body() if hydro
-                                                  else {})
+    if scene.hydro.hydrostatics == "large_angle":
+        restoring, potential = loads.large_angle_hydrostatics(scene, topo, q)
+    else:
+        restoring, potential = loads.restoring_forces(topo, q, hydro.stiffness_by_body() if hydro
+                                                      else {})
     tau += restoring
     tau_pto, pto_signals = loads.pto_forces(scene, topo, q, s, u, params)
     tau += tau_pto + loads.friction_forces(scene, topo, s, params)
     tau += loads.drag_forces(scene, topo, q, s, params)
-    for conservative in (loads.mooring_forces(scene, topo, q, s, params),
-                         loads.end_stop_forces(scene, topo, q, s, params),
+    tau_moor, mooring_energy, tensions = loads.mooring_forces(scene, topo, q, s, params)
+    tau += tau_moor
+    potential += mooring_energy
+    for conservative in (loads.end_stop_forces(scene, topo, q, s, params),
                          loads.gravity_forces(scene, topo, q)):
         tau += conservative[0]
         potential += conservative[1]
-    tau += loads.static_loads(scene, topo, q, hydro.buoyancy(scene.water) if hydro else {})
+    if scene.hydro.hydrostatics == "linear":
+        tau += loads.static_loads(scene, topo, q, hydro.buoyancy(scene.water) if hydro else {})
     tau += _preloads(scene, topo, q, s, u, w, chi, tau, pto_signals, params)
 
     M = tree.mass_matrix(q, added_mass)
@@ -138,7 +144,7 @@ def build_plant(scene: Scene | str, hydro: HydroModel | None = None, *,
     x_dot = ca.vertcat(ca.mtimes(tree.K(q), s), s_dot, chi_dot)
     kinetic = 0.5 * ca.mtimes([s.T, M, s])
     power["energy"] = kinetic + potential
-    y, output_names = _outputs(scene, topo, q, s, pto_signals, power)
+    y, output_names = _outputs(scene, topo, q, s, pto_signals, power, tensions)
     p = params.vector
 
     coords = list(tree.coordinate_names)
@@ -218,7 +224,7 @@ def _selector(topo: Topology, dofs: list[str]) -> np.ndarray:
     return select
 
 
-def _outputs(scene, topo: Topology, q, s, pto_signals, power):
+def _outputs(scene, topo: Topology, q, s, pto_signals, power, tensions):
     tree = topo.tree
     q_rest = ca.DM.zeros(tree.n_q)
     values, names = [q, s], list(tree.coordinate_names) + [f"{c}__vel" for c in
@@ -235,6 +241,8 @@ def _outputs(scene, topo: Topology, q, s, pto_signals, power):
     # forces, springs included, are external: their power is <pto>__power
     values += [power["radiated_power"], power["excitation_power"], power["energy"]]
     names += ["radiated_power", "excitation_power", "energy"]
+    values += list(tensions.values())
+    names += [f"{line}__tension" for line in tensions]
     return ca.vertcat(*values), names
 
 
@@ -270,6 +278,8 @@ def _units(plant, signal: str) -> str:
             kind = "force" if base == pto.name else base.split("__")[-1]
             return {"position": coord, "velocity": f"{coord}/s", "force": force,
                     "power": "W"}[kind]
+    if signal.endswith("__tension"):
+        return "N"
     if signal.endswith("__vel"):
         return f"{_coordinate_unit(plant, signal[:-5])}/s"
     if "__" in signal and signal.split("__")[-1] in _BODY_UNITS and \

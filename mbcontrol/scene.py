@@ -109,12 +109,24 @@ class Friction:
 
 @dataclass(frozen=True)
 class Mooring:
-    """Linear spring-damper between a body point and an anchor, per n-frame axis."""
+    """A mooring at a body point (the fairlead).
+
+    kind "linear": a spring-damper from the fairlead's rest position, per n-frame axis.
+    kind "catenary": a quasi-static elastic catenary line to a seabed anchor
+    (mbcontrol.catenary): its tension at the fairlead, from the line's length, axial stiffness
+    EA and submerged weight per metre, with seabed contact.
+    """
     name: str
     body: str
     point: tuple[float, float, float]          # m, fairlead on the body, n-frame at rest
-    stiffness: tuple[float, float, float]      # N/m along n-frame x, y, z
+    stiffness: tuple[float, float, float] = (0.0, 0.0, 0.0)  # N/m along n-frame x, y, z
     damping: tuple[float, float, float] = (0.0, 0.0, 0.0)  # N s/m
+    kind: str = "linear"                       # "linear" | "catenary"
+    anchor: tuple[float, float, float] | None = None   # m, n-frame (catenary)
+    length: float = 0.0                        # m, unstretched (catenary)
+    EA: float = 0.0                            # N, axial stiffness (catenary)
+    weight: float = 0.0                        # N/m, submerged weight (catenary)
+    excursion: float | None = None             # m, fairlead motion the force table covers
 
 
 @dataclass(frozen=True)

@@ -132,7 +132,10 @@ def _friction(r: Reader) -> Friction:
 
 
 def _mooring(r: Reader) -> Mooring:
-    r.allow("name", "body", "point", "stiffness", "damping")
+    kind = r.choice("type", ("linear", "catenary"), default="linear")
+    if kind == "catenary":
+        return _catenary(r)
+    r.allow("name", "type", "body", "point", "stiffness", "damping")
     stiffness = r.vector("stiffness", None)
     damping = r.vector("damping", None, default=(0.0, 0.0, 0.0))
     for key, values in (("stiffness", stiffness), ("damping", damping)):
@@ -140,6 +143,28 @@ def _mooring(r: Reader) -> Mooring:
             r.fail(key, f"expected three non-negative numbers, got {list(values)}")
     return Mooring(name=r.name(), body=r.string("body"), point=r.vector("point", "length"),
                    stiffness=stiffness, damping=damping)
+
+
+def _catenary(r: Reader) -> Mooring:
+    r.allow("name", "type", "body", "point", "anchor", "length", "EA", "weight", "excursion")
+    m = Mooring(name=r.name(), body=r.string("body"), point=r.vector("point", "length"),
+                kind="catenary", anchor=r.vector("anchor", "length"),
+                length=r.positive("length", "length"), EA=r.positive("EA"),
+                weight=r.positive("weight"),
+                excursion=r.positive("excursion", "length") if "excursion" in r.data else None)
+    try:    # geometry checks (anchor below the fairlead, within the line's reach)
+        catenary_line(m)
+    except ValueError as exc:
+        r.fail("anchor", str(exc))
+    return m
+
+
+def catenary_line(m: Mooring):
+    """The mbcontrol.catenary.CatenaryLine of a catenary mooring."""
+    from .catenary import CatenaryLine
+
+    return CatenaryLine(name=m.name, anchor=m.anchor, fairlead=m.point, length=m.length, EA=m.EA,
+                        weight=m.weight, excursion=m.excursion)
 
 
 def _end_stop(r: Reader) -> EndStop:

@@ -2,57 +2,66 @@
 
 Frames and units: n-frame NED (x forward, y starboard, z down, origin on the undisturbed free
 surface, water at z > 0); body axes coincide with the n-frame axes at rest. SI units throughout.
-All functions take numpy inputs (and return numpy) or CasADi SX/MX/DM inputs (and return pure
+The functions take numpy inputs (and return numpy) or CasADi SX/MX/DM inputs (and return pure
 CasADi expressions: no callbacks, no branching on values), so they can go into a plant that is
 compiled to C and integrated with a fixed-step RK4.
 
 Method
 ------
-Sphere: exact spherical-cap formulas (volume pi h^2 (3r - h)/3, centroid 3(2r - h)^2/(4(3r - h))
-below the sphere centre).
+Sphere: exact cap formulas (wet cap height h: volume pi h^2 (3r - h)/3, centroid
+3 (2r - h)^2 / (4 (3r - h)) below the sphere's centre).
 
-Box and cylinder: the body is cut into straight *fibres* parallel to its body z axis (vertical at
-rest), one through each point of a quadrature rule on the cross-section, with weight w_i (m^2):
+Box and vertical cylinder (axis "z"): straight *fibres* along body z through the nodes of a
+cross-section rule with weights w_i (m^2): Gauss-Legendre n x n on the Lx x Ly rectangle; for
+the disk, Gauss-Legendre in radius (weight rho d rho, ceil(n/2) nodes) times 2n uniform angles
+(offset half a step, so no node sits on a symmetry plane). A fibre's wet part is an exact interval
+(its depth is linear along it), clipped to its ends; its buoyancy acts at the interval's midpoint.
 
-- box: Gauss-Legendre n x n on the Lx x Ly rectangle, fibres of length Lz;
-- cylinder with axis "z": Gauss-Legendre in radius (weight rho d rho, ceil(n/2) points) times a
-  uniform rule of 2n angles (offset by half a step so no node sits on a symmetry plane);
-- cylinder with axis "x" or "y": vertical *chords* of the circular section, at Gauss-Legendre
-  points along the axis (n) times Gauss-Legendre points in phi (n), t = r sin(phi) across, chord
-  length 2 r cos(phi). Fibres along a horizontal axis would be horizontal at rest: every fibre
-  wholly wet or dry, so V would be a staircase in heave (zero waterplane stiffness).
+Horizontal cylinder (axis "x" or "y"): 2n slices across the axis at Gauss-Legendre nodes, each
+slice's wet part an exact circular segment (area and first moment in closed form). Fibres along a
+horizontal axis would be wholly wet or dry at rest, making V a staircase in heave (zero
+waterplane stiffness); the slices are exact in roll about the axis and cost ~25 operations each.
 
-A fibre's wet part is an exact interval (its depth is linear along it), clipped to its ends, and
-its buoyancy acts at that interval's midpoint: V = sum w_i l_i, first moment sum w_i l_i m_i.
-This discrete model is *exactly conservative*: it is the quadrature, with body-fixed nodes, of
-U = rho g int_wet (z + eta) dV, and because the integrand vanishes on the free surface the moving
-end of each interval contributes nothing to dU; so (force, moment) = -grad U to round-off
-(tested). Clipping uses fmin/fmax rather than a smooth (softplus) clip: a smoothed clip would
-change V (by the smoothing width times the wet fibres) and the "-grad U" identity would hold only
-for a smoothed potential; the kinks of fmin/fmax are where the waterline passes a fibre end, and
-RK4 only loses local order there. A fibre with |direction_z| < 1e-12 (horizontal) uses a safe
-denominator 1e-12: the crossing point is then far outside the fibre, which is wholly wet or dry
-according to the sign of its depth, the correct limit.
+Exactly conservative: each model is a body-fixed quadrature of U = rho g int_wet (z + eta) dV with
+exact inner integrals, and the integrand vanishes on the free surface, so the moving end of each
+wet interval or segment adds nothing to dU: (force, moment) = -grad U to round-off (tested to
+4e-16 relative). Clipping uses fmin/fmax, not a smooth clip: a softplus-type clip would bias V by
+its width times the wet fibres, and "-grad U" would hold only for a smoothed potential; the kinks
+of fmin/fmax occur where the waterline passes a fibre end (RK4 loses local order only there). A
+horizontal fibre (|direction_z| < 1e-12) uses a safe denominator: its crossing point falls far
+outside and it is wholly wet or dry by the sign of its depth, the correct limit.
 
-Accuracy and cost (default n = 12; measured by the study script described in
-tests/test_large_angle.py against independent references: convex-polyhedron clipping for the box,
-slice integrals of circular segments for the cylinder). The wet fibre length is piecewise linear
-across the cross-section (kinks where the waterline meets a fibre end), so the errors fall like
-n^-2 (between n^-2 and n^-3 on the curves charted); poses with the waterline parallel to the
-fibres (heel near 90 deg) fall like n^-1 only, since then each fibre is nearly all wet or all dry.
+Accuracy and cost
+-----------------
+References (tests/test_large_angle.py): convex-polyhedron clipping for boxes; circular-segment
+slices integrated by adaptive quadrature for cylinders (itself agreeing to 1e-10 with a clipped
+360-sided prism and to 5e-8 with Capytaine's immersed_part volume). The wet fibre length is
+piecewise linear across the cross-section, with kinks where the waterline meets the fibre ends,
+so errors fall like n^-2 (irregularly: they depend on where the kinks fall between nodes). They
+are 0 (round-off) when every fibre crosses the waterline (upright and slightly heeled bodies),
+when fully immersed and when dry. Near 90 deg heel the fibres lie along the waterline and the
+error falls like 1/n only. Worst |dV|/V_wet over 41 drafts from 25 to 75 % wet and heel axes at
+0/30/60/90 deg azimuth (centre-of-buoyancy error / body size is about half of it):
 
-================================  =======  =======  =======  =======  =======
-max |dV|/V_total (%), heel         0 deg   10 deg   30 deg   60 deg   89 deg
-================================  =======  =======  =======  =======  =======
-box 2 x 1 x 1, n = 12              0        1.5e-3   1.2e-2   6.4e-2   0.40
-vertical cylinder r 1, L 2         0        3.7e-3   1.3e-2   7.9e-2   0.22
-horizontal cylinder r 1, L 3       5.9e-4   4.7e-3   2.4e-2   2.8e-2   4.2e-2
-================================  =======  =======  =======  =======  =======
+==========================  =======  =======  =======  =======  =======
+heel <= 30 deg                n = 8   n = 12   n = 16   n = 24   n = 32
+==========================  =======  =======  =======  =======  =======
+box 2 x 1 x 1                5.7e-3   4.5e-3   1.9e-3   1.4e-3   4.5e-4
+flat barge 4 x 2 x 0.5       4.8e-2   1.3e-2   1.4e-2   4.9e-3   2.4e-3
+vertical cylinder r 1, L 2   4.6e-4   9.2e-5   1.0e-4   1.9e-5   1.8e-5
+horizontal cyl. r 1, L 3     2.3e-4   7.5e-5   4.2e-5   1.2e-5   6.6e-6
+compiled, us/eval: box       0.56     1.2      2.4      5.5
+                   vert cyl  0.63     1.4      2.5      5.8
+                   horiz cyl 0.27     0.44     0.54     0.70
+==========================  =======  =======  =======  =======  =======
 
-(max over drafts from nearly dry to nearly submerged, heel about x then y; an exact 0 where every
-fibre is wholly wet or crosses the waterline between its ends). The centre of buoyancy is off by
-at most 0.3 % of the body size at heel <= 30 deg. Cost: 144 fibres, about 2 400 SX nodes for the
-wrench; 1.1 us per evaluation compiled with gcc -O3 (SX virtual machine: 16 us).
+(n = 16 at 60 / 89 deg: box 7.5e-3 / 0.13, vertical cylinder 7.5e-4 / 3.6e-2, horizontal
+cylinder 4.3e-4 / 4.6e-2.) Sphere: exact, 0.016 us. Times: force + moment, gcc -O3 -march=native,
+one core of the shared test machine; the SX virtual machine takes 17 us (box, n = 16), numpy
+~0.2 ms. Default n = 16: < 0.1 % of the wet volume at heel <= 30 deg for both cylinders at any
+draft and for boxes whose fibres all cross the waterline; at the worst draft a box heeled 30 deg
+is off by up to 0.2 % (2 x 1 x 1) to 1.4 % (flat barge) of the wet volume (0.06 % and 0.4 % of
+the body's whole volume), and needs n ~ 32-48 for 0.1 %. Pass a smaller n for speed.
 """
 from __future__ import annotations
 
@@ -64,16 +73,20 @@ import numpy as np
 
 from mbcontrol.errors import HydroError
 
-DEFAULT_N = 12
+DEFAULT_N = 16
 _EPS_DIR = 1e-12      # safe |z-component| of the fibre direction (dimensionless)
 _V_TINY = 1e-12       # relative volume below which the centre of buoyancy is reported at the CoG
 
 
 # ----------------------------------------------------------------------------- fibre layouts
+@lru_cache(maxsize=64)
 def _gauss(n: int, a: float, b: float) -> tuple[np.ndarray, np.ndarray]:
     """Gauss-Legendre nodes and weights on [a, b]."""
     x, w = np.polynomial.legendre.leggauss(n)
-    return 0.5 * (b - a) * x + 0.5 * (a + b), 0.5 * (b - a) * w
+    x, w = 0.5 * (b - a) * x + 0.5 * (a + b), 0.5 * (b - a) * w
+    x.setflags(write=False)
+    w.setflags(write=False)                                # cached: shared between callers
+    return x, w
 
 
 def _counts(n) -> tuple[int, int]:
@@ -101,7 +114,7 @@ def _layout(kind: str, dims: tuple, offset: tuple, axis: str, n: tuple) -> tuple
         U, V = np.meshgrid(u, v, indexing="ij")
         x, y, w = U.ravel(), V.ravel(), np.outer(wu, wv).ravel()
         h = np.full(x.size, lz / 2)
-    elif axis == "z":
+    else:                                                  # vertical cylinder (axis "z")
         r, length = dims
         nr, nt = max(1, math.ceil(n1 / 2)), 2 * n2
         rho, wr = _gauss(nr, 0.0, r)
@@ -110,31 +123,10 @@ def _layout(kind: str, dims: tuple, offset: tuple, axis: str, n: tuple) -> tuple
         x, y = (Rr * np.cos(T)).ravel(), (Rr * np.sin(T)).ravel()
         w = np.outer(wr * rho, np.full(nt, 2 * math.pi / nt)).ravel()
         h = np.full(x.size, length / 2)
-    else:
-        r, length = dims
-        s, ws = _gauss(n1, -length / 2, length / 2)
-        phi, wp = _gauss(n2, -math.pi / 2, math.pi / 2)
-        S, Phi = np.meshgrid(s, phi, indexing="ij")
-        along, across = S.ravel(), (r * np.sin(Phi)).ravel()
-        w = np.outer(ws, wp * r * np.cos(phi)).ravel()  # dt = r cos(phi) dphi
-        h = (r * np.cos(Phi)).ravel()
-        x, y = (along, across) if axis == "x" else (across, along)
     P = np.vstack([x + o[0], y + o[1], np.full(x.size, o[2])])
     for a in (P, h, w):
         a.setflags(write=False)
     return P, h, w
-
-
-def fibres(geometry: dict, cog_rest, n=DEFAULT_N) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The fibre layout of a box or cylinder: (P, h, w), see the module docstring.
-
-    P (3, N): fibre centres in the body frame relative to the CoG, m; h (N,): half-lengths, m;
-    w (N,): cross-section weights, m^2 (sum w_i 2 h_i = the body's volume). Fibres run along body z.
-    """
-    kind, dims, offset, axis = _parse(geometry, cog_rest)
-    if kind == "sphere":
-        raise HydroError("large_angle.fibres: a sphere has exact formulas, no fibres")
-    return _layout(kind, dims, offset, axis, _counts(n))
 
 
 def _parse(geometry: dict, cog_rest) -> tuple:
@@ -247,17 +239,62 @@ def _sphere_sums(radius, offset, R, r_cog, eta, symbolic):
     return V, a, V * zeta + below
 
 
-def _sums(geometry, cog_rest, R, r_cog, eta, n):
+def _slice_sums(radius, length, offset, axis, n, R, r_cog, eta, symbolic):
+    """(V, a, U/(rho g)) of a horizontal cylinder: exact circular-segment slices across the axis.
+
+    Slice k (Gauss-Legendre node s_k along the axis) is a disk of radius r; within its plane the
+    depth grows by g = sqrt(1 - a_z^2) per metre along d = (e_z - a_z a)/g, so its wet part is
+    xi > xi* = -depth/g: area r^2 acos(xi*/r) - xi* sqrt(r^2 - xi*^2), first moment along d
+    (2/3)(r^2 - xi*^2)^(3/2). xi* is clipped to +-r(1 - 1e-14): the area there is ~1e-21 r^2, and
+    the derivatives of acos and sqrt stay finite, so AD never forms inf * 0.
+    """
+    R, r_cog, eta, fmin, fmax, _ = _prep(R, r_cog, eta, symbolic)
+    s, w = _gauss(n, -length / 2, length / 2)
+    col = {"x": 0, "y": 1}[axis]
+    o = np.asarray(offset, dtype=float)
+    sq, acos = (ca.sqrt, ca.acos) if symbolic else (np.sqrt, np.arccos)
+    if symbolic:
+        a, Ro, sd, wd = R[:, col], ca.mtimes(R, ca.DM(o)), ca.DM(s).T, ca.DM(w).T
+    else:
+        a, Ro, sd, wd = R[:, col], R @ o, s, w
+    centre = r_cog + Ro
+    zeta = centre[2] + a[2] * sd                           # depth of each slice centre
+    if callable(eta):
+        zeta = zeta + eta(centre[0] + a[0] * sd, centre[1] + a[1] * sd)
+    else:
+        zeta = zeta + eta
+    g2 = a[0] ** 2 + a[1] ** 2
+    g = sq(fmax(g2, _EPS_DIR**2))                          # safe: an upright axis gives dry/wet slices
+    r_in = radius * (1 - 1e-14)
+    xi = fmin(fmax(-zeta / g, -r_in), r_in)
+    q = radius**2 - xi**2
+    area = radius**2 * acos(xi / radius) - xi * sq(q)
+    m = 2.0 / 3.0 * q * sq(q)
+    ez = ca.DM([0, 0, 1]) if symbolic else np.array([0.0, 0.0, 1.0])
+    if symbolic:
+        V, sA, sm, sAz = ca.sum2(wd * area), ca.sum2(wd * area * sd), ca.sum2(wd * m), ca.sum2(wd * area * zeta)
+    else:
+        V, sA, sm, sAz = float(w @ area), float(w @ (area * s)), float(w @ m), float(w @ (area * zeta))
+    a_vec = Ro * V + a * sA + (ez - a[2] * a) * (sm / g)
+    return V, a_vec, sAz + g2 / g * sm
+
+
+def _sums(geometry, cog_rest, R, r_cog, eta, n, symbolic):
+    """(V, a, U/(rho g), total volume) of any primitive; a = int_wet (x - r_cog) dV."""
     kind, dims, offset, axis = _parse(geometry, cog_rest)
-    symbolic = _is_casadi(R, r_cog, eta)
     if kind == "sphere":
         V, a, u = _sphere_sums(dims[0], offset, R, r_cog, eta, symbolic)
         vol = 4 / 3 * math.pi * dims[0] ** 3
+    elif axis != "z":
+        V, a, u = _slice_sums(*dims, offset, axis, 2 * _counts(n)[0], R, r_cog, eta, symbolic)
+        vol = math.pi * dims[0] ** 2 * dims[1]
     else:
         P, h, w = _layout(kind, dims, offset, axis, _counts(n))
         V, a, u = _fibre_sums(P, h, w, R, r_cog, eta, symbolic)
         vol = float(np.dot(w, 2 * h))
-    return V, a, u, vol, symbolic
+    if not symbolic:
+        V, u = float(V), float(u)
+    return V, a, u, vol
 
 
 # ----------------------------------------------------------------------------- public API
@@ -272,11 +309,13 @@ def buoyancy(geometry: dict, cog_rest, R, r_cog, rho: float, g: float, *, n=DEFA
     R : rotation body -> n-frame (3x3; numpy or CasADi).
     r_cog : current CoG position, n-frame, m (3).
     rho, g : water density (kg/m^3) and gravity (m/s^2); numbers or CasADi scalars.
-    n : quadrature points per cross-section direction (int, or a pair), see the module docstring;
-        ignored for a sphere. Default 12 (144 fibres for a box).
+    n : resolution (int, or a pair (n1, n2) for the two directions): box n1 x n2 fibres; vertical
+        cylinder ceil(n1/2) radii x 2 n2 angles; horizontal cylinder 2 n1 slices; ignored for a
+        sphere. Default 16 (256 fibres, 32 slices). Accuracy and cost: see the module docstring.
     eta : free-surface elevation, m, positive up (the surface is z = -eta): a number or CasADi
         scalar (uniform level), or a callable ``eta(x, y)`` evaluated elementwise at each fibre's
-        centre (for a sphere: at its centre), a long-wave approximation that is not conservative.
+        centre (for a sphere: at its centre; for slices: at theirs), a long-wave approximation that
+        is not conservative; with numpy R and r_cog it must return numbers.
 
     Returns
     -------
@@ -286,7 +325,8 @@ def buoyancy(geometry: dict, cog_rest, R, r_cog, rho: float, g: float, *, n=DEFA
     are -dU/d(translation), -dU/d(rotation about n-frame axes through the CoG)).
     CasADi inputs give 3x1 CasADi expressions; numpy inputs give numpy (3,) arrays and floats.
     """
-    V, a, u, vol, symbolic = _sums(geometry, cog_rest, R, r_cog, eta, n)
+    symbolic = _is_casadi(R, r_cog, eta, rho, g)
+    V, a, u, vol = _sums(geometry, cog_rest, R, r_cog, eta, n, symbolic)
     k = rho * g
     if symbolic:
         r_c = ca.reshape(r_cog if _is_casadi(r_cog) else ca.DM(np.asarray(r_cog, dtype=float)), 3, 1)
@@ -304,5 +344,5 @@ def buoyancy(geometry: dict, cog_rest, R, r_cog, rho: float, g: float, *, n=DEFA
 def potential(geometry: dict, cog_rest, R, r_cog, rho: float, g: float, *, n=DEFAULT_N, eta=0.0):
     """Hydrostatic potential U = rho g int_wet (z + eta) dV (J) of the same discrete model as
     :func:`buoyancy`, whose wrench is exactly -grad U. Weight (m g z) is not included."""
-    _, _, u, _, _ = _sums(geometry, cog_rest, R, r_cog, eta, n)
+    _, _, u, _ = _sums(geometry, cog_rest, R, r_cog, eta, n, _is_casadi(R, r_cog, eta, rho, g))
     return rho * g * u
