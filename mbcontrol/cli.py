@@ -145,8 +145,16 @@ def _simulate(args) -> int:
     if args.wave != "none":
         if duration is None:
             duration = 30 * args.period if args.wave == "regular" and args.period else 600.0
+        omega = plant.hydro.omega if plant.hydro is not None else None
+        band = (float(omega[0]), float(omega[-1])) if omega is not None else None
         wave = from_args(args.wave, height=args.height, period=args.period, hs=args.hs,
-                         tp=args.tp, gamma=args.gamma, seed=args.seed, duration=duration)
+                         tp=args.tp, gamma=args.gamma, seed=args.seed, duration=duration,
+                         data_band=band)
+        outside = wave.settings.get("spectrum_outside_data", 0.0)
+        if outside > 1e-3:
+            print(f"mbcontrol: note: {100 * outside:.2g} % of the spectrum's variance lies outside the "
+                  f"hydro data ({band[0]:.3g}..{band[1]:.3g} rad/s) and is left out; Hs is kept on the "
+                  f"rest", file=sys.stderr)
     elif duration is None:
         duration = 60.0
     controller = _controller(args)

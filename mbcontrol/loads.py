@@ -123,7 +123,8 @@ def mooring_forces(scene: Scene, topo: Topology, q, s, params: Parameters):
     Catenary lines: the quasi-static line tension at the fairlead's current position
     (mbcontrol.catenary: a table of the exact solution refined by Newton steps, compiled
     with the plant). Returns (generalised force, spring energy 1/2 Σ k_a d_a² of the linear
-    moorings (J; a catenary's elastic and gravity energy is not included), {line: tension (N)}).
+    moorings (J; a catenary's elastic and gravity energy is not included), {line: (tension (N),
+    fairlead's horizontal distance from the anchor (m), its height above it (m))}).
     """
     from .scene_parse import catenary_line
 
@@ -133,9 +134,11 @@ def mooring_forces(scene: Scene, topo: Topology, q, s, params: Parameters):
         k = topo.body_index(m.body)
         local = np.asarray(m.point) - topo.origin(m.body)      # body axes = n axes at rest
         if m.kind == "catenary":
-            force, tension = catenary_line(m).force_function()(tree.point(q, k, local))
+            fairlead = tree.point(q, k, local)
+            force, tension = catenary_line(m).force_function()(fairlead)
             tau += tree.point_force(q, k, local, force)
-            tensions[m.name] = tension
+            span = ca.norm_2(fairlead[:2] - ca.DM(m.anchor[:2]))
+            tensions[m.name] = (tension, span, m.anchor[2] - fairlead[2])
             continue
         stiffness = ca.vertcat(*[params.add(f"{m.name}__stiffness_{a}", v)
                                  for a, v in zip("xyz", m.stiffness)])

@@ -241,8 +241,9 @@ def _outputs(scene, topo: Topology, q, s, pto_signals, power, tensions):
     # forces, springs included, are external: their power is <pto>__power
     values += [power["radiated_power"], power["excitation_power"], power["energy"]]
     names += ["radiated_power", "excitation_power", "energy"]
-    values += list(tensions.values())
-    names += [f"{line}__tension" for line in tensions]
+    for line, signals in tensions.items():
+        values += list(signals)
+        names += [f"{line}__tension", f"{line}__span", f"{line}__height"]
     return ca.vertcat(*values), names
 
 
@@ -280,6 +281,8 @@ def _units(plant, signal: str) -> str:
                     "power": "W"}[kind]
     if signal.endswith("__tension"):
         return "N"
+    if signal.endswith(("__span", "__height")):
+        return "m"
     if signal.endswith("__vel"):
         return f"{_coordinate_unit(plant, signal[:-5])}/s"
     if "__" in signal and signal.split("__")[-1] in _BODY_UNITS and \

@@ -105,8 +105,12 @@ def irregular(hs: float, tp: float, *, gamma: float = 3.3, seed: int = 0,
 
 
 def from_args(kind: str, *, height=None, period=None, hs=None, tp=None, gamma=3.3, seed=0,
-              duration=600.0) -> Wave:
-    """The wave a CLI or config describes: 'regular', 'jonswap' or 'pm'."""
+              duration=600.0, data_band=None) -> Wave:
+    """The wave a CLI or config describes: 'regular', 'jonswap' or 'pm'.
+
+    data_band: (lo, hi) rad/s of the model's hydro data; an irregular sea's components are kept
+    inside it (Hs stays exact on the kept components; settings["spectrum_outside_data"] records
+    the fraction of the spectrum's variance that fell outside)."""
     if kind == "regular":
         if height is None or period is None:
             raise ValueError("a regular wave needs --height and --period")
@@ -114,7 +118,20 @@ def from_args(kind: str, *, height=None, period=None, hs=None, tp=None, gamma=3.
     if kind in ("jonswap", "pm"):
         if hs is None or tp is None:
             raise ValueError(f"a {kind} sea needs --hs and --tp")
-        return irregular(hs, tp, gamma=gamma, seed=seed, duration=duration, kind=kind)
+        band = (0.3, 4.0)
+        if data_band is None:
+            return irregular(hs, tp, gamma=gamma, seed=seed, duration=duration, kind=kind)
+        wp = 2 * np.pi / tp
+        lo, hi = max(band[0], data_band[0] / wp), min(band[1], data_band[1] / wp)
+        if not lo < hi:
+            raise ValueError(f"a {kind} sea with tp = {tp} s lies outside the hydro data's band "
+                             f"{data_band[0]:.3g}..{data_band[1]:.3g} rad/s")
+        wave = irregular(hs, tp, gamma=gamma, seed=seed, duration=duration, band=(lo, hi), kind=kind)
+        w = np.linspace(band[0] * wp, band[1] * wp, 4001)
+        S = jonswap_spectrum(w, hs, tp, gamma if kind == "jonswap" else 1.0)
+        inside = (w >= lo * wp) & (w <= hi * wp)
+        wave.settings["spectrum_outside_data"] = float(1 - np.trapezoid(S * inside, w) / np.trapezoid(S, w))
+        return wave
     raise ValueError(f"unknown wave type {kind!r}; expected regular, jonswap or pm")
 
 

@@ -89,3 +89,23 @@ def test_anchor_beyond_reach_names_the_mooring():
     with pytest.raises(SceneError, match=r"slider\.toml: mooring\[0\]\.anchor: mooring 'bow': anchor "
                                          r"\(-40, 0, 10\) is \d+ m from the fairlead, beyond the line's reach"):
         parse_scene(tomllib.loads(text), Path("slider.toml"))
+
+
+def test_slack_line_and_envelope_are_reported():
+    import json
+
+    from mbcontrol.simulate import simulate
+
+    plant = _plant()
+    x0 = plant.x0()
+    x0[plant.states.index("surge")] = 2.5     # beyond the table's ±1.96 m; stern line goes slack
+    with pytest.warns(RuntimeWarning) as caught:
+        ds = simulate(plant, duration=2.0, dt=0.01, x0=x0)
+    text = " ".join(str(w.message) for w in caught)
+    assert "mooring 'stern' was slack at t = 0 s" in text
+    assert "mooring 'bow': the fairlead left the force table's envelope" in text
+    report = json.loads(ds.attrs["moorings"])
+    assert report["stern"]["least_stretched"]["status"] == "slack"
+    assert report["bow"]["most_stretched"]["status"] == "seabed contact"
+    assert report["bow"]["left_envelope"] and report["bow"]["tension_max_N"] > report["bow"]["tension_min_N"]
+    assert ds["bow__span"].attrs["units"] == "m"

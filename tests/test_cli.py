@@ -83,3 +83,21 @@ def test_simulate_issue3_models(capsys, model):
     result = json.loads(out)
     pto = next(iter(result["ptos"].values()))
     assert pto["mean_power_W"] > 0 and pto["max_stroke"] > 0       # a damper absorbs
+
+
+@pytest.mark.parametrize("model, scene_param", [("raft3", None), ("array4", None), ("flap_pair", None),
+                                                ("barge_chain", None), ("barge_chain", "N=2")])
+@pytest.mark.parametrize("sea", ["regular", "jonswap"])
+def test_simulate_issue4_models(capsys, model, scene_param, sea):
+    """Issue 4: every new catalogue model runs from the CLI in regular and irregular waves
+    (tank scale: H 4 cm, T 1.2 s; Hs 4 cm, Tp 1.2 s; 2.5 s for the flaps), every PTO absorbing."""
+    period = "2.5" if model == "flap_pair" else "1.2"      # FOSWEC-like seas are longer
+    wave = ["--height", "0.04", "--period", period] if sea == "regular" else ["--hs", "0.04", "--tp", period]
+    extra = ["--scene-param", scene_param] if scene_param else []
+    code, out, _ = run(capsys, "simulate", model, "--wave", sea, *wave, "--duration", "30", "--json", *extra)
+    assert code == 0
+    result = json.loads(out)
+    assert len(result["ptos"]) == {"raft3": 2, "array4": 4, "flap_pair": 2}.get(
+        model, 1 if scene_param == "N=2" else 3)
+    for pto in result["ptos"].values():
+        assert pto["mean_power_W"] > 0 and pto["max_stroke"] > 0

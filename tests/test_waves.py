@@ -457,3 +457,16 @@ def test_from_elevation_excitation_equals_irf_convolution():
     # measured 1e-5 of the peak (quadrature of K_e and the 0.1 s convolution sum); 1e-4
     # leaves room for platform round-off while any phase or sign error would be O(1)
     assert np.max(np.abs(conv - ref)) < 1e-4 * np.max(np.abs(ref))
+
+
+def test_irregular_sea_kept_inside_the_hydro_data():
+    from mbcontrol.waves import from_args, jonswap_spectrum
+    wave = from_args("jonswap", hs=0.04, tp=1.2, seed=3, duration=300.0, data_band=(0.5, 14.0))
+    assert wave.omega.min() >= 0.5 and wave.omega.max() <= 14.0
+    assert 4 * np.sqrt(0.5 * np.sum(wave.amplitude**2)) == pytest.approx(0.04, rel=1e-12)
+    # the variance above 14 rad/s (2.67 wp), from the JONSWAP formula by direct quadrature
+    w = np.linspace(14.0, 4 * 2 * np.pi / 1.2, 20001)
+    tail = np.trapezoid(jonswap_spectrum(w, 0.04, 1.2, 3.3), w) / (0.04 / 4) ** 2
+    assert wave.settings["spectrum_outside_data"] == pytest.approx(tail, rel=0.02)
+    with pytest.raises(ValueError, match="lies outside the hydro data's band"):
+        from_args("jonswap", hs=0.04, tp=60.0, data_band=(0.5, 14.0))   # all of it below 0.5 rad/s

@@ -513,8 +513,9 @@ def fit_radiation(ds, dofs=None, *, tol: float = 0.02, max_order: int = 30, omeg
         dc_zero : impose K(0) = 0 (vector fit and output refit). refit : after truncating to r states,
         refit C by least squares with A, B fixed (keeps stability, lowers the order needed).
         markov : impose C B = K(t=0+) = (2/π)∫B dω (data, B(0) = 0, tail as impulse_response's "auto")
-        and fit lightly weighted extrapolated points above the band; skipped (report["markov_imposed"])
-        when B has not decayed to 25 % of its peak at the top frequency, where K(0+) is unknown.
+        and fit lightly weighted extrapolated points above the band; skipped for a DOF group
+        (report["markov_imposed"]) whose B has not decayed to 25 % of its peak at the top
+        frequency, where K(0+) is unknown.
         The data fix the model only inside the band; this pins its initial impulse value and the
         high-frequency asymptote K(jω) ≈ C B/(jω), instead of leaving them to far-away poles.
     passive : test each group exactly; if not passive, change C (poles kept) by the least data-weighted
@@ -530,32 +531,40 @@ def fit_radiation(ds, dofs=None, *, tol: float = 0.02, max_order: int = 30, omeg
     Ks = 0.5 * (K + np.swapaxes(K, 1, 2)) if asym < 1e-2 else K  # BEM reciprocity, up to discretisation
     groups, link = _groups(Ks)
     # K(t=0+) = (2/π)∫B dω = C B, with B(0) = 0 and the power-law tail of impulse_response. Only
-    # meaningful if B has decayed inside the band (Σ|B_ii| at ω_max <= 25 % of its peak);
-    # otherwise the tail is a guess and neither the constraint nor the extrapolation is used.
+    # meaningful for a group whose B has decayed inside the band (Σ|B_ii| over its DOFs at ω_max
+    # <= 25 % of its peak); otherwise the tail is a guess and neither the constraint nor the
+    # extrapolation is used for that group.
     wz, Bz, p_tail = _with_tail(w, Ks.real, "auto")
-    bsum = np.sum(np.abs(np.einsum("kii->ki", Ks.real)), axis=1)
-    decayed = bool(bsum[-1] <= 0.25 * bsum.max())
-    M1 = _cos_transform(wz, Bz, np.zeros(1))[0] if (markov and decayed) else None
+    M1_all = _cos_transform(wz, Bz, np.zeros(1))[0] if markov else None
+    diag_b = np.abs(np.einsum("kii->ki", Ks.real))
+
+    def group_markov(gidx):
+        bsum = diag_b[:, gidx].sum(axis=1)
+        decayed = bool(bsum[-1] <= 0.25 * bsum.max())
+        return M1_all[np.ix_(gidx, gidx)] if M1_all is not None and decayed else None
     wf, Kf = _densify(w, Ks)
     # the groups are fitted on the refined grid; the tolerance holds on the BEM frequencies, so
     # if interpolated points diluted the error there, refit to a proportionally tighter target
-    target, targets = tol, []
+    target, targets, best = tol, [], None
     for _ in range(RETARGETS + 1):
         targets.append(float(target))
         parts, pre, info = [], [], []  # pre: the unconstrained fits (what passive=False returns)
         for gidx in groups:
             Kg = Kf[:, gidx][:, :, gidx]
             common = (wf, Kg, link[np.ix_(gidx, gidx)])
-            rest = (target, max_order, n_iter, dc_zero, refit, None if M1 is None else M1[np.ix_(gidx, gidx)],
+            rest = (target, max_order, n_iter, dc_zero, refit, group_markov(gidx),
                     p_tail, passive_max_states if passive else 0)
             abc, rep, before = _best_scaled_fit(common, rest, [dofs[i] for i in gidx], passive)
             parts.append((gidx, *abc))
             pre.append((gidx, *before))
             info.append({"dofs": [dofs[i] for i in gidx], **rep})
         model, entry, err = _assemble(parts, w, K, dofs)
+        if best is None or err < best[2]:
+            best = (model, entry, err, parts, pre, info)
         if err <= tol or wf.size == w.size:
             break
         target *= 0.95 * tol / err
+    model, entry, err, parts, pre, info = best     # a tighter target can cost passivity: keep the best
     A, B, C, order = model.A, model.B, model.C, model.order
     k0_data = _cos_transform(*_with_tail(w, K.real, None)[:2], np.zeros(1))[0]
     pas = {"enforce": bool(passive), "enforced": any(g.get("passivity", {}).get("enforced") for g in info),
@@ -573,7 +582,7 @@ def fit_radiation(ds, dofs=None, *, tol: float = 0.02, max_order: int = 30, omeg
         "n_states": int(order), "poles_per_group": [g["history"][-1]["poles"] for g in info],
         "fit_error": err, "dofs": list(dofs), "entry_errors": entry.tolist(),
         "groups": info, "symmetrized": bool(asym < 1e-2), "asymmetry": float(asym),
-        "tail_exponent": float(p_tail), "markov_imposed": M1 is not None,
+        "tail_exponent": float(p_tail), "markov_imposed": [group_markov(g) is not None for g in groups],
         "omega_fit": [float(w.min()), float(w.max())], "n_omega": int(w.size), "tol": float(tol),
         "tol_met": bool(err <= tol), "internal_targets": targets,
         "max_real_eig": float(np.max(np.linalg.eigvals(A).real)) if order else None,
