@@ -5,9 +5,12 @@
 from __future__ import annotations
 
 from .base import Controller
+from .latching import Declutching, Latching
 from .passive import Passive
+from .reactive import Reactive
 
-REGISTRY = {"passive": Passive}
+REGISTRY = {"passive": Passive, "reactive": Reactive, "latching": Latching,
+            "declutching": Declutching}
 
 
 def make(name: str, **settings) -> Controller:

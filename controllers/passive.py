@@ -49,13 +49,15 @@ class Passive:
 
 
 def optimal_damping(plant, wave, *, pto: str | None = None, params=None,
-                    bounds=(1e-4, 1e4)) -> tuple[float, float]:
+                    bounds=None) -> tuple[float, float]:
     """PTO damping that maximises the mean absorbed power in `wave`: (damping, power W).
 
     Evaluated on the frequency-domain solution built straight from the BEM data (linear
     theory: Coulomb friction is left out, as linear theory cannot hold it), with the PTO's
     force -damping * v alone, as in closed loop. For a regular wave or an irregular sea (sum
-    over its components). bounds: search interval, N s/m or N m s/rad.
+    over its components). bounds: search interval, N s/m or N m s/rad; default: 1e-3 to 1e3
+    times the PTO's intrinsic impedance |Z_i| at the wave's most energetic component (the
+    regular-wave optimum is |Z_i| itself), so the search fits a tank model and a 10 m buoy.
     """
     from scipy.optimize import minimize_scalar
 
@@ -74,6 +76,12 @@ def optimal_damping(plant, wave, *, pto: str | None = None, params=None,
                                       outputs=[f"{name}__velocity"])[:, 0]
         return float(np.sum(0.5 * damping * np.abs(v * wave.amplitude) ** 2))
 
+    if bounds is None:
+        from mbcontrol.bounds import pto_thevenin
+        k = int(np.argmax(wave.amplitude))
+        scale = float(np.abs(pto_thevenin(plant, wave.omega[k:k + 1], pto=name, direction=wave.direction,
+                                          params=base, check_passive=False).impedance[0]))
+        bounds = (1e-3 * scale, 1e3 * scale)
     result = minimize_scalar(lambda z: -power(np.exp(z)), method="bounded",
                              bounds=np.log(bounds), options={"xatol": 1e-4})
     return float(np.exp(result.x)), -float(result.fun)
