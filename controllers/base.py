@@ -34,3 +34,13 @@ def signal_indices(plant, names: list[str]) -> list[int]:
         raise KeyError(f"{plant.name}: no output(s) {missing}; outputs are "
                        f"{', '.join(plant.outputs)}")
     return [plant.outputs.index(n) for n in names]
+
+
+def per_pto(plant, value, what: str) -> np.ndarray:
+    """One gain per PTO (scene order) from a number for all or a dict by PTO name."""
+    names = [p.name for p in plant.scene.ptos]
+    gains = value if isinstance(value, dict) else {n: value for n in names}
+    unknown = set(gains) - set(names)
+    if unknown:
+        raise KeyError(f"{plant.name}: {what} for unknown PTO(s) {sorted(unknown)}")
+    return np.array([float(gains.get(n, 0.0)) for n in names])

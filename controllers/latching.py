@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .base import signal_indices
+from .base import per_pto, signal_indices
 
 
 class _Switching:
@@ -45,13 +45,7 @@ class _Switching:
 
     def reset(self, plant) -> None:
         names = [p.name for p in plant.scene.ptos]
-        gains = self.damping if isinstance(self.damping, dict) else {n: self.damping
-                                                                     for n in names}
-        unknown = set(gains) - set(names)
-        if unknown:
-            raise KeyError(f"{plant.name}: {self.name} damping for unknown PTO(s) "
-                           f"{sorted(unknown)}")
-        self._c = np.array([float(gains.get(n, 0.0)) for n in names])
+        self._c = per_pto(plant, self.damping, f"{self.name} damping")
         if np.any(self._c < 0) or self._hold_time < 0:
             raise ValueError(f"{self.name}: damping and hold time must be >= 0, got "
                              f"{self._c}, {self._hold_time}")

@@ -4,7 +4,7 @@ from __future__ import annotations
 import casadi as ca
 import numpy as np
 
-from .base import signal_indices
+from .base import per_pto, signal_indices
 
 
 class Passive:
@@ -23,12 +23,7 @@ class Passive:
 
     def reset(self, plant) -> None:
         names = [p.name for p in plant.scene.ptos]
-        gains = self.damping if isinstance(self.damping, dict) else {n: self.damping
-                                                                     for n in names}
-        unknown = set(gains) - set(names)
-        if unknown:
-            raise KeyError(f"{plant.name}: passive damping for unknown PTO(s) {sorted(unknown)}")
-        self._gains = np.array([float(gains.get(n, 0.0)) for n in names])
+        self._gains = per_pto(plant, self.damping, "passive damping")
         if np.any(self._gains < 0):
             raise ValueError(f"passive damping must be >= 0, got {self._gains}")
         self._velocity = signal_indices(plant, [f"{n}__velocity" for n in names])

@@ -24,7 +24,7 @@ from __future__ import annotations
 import casadi as ca
 import numpy as np
 
-from .base import signal_indices
+from .base import per_pto, signal_indices
 
 
 class Reactive:
@@ -44,8 +44,8 @@ class Reactive:
 
     def reset(self, plant) -> None:
         names = [p.name for p in plant.scene.ptos]
-        self._c = _per_pto(plant, names, self.damping, "damping")
-        self._k = _per_pto(plant, names, self.stiffness, "stiffness")
+        self._c = per_pto(plant, self.damping, "reactive damping")
+        self._k = per_pto(plant, self.stiffness, "reactive stiffness")
         if np.any(self._c < 0):
             raise ValueError(f"reactive damping must be >= 0, got {self._c}")
         self._velocity = signal_indices(plant, [f"{n}__velocity" for n in names])
@@ -66,14 +66,6 @@ class Reactive:
     def describe(self) -> dict:
         return {"name": self.name, "damping": self.damping, "stiffness": self.stiffness,
                 "period_s": self.period}
-
-
-def _per_pto(plant, names, value, what) -> np.ndarray:
-    gains = value if isinstance(value, dict) else {n: value for n in names}
-    unknown = set(gains) - set(names)
-    if unknown:
-        raise KeyError(f"{plant.name}: {what} for unknown PTO(s) {sorted(unknown)}")
-    return np.array([float(gains.get(n, 0.0)) for n in names])
 
 
 def _base_params(plant, pto: str, params=None) -> dict:
