@@ -214,7 +214,7 @@ def _fit_cached(data: xr.Dataset, dofs, tol, source: str, omega_max: float = np.
     for var in ("added_mass", "radiation_damping", "added_mass_inf"):
         digest.update(np.ascontiguousarray(data[var].values).tobytes())
     # the fitting code is part of the key: a changed algorithm never serves an old fit
-    for module in (bem.radiation, bem.passivity, bem.sdp):
+    for module in (bem.radiation, bem.vector_fit, bem.passivity, bem.sdp):
         digest.update(Path(module.__file__).read_bytes())
     band = fit_band_limit(data, omega_max)
     digest.update(json.dumps([list(dofs), tol, band]).encode())

@@ -322,7 +322,7 @@ def test_hankel_baseline_on_the_barge(barge):
 
 # ------------------------------------------------------------------ congruence scaling
 def test_congruence_scale_per_unit_class():
-    from mbcontrol.hydro.radiation import _congruence_scale, _unit_class
+    from mbcontrol.hydro.vector_fit import _congruence_scale, _unit_class
     dofs = ["a__Heave", "b__Surge", "a__Pitch", "b__Roll"]
     K = np.diag([4.0, 1.0, 9.0, 16.0])[None] * (1 + 0.5j)
     sc = _congruence_scale(K, [_unit_class(d) for d in dofs])
