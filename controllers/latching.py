@@ -162,22 +162,10 @@ def _port_inertia(plant, names) -> np.ndarray:
 # tuning by simulation
 
 def mean_power(ds, pto: str, start: float = 0.0, end: float | None = None) -> float:
-    """Mean absorbed power (W) over [start, end) s, from the work the PTO does.
-
-    -sum F_k (x_{k+1} - x_k) / (t_end - t_start) over the steps in the window. For a
-    controller's force, held over each step, this is exact; the mean of the sampled power
-    -F_k v_k is not: it misses -F a dt / 2 per step, which for reactive control (a large
-    spring force in phase with the acceleration) is 6 % of the power at dt = 0.01 s on the
-    sphere. For an irregular sea use start = the ramp time.
-    """
-    t = ds["time"].values
-    i0 = int(np.searchsorted(t, start - 1e-9))
-    i1 = t.size - 1 if end is None else int(np.searchsorted(t, end - 1e-9))
-    if i1 <= i0:
-        raise ValueError(f"empty power window [{start:.4g}, {end}) s in a {t[-1]:.4g} s record")
-    force, x = ds[f"{pto}__force"].values, ds[f"{pto}__position"].values
-    work = -np.sum(force[i0:i1] * np.diff(x[i0:i1 + 1]))
-    return float(work / (t[i1] - t[i0]))
+    """Mean absorbed power (W) over [start, end) s, from the work the PTO does
+    (mbcontrol.metrics.step_power). For an irregular sea use start = the ramp time."""
+    from mbcontrol.metrics import pto_metrics
+    return pto_metrics(ds, pto, start, end)["mean_power_W"]
 
 
 def steady_mean_power(ds, pto: str, period: float, skip_periods: int = 5) -> float:
