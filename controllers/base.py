@@ -5,6 +5,9 @@ name), then called as `controller(t, y) -> u` every `period` seconds with the pl
 vector y; u (one force or torque per PTO, N or N m) is held until the next call (zero-order
 hold). In closed loop u is the PTO's whole force: the scene's PTO law is set aside. A controller whose law is a static CasADi expression of y may also return it from
 `casadi_law(plant)`; with period equal to the simulation step it then runs inside compiled code.
+A controller with the attribute `uses_state = True` is called as `controller(t, y, x)` with the
+plant's whole state x as well: full-state feedback, an oracle for studies (no real device
+measures radiation states), which its describe() must say.
 """
 from __future__ import annotations
 

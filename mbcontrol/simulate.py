@@ -116,7 +116,14 @@ def _last_command(plant, controller, t, x, U, w, p) -> np.ndarray:
     if controller is None:
         return np.zeros((1, len(plant.inputs)))
     y = np.asarray(plant.h(x, U[-1], w, p)).ravel()
-    return np.asarray(controller(t, y), float).reshape(1, -1)
+    return _command(controller, t, y, x, U.shape[1]).reshape(1, -1)
+
+
+def _command(controller, t, y, x, nu) -> np.ndarray:
+    """The controller's command; a controller with `uses_state = True` (full-state feedback,
+    an oracle for studies) is also handed the plant's state."""
+    u = controller(t, y, x) if getattr(controller, "uses_state", False) else controller(t, y)
+    return np.asarray(u, float).reshape(nu)
 
 
 def _parameters(plant, params, controller) -> np.ndarray:
@@ -143,7 +150,7 @@ def _run_rk4(plant, controller, law, embedded, x0, W_half, p, dt, n, compiled, c
     for i in range(0, n, m):
         k = min(m, n - i)
         y = np.asarray(plant.h(X[i], u_prev, W_half[2 * i], p)).ravel()
-        u_prev = np.asarray(controller(i * dt, y), float).reshape(nu)
+        u_prev = _command(controller, i * dt, y, X[i], nu)
         U[i:i + k] = u_prev
         Xk, _ = integrators.run_rk4(plant, X[i], U[i:i + k], W_half[2 * i:2 * (i + k) + 1], p,
                                     dt, compiled=compiled)
@@ -165,7 +172,7 @@ def _run_cvodes(plant, wave, controller, x0, p, dt, n, rtol, check):
         if controller is not None:
             w_now = _wave_at(terms, i * dt)
             y = np.asarray(plant.h(X[i], u_prev, w_now, p)).ravel()
-            u_prev = np.asarray(controller(i * dt, y), float).reshape(nu)
+            u_prev = _command(controller, i * dt, y, X[i], nu)
         U[i:i + k] = u_prev
         grid = (i + np.arange(k + 1)) * dt
         integrator = integrators.cvodes_integrator(plant, terms, grid, rtol=rtol, atol=rtol * 1e-3)
