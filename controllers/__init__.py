@@ -6,11 +6,12 @@ from __future__ import annotations
 
 from .base import Controller
 from .latching import Declutching, Latching
+from .mpc import Mpc
 from .passive import Passive
 from .reactive import Reactive
 
 REGISTRY = {"passive": Passive, "reactive": Reactive, "latching": Latching,
-            "declutching": Declutching}
+            "declutching": Declutching, "mpc": Mpc}
 
 
 def make(name: str, **settings) -> Controller:

@@ -25,12 +25,18 @@ damper would leave a creep of O(h F_rest / M)). It is stable for an inertia erro
 40 % (the loop's poles, z^2 + 2(r - 1) z + (1 - r) = 0, r = M_assumed / M_true, lie inside the
 unit circle for 0 < r < 1.4). The brake dissipates -u v, which is counted in the PTO's power as
 a real brake's would be; it vanishes with h (the tests measure its share).
+
+Force limit: every command, brake and damper alike, is saturated to +-force_max (N or N m;
+None: the scene PTO's force_max, inf: none; controllers.passive.force_limits). A saturated
+brake cannot hold the body: it slips while "latched" and the brake keeps estimating the rest
+of the force from the velocity change under the force it really applied.
 """
 from __future__ import annotations
 
 import numpy as np
 
 from .base import per_pto, signal_indices
+from .passive import force_limits, limits_report, saturate
 
 
 class _Switching:
@@ -38,10 +44,12 @@ class _Switching:
     name = "switching"
 
     def __init__(self, damping: float = 0.0, hold_time: float = 0.0,
-                 period: float | None = None):
+                 period: float | None = None, force_max=None):
         self.damping = damping
         self._hold_time = hold_time
         self.period = period          # s; None: every simulation step (switch at each step)
+        self.force_max = force_max
+        self._limits = None
 
     def reset(self, plant) -> None:
         names = [p.name for p in plant.scene.ptos]
@@ -50,6 +58,7 @@ class _Switching:
             raise ValueError(f"{self.name}: damping and hold time must be >= 0, got "
                              f"{self._c}, {self._hold_time}")
         self._names = names
+        self._limits = force_limits(plant, self.force_max)
         self._velocity = signal_indices(plant, [f"{n}__velocity" for n in names])
         n = len(names)
         self._held = np.zeros(n, bool)            # in the hold (latched / declutched) phase
@@ -85,6 +94,7 @@ class _Switching:
                 self._sign[i] = s if s != 0 else self._sign[i]
             if self._held[i]:
                 u[i] = self._hold_force(i, v[i], h)
+        u = saturate(u, self._limits)     # the force applied: the brake's estimate uses it
         self._t_prev, self._v_prev, self._u_prev = t, v, u
         return u.copy()
 
@@ -92,7 +102,10 @@ class _Switching:
         raise NotImplementedError
 
     def describe(self) -> dict:
-        return {"name": self.name, "damping": self.damping, "period_s": self.period}
+        return {"name": self.name, "damping": self.damping, "period_s": self.period,
+                "saturation": "command (brake and damper) clipped to +-force_max per PTO "
+                              "(null: none)",
+                "force_max": limits_report(self._limits)}
 
 
 class Latching(_Switching):
@@ -100,14 +113,14 @@ class Latching(_Switching):
     a damper u = -damping * v until the next crossing.
 
     damping: N s/m (or N m s/rad), one number or a dict by PTO name; latch_time: s. The hold
-    is a deadbeat brake (see the module docstring); its force is not limited (compare the
-    result's max force with the PTO's force_max).
+    is a deadbeat brake (see the module docstring), limited like the damper to +-force_max
+    (N or N m; None: the scene PTO's force_max).
     """
     name = "latching"
 
     def __init__(self, damping: float = 0.0, latch_time: float = 0.0,
-                 period: float | None = None):
-        super().__init__(damping, latch_time, period)
+                 period: float | None = None, force_max=None):
+        super().__init__(damping, latch_time, period, force_max)
         self.latch_time = latch_time
 
     def reset(self, plant) -> None:
@@ -128,13 +141,14 @@ class Declutching(_Switching):
     """Declutching: PTO force off (u = 0) for `declutch_time` s from each velocity zero
     crossing, then a damper u = -damping * v until the next crossing.
 
-    damping: N s/m (or N m s/rad), one number or a dict by PTO name; declutch_time: s.
+    damping: N s/m (or N m s/rad), one number or a dict by PTO name; declutch_time: s;
+    force_max: N (or N m), the damper's saturation (None: the scene PTO's force_max).
     """
     name = "declutching"
 
     def __init__(self, damping: float = 0.0, declutch_time: float = 0.0,
-                 period: float | None = None):
-        super().__init__(damping, declutch_time, period)
+                 period: float | None = None, force_max=None):
+        super().__init__(damping, declutch_time, period, force_max)
         self.declutch_time = declutch_time
 
     def _hold_force(self, i: int, v: float, h: float) -> float:
@@ -219,7 +233,8 @@ def _regular(wave, what):
 
 def optimal_latch_time(plant, wave, *, damping: float | None = None, pto: str | None = None,
                        dt: float | None = None, skip: int = 8, periods: int = 3,
-                       tune_damping: bool = False) -> tuple[float, float, float]:
+                       tune_damping: bool = False,
+                       force_max=None) -> tuple[float, float, float]:
     """(latch_time s, damping N s/m, simulated mean power W) for a regular wave of period T.
 
     Starts from the classical rule latch_time = (T - T_n) / 2 (released at the end of its
@@ -230,7 +245,9 @@ def optimal_latch_time(plant, wave, *, damping: float | None = None, pto: str | 
     damping (while free): default Re Z_i(omega_n), the radiation damping at the natural
     frequency, where the free body oscillates and its impedance is purely resistive. With
     tune_damping, a second 1-D search in log damping (x 1/4..4) at the best latch time.
-    dt: simulation step, default T / 500.
+    dt: simulation step, default T / 500. force_max: the simulated controllers' force limit
+    (N or N m; None: the scene PTO's, as Latching's default), so the tuning sees the brake
+    the device has.
     """
     from .reactive import intrinsic_impedance
     name = pto or plant.scene.ptos[0].name
@@ -244,7 +261,8 @@ def optimal_latch_time(plant, wave, *, damping: float | None = None, pto: str | 
         damping = float(intrinsic_impedance(plant, [2 * np.pi / T_n], pto=name)[0][0].real)
 
     def power(latch: float, c: float) -> float:
-        return _simulated_power(plant, wave, Latching(c, latch), name, dt, periods, skip)
+        return _simulated_power(plant, wave, Latching(c, latch, force_max=force_max), name, dt,
+                                periods, skip)
 
     guess = 0.5 * (T - T_n)
     latch, best = _search(lambda x: power(x, damping), max(0.0, guess - 0.1 * T),
@@ -258,7 +276,8 @@ def optimal_latch_time(plant, wave, *, damping: float | None = None, pto: str | 
 
 def optimal_declutch(plant, wave, *, damping: float | None = None, pto: str | None = None,
                      dt: float | None = None, skip: int = 8, periods: int = 3,
-                     tune_damping: bool = False) -> tuple[float, float, float]:
+                     tune_damping: bool = False,
+                     force_max=None) -> tuple[float, float, float]:
     """(declutch_time s, damping N s/m, simulated mean power W) for a regular wave of period T.
 
     A bounded 1-D search over declutch_time tau in [0, 0.45 T] on the simulated mean power (as
@@ -266,6 +285,7 @@ def optimal_declutch(plant, wave, *, damping: float | None = None, pto: str | No
     optimum |Z_i(omega)| times T / (T - 2 tau), since the damper now acts over only that share
     of each cycle (it keeps the cycle's mean damping). With tune_damping, a second 1-D search
     in log damping (x 1/4..4) at the best tau. dt: simulation step, default T / 500.
+    force_max: the simulated controllers' force limit (None: the scene PTO's).
     """
     from .reactive import intrinsic_impedance
     name = pto or plant.scene.ptos[0].name
@@ -277,7 +297,8 @@ def optimal_declutch(plant, wave, *, damping: float | None = None, pto: str | No
         return damping if damping is not None else passive * T / (T - 2 * tau)
 
     def power(tau: float, c: float) -> float:
-        return _simulated_power(plant, wave, Declutching(c, tau), name, dt, periods, skip)
+        return _simulated_power(plant, wave, Declutching(c, tau, force_max=force_max), name,
+                                dt, periods, skip)
 
     tau, best = _search(lambda x: power(x, damping_at(x)), 0.0, 0.45 * T, xatol=dt)
     c = damping_at(tau)

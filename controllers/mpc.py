@@ -357,6 +357,7 @@ class _QpoasesBackend:
     def __init__(self, form):
         import casadi as ca
         self.H, self.A = form.H, form.A
+        self.called = False
         opts = {"printLevel": "none", "sparse": False, "error_on_fail": False,
                 "hessian_type": "posdef"}
         self.solver = _quiet(lambda: ca.conic(
@@ -364,7 +365,13 @@ class _QpoasesBackend:
             opts))
 
     def solve(self, g, lbx, ubx, lba, uba, x0):
-        out = self.solver(h=self.H, a=self.A, g=g, lbx=lbx, ubx=ubx, lba=lba, uba=uba, x0=x0)
+        call = (lambda: self.solver(h=self.H, a=self.A, g=g, lbx=lbx, ubx=ubx, lba=lba,
+                                    uba=uba, x0=x0))
+        if not self.called:                 # qpOASES prints its banner on the first solve
+            self.called = True
+            out = _quiet(call)
+        else:
+            out = call()
         stats = self.solver.stats()
         if not stats.get("success", False):
             return None, str(stats.get("return_status", "failed"))
@@ -409,19 +416,36 @@ class _CvxpyBackend:
         return np.asarray(self.x.value).ravel(), "solved"
 
 
-def _quiet(build):
-    """Build with the C library's stdout silenced (qpOASES prints a banner)."""
+def _quiet(call):
+    """Run with output silenced: qpOASES prints a banner, through CasADi's stream (which
+    CasADi hands to Python's sys.stdout) or straight to the process's stdout."""
+    import contextlib
+    import io
     import os
     import sys
     sys.stdout.flush()
-    saved = os.dup(1)
+    sys.stderr.flush()
+    saved = [os.dup(1), os.dup(2)]
     try:
-        with open(os.devnull, "w") as null:
+        with open(os.devnull, "w") as null, contextlib.redirect_stdout(io.StringIO()), \
+                contextlib.redirect_stderr(io.StringIO()):
             os.dup2(null.fileno(), 1)
-            return build()
+            os.dup2(null.fileno(), 2)
+            return call()
     finally:
-        os.dup2(saved, 1)
-        os.close(saved)
+        _flush_c_stdio()                # a pipe's C buffer would print after the restore
+        os.dup2(saved[0], 1)
+        os.dup2(saved[1], 2)
+        for fd in saved:
+            os.close(fd)
+
+
+def _flush_c_stdio() -> None:
+    import ctypes
+    try:
+        ctypes.CDLL(None).fflush(None)
+    except (OSError, AttributeError):
+        pass
 
 
 def _limits(plant, value, scene_values, what) -> np.ndarray:

@@ -1,5 +1,16 @@
-"""Passive control: each PTO a linear damper, u = -damping * v (absorbed power c v^2 >= 0)."""
+"""Passive control: each PTO a linear damper, u = -damping * v (absorbed power c v^2 >= 0).
+
+PTO limits. The command is saturated to +-force_max (N or N m; default: the scene PTO's
+force_max, inf: no limit), in the Python path and in the compiled CasADi law alike
+(`force_limits`, `saturate`, `casadi_saturate`, shared with reactive and latching). A
+saturated damper still absorbs power but no longer bounds the stroke: the stroke limit is met
+by tuning, `optimal_damping(..., force_max=, stroke_max=)`, which keeps the predicted force and
+stroke peaks of the linear frequency-domain solution within the limits (the peak statistic is
+documented in `controllers.reactive.fd_statistics`); the WECCCOMP tests verify it by simulation.
+"""
 from __future__ import annotations
+
+import math
 
 import casadi as ca
 import numpy as np
@@ -7,18 +18,62 @@ import numpy as np
 from .base import per_pto, signal_indices
 
 
+def force_limits(plant, force_max=None) -> np.ndarray:
+    """Per-PTO force limit (N or N m, > 0, inf: none), scene order.
+
+    force_max None: each scene PTO's own force_max; a number: that limit on every PTO; a dict
+    by PTO name: those PTOs' limits, the others keep their scene limit.
+    """
+    ptos = plant.scene.ptos
+    limits = np.array([p.force_max for p in ptos], float)
+    if isinstance(force_max, dict):
+        per_pto(plant, force_max, "force_max")          # rejects unknown PTO names
+        limits = np.array([float(force_max.get(p.name, p.force_max)) for p in ptos])
+    elif force_max is not None:
+        limits = np.full(len(ptos), float(force_max))
+    if not np.all(limits > 0):                           # NaN fails too
+        raise ValueError(f"{plant.name}: force_max must be > 0 (inf: none), got {limits}")
+    return limits
+
+
+def saturate(u: np.ndarray, limits: np.ndarray) -> np.ndarray:
+    """u clipped to +-limits (inf limits leave u unchanged)."""
+    return np.clip(u, -limits, limits)
+
+
+def casadi_saturate(u, limits: np.ndarray):
+    """The CasADi expression of `saturate`: fmin/fmax on the PTOs with a finite limit only,
+    so a law without limits is the very expression it was before limits existed."""
+    if np.all(np.isinf(limits)):
+        return u
+    return ca.vertcat(*[u[i] if math.isinf(f) else ca.fmin(ca.fmax(u[i], -f), f)
+                        for i, f in enumerate(limits)])
+
+
+def limits_report(limits) -> list | None:
+    """describe()'s view of the force limits: one per PTO, None where there is none (JSON
+    has no infinity); None before reset."""
+    if limits is None:
+        return None
+    return [float(f) if math.isfinite(f) else None for f in limits]
+
+
 class Passive:
-    """A linear damper on every PTO: u = -damping * v, the PTO's whole force.
+    """A linear damper on every PTO: u = sat(-damping * v), the PTO's whole force.
 
     damping: N s/m (or N m s/rad) per PTO, one number for all, or a dict by PTO name. In
     closed loop the controller owns the PTO force (the scene's PTO law is set aside).
+    force_max: N (or N m), the saturation of the command, as `force_limits` reads it (None:
+    the scene PTO's force_max; inf: none).
     """
     name = "passive"
 
-    def __init__(self, damping=0.0, period: float | None = None):
+    def __init__(self, damping=0.0, period: float | None = None, force_max=None):
         self.damping = damping
         self.period = period          # s; None: every simulation step
+        self.force_max = force_max
         self._gains = None
+        self._limits = None
         self._law = None
 
     def reset(self, plant) -> None:
@@ -26,25 +81,29 @@ class Passive:
         self._gains = per_pto(plant, self.damping, "passive damping")
         if np.any(self._gains < 0):
             raise ValueError(f"passive damping must be >= 0, got {self._gains}")
+        self._limits = force_limits(plant, self.force_max)
         self._velocity = signal_indices(plant, [f"{n}__velocity" for n in names])
         self._law = None
 
     def __call__(self, t: float, y: np.ndarray) -> np.ndarray:
-        return -self._gains * np.asarray(y)[self._velocity]
+        return saturate(-self._gains * np.asarray(y)[self._velocity], self._limits)
 
     def casadi_law(self, plant):
         if self._law is None:
             y = ca.SX.sym("y", len(plant.outputs))
-            u = -ca.DM(self._gains) * y[self._velocity]
+            u = casadi_saturate(-ca.DM(self._gains) * y[self._velocity], self._limits)
             self._law = ca.Function("passive_law", [y], [u])
         return self._law
 
     def describe(self) -> dict:
-        return {"name": self.name, "damping": self.damping, "period_s": self.period}
+        return {"name": self.name, "damping": self.damping, "period_s": self.period,
+                "saturation": "command clipped to +-force_max per PTO (null: none)",
+                "force_max": limits_report(self._limits)}
 
 
-def optimal_damping(plant, wave, *, pto: str | None = None, params=None,
-                    bounds=None) -> tuple[float, float]:
+def optimal_damping(plant, wave, *, pto: str | None = None, params=None, bounds=None,
+                    force_max: float | None = None, stroke_max: float | None = None,
+                    exceedance: float = 0.01) -> tuple[float, float]:
     """PTO damping that maximises the mean absorbed power in `wave`: (damping, power W).
 
     Evaluated on the frequency-domain solution built straight from the BEM data (linear
@@ -53,7 +112,22 @@ def optimal_damping(plant, wave, *, pto: str | None = None, params=None,
     over its components). bounds: search interval, N s/m or N m s/rad; default: 1e-3 to 1e3
     times the PTO's intrinsic impedance |Z_i| at the wave's most energetic component (the
     regular-wave optimum is |Z_i| itself), so the search fits a tank model and a 10 m buoy.
+
+    Limits (keyword-only; None: unconstrained, the search above): force_max (N or N m) and
+    stroke_max (m or rad) bound the predicted peaks of the PTO force and position in `wave`,
+    as `controllers.reactive.fd_statistics` predicts them (a regular wave: its amplitudes; a
+    sea: the Rice level the record exceeds with probability <~ `exceedance`). The search is
+    then a log grid over `bounds`, refined by Brent's method inside the feasible set or by
+    bisection to its edge. A damper lowers the stroke and raises the force, so limits that
+    no damping meets raise ValueError. (A damper only absorbs, so its electrical power is
+    the PTO efficiency times this mechanical power: the optimum is the same for both.)
     """
+    if force_max is not None or stroke_max is not None:
+        from .reactive import constrained_tuning
+        c, _, power = constrained_tuning(plant, wave, pto=pto, params=params, passive=True,
+                                         bounds=bounds, force_max=force_max,
+                                         stroke_max=stroke_max, exceedance=exceedance)
+        return c, power
     from scipy.optimize import minimize_scalar
 
     from mbcontrol.analysis import frequency_domain_response
@@ -72,11 +146,17 @@ def optimal_damping(plant, wave, *, pto: str | None = None, params=None,
         return float(np.sum(0.5 * damping * np.abs(v * wave.amplitude) ** 2))
 
     if bounds is None:
-        from mbcontrol.bounds import pto_thevenin
-        k = int(np.argmax(wave.amplitude))
-        scale = float(np.abs(pto_thevenin(plant, wave.omega[k:k + 1], pto=name, direction=wave.direction,
-                                          params=base, check_passive=False).impedance[0]))
-        bounds = (1e-3 * scale, 1e3 * scale)
+        bounds = default_bounds(plant, wave, name, base)
     result = minimize_scalar(lambda z: -power(np.exp(z)), method="bounded",
                              bounds=np.log(bounds), options={"xatol": 1e-4})
     return float(np.exp(result.x)), -float(result.fun)
+
+
+def default_bounds(plant, wave, name: str, params) -> tuple[float, float]:
+    """1e-3 to 1e3 times |Z_i| (N s/m or N m s/rad) at the wave's most energetic component."""
+    from mbcontrol.bounds import pto_thevenin
+    k = int(np.argmax(wave.amplitude))
+    scale = float(np.abs(pto_thevenin(plant, wave.omega[k:k + 1], pto=name,
+                                      direction=wave.direction, params=params,
+                                      check_passive=False).impedance[0]))
+    return 1e-3 * scale, 1e3 * scale

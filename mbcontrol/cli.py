@@ -1,4 +1,4 @@
-"""The `mbcontrol` command: catalogue, hydrodynamics, simulation and linearisation.
+"""The `mbcontrol` command: catalogue, hydrodynamics, simulation, linearisation, control design.
 
 Examples:
   mbcontrol models
@@ -7,6 +7,8 @@ Examples:
   mbcontrol simulate hinged_barge --wave jonswap --hs 0.03 --tp 1.0 --seed 3 --out run.nc
   mbcontrol simulate hinged_barge --wave regular --height 0.02 --period 1 --controller passive --set damping=1.5
   mbcontrol linearize hinged_barge --bode bode.png --json
+  mbcontrol design sphere --controller reactive --wave regular --height 2.5 --period 9.6664
+  mbcontrol design sphere --controller passive --wave jonswap --hs 2.5 --tp 8 --json
 """
 from __future__ import annotations
 
@@ -17,6 +19,23 @@ import sys
 import numpy as np
 
 from .errors import MbcontrolError
+
+
+DESIGN_HELP = """Tune a PTO controller for a sea, then check, bound and simulate it.
+
+The controller is tuned by its module's tuner (passive: optimal damping; reactive: complex-
+conjugate matching, or the best stable pair in a sea; latching / declutching: hold time by
+closed-loop simulation, regular waves only; mpc: its defaults, given the wave), within the
+PTO's force and stroke limits unless --unconstrained. It prints the tuned parameters, the
+power linear theory predicts, the stability margins of a linear law (gain, phase, distance
+of the Nyquist curve from -1, closed-loop poles), the complex-conjugate and force/stroke-
+constrained power bounds, and the metrics of a closed-loop simulation on the nonlinear plant
+with the share of each bound it reaches. It ends with the `mbcontrol simulate` command line
+that re-runs that simulation (the parameters as --set KEY=VALUE).
+
+Example:
+  mbcontrol design sphere --controller passive --wave regular --height 2.5 --period 9.6664
+"""
 
 
 def main(argv=None) -> int:
@@ -66,6 +85,29 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--plot", help="write a time-series figure (PNG) to this file")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
     p.set_defaults(run=_simulate)
+
+    p = sub.add_parser("design", help="tune a controller for a sea; check its stability margins, "
+                                      "bound it and simulate it",
+                       description=DESIGN_HELP, formatter_class=argparse.RawTextHelpFormatter)
+    _model_options(p)
+    _wave_options(p)
+    p.add_argument("--controller", required=True, metavar="NAME",
+                   help="passive, reactive, latching, declutching or mpc")
+    p.add_argument("--pto", help="the PTO to tune and score (default: the first)")
+    p.add_argument("--duration", type=float, default=None,
+                   help="closed-loop simulation, s (default: 30 periods, longer if the linear\n"
+                        "loop settles slowly; a sea: its repeat period, max(600 s, 20 Tp))")
+    p.add_argument("--dt", type=float, default=None,
+                   help="time step, s (default: period / 1000, or Tp / 1000)")
+    p.add_argument("--unconstrained", action="store_true",
+                   help="tune without the PTO's force and stroke limits (e.g. complex-conjugate\n"
+                        "control) and with no controller saturation; the limits are still\n"
+                        "reported (violations, constrained bound)")
+    p.add_argument("--bounds", choices=("auto", "full", "off"), default="auto",
+                   help="auto: complex-conjugate, and pseudo-spectral unless the sea has more than\n"
+                        "150 components; full: always both (slow for long seas); off: none")
+    p.add_argument("--json", action="store_true", help="print the design as JSON")
+    p.set_defaults(run=_design)
 
     p = sub.add_parser("linearize", help="linearise about rest; poles, Bode plot")
     _model_options(p)
@@ -135,29 +177,37 @@ def _hydro(args) -> int:
     return 0
 
 
+def _wave(args, plant, duration):
+    """The wave the CLI options describe, None for --wave none; notes a spectrum cut by the
+    hydro data's band on stderr."""
+    from .waves import from_args
+    if args.wave == "none":
+        return None
+    omega = plant.hydro.omega if plant.hydro is not None else None
+    band = (float(omega[0]), float(omega[-1])) if omega is not None else None
+    wave = from_args(args.wave, height=args.height, period=args.period, hs=args.hs,
+                     tp=args.tp, gamma=args.gamma, seed=args.seed, duration=duration,
+                     data_band=band)
+    outside = wave.settings.get("spectrum_outside_data", 0.0)
+    if outside > 1e-3:
+        print(f"mbcontrol: note: {100 * outside:.2g} % of the spectrum's variance lies outside the "
+              f"hydro data ({band[0]:.3g}..{band[1]:.3g} rad/s) and is left out; Hs is kept on the "
+              f"rest", file=sys.stderr)
+    return wave
+
+
 def _simulate(args) -> int:
     from .metrics import summary
     from .simulate import simulate
-    from .waves import from_args
     plant = _plant(args)
-    wave = None
     duration = args.duration
     if args.wave != "none":
         if duration is None:
             duration = 30 * args.period if args.wave == "regular" and args.period else 600.0
-        omega = plant.hydro.omega if plant.hydro is not None else None
-        band = (float(omega[0]), float(omega[-1])) if omega is not None else None
-        wave = from_args(args.wave, height=args.height, period=args.period, hs=args.hs,
-                         tp=args.tp, gamma=args.gamma, seed=args.seed, duration=duration,
-                         data_band=band)
-        outside = wave.settings.get("spectrum_outside_data", 0.0)
-        if outside > 1e-3:
-            print(f"mbcontrol: note: {100 * outside:.2g} % of the spectrum's variance lies outside the "
-                  f"hydro data ({band[0]:.3g}..{band[1]:.3g} rad/s) and is left out; Hs is kept on the "
-                  f"rest", file=sys.stderr)
     elif duration is None:
         duration = 60.0
-    controller = _controller(args)
+    wave = _wave(args, plant, duration)
+    controller = _controller(args, wave)
     params = dict(_key_value(s, "--param") for s in args.param)
     ds = simulate(plant, wave, duration=duration, dt=args.dt, controller=controller,
                   method=args.method, params=params or None, progress=not args.json)
@@ -175,6 +225,98 @@ def _simulate(args) -> int:
     else:
         _print_summary(result)
     return 0
+
+
+def _design(args) -> int:
+    from mbcontrol.controllers.design import design
+    plant = _plant(args)
+    if args.wave == "none":
+        raise ValueError("design needs a wave: --wave regular|jonswap|pm")
+    wave = _wave(args, plant, args.duration or 600.0)
+    result = design(plant, wave, args.controller, pto=args.pto, simulate_s=args.duration,
+                    dt=args.dt, bounds={"auto": True, "full": "full", "off": False}[args.bounds],
+                    limits=not args.unconstrained)
+    command = _simulate_command(args, result)
+    if args.json:
+        print(json.dumps({**result.to_dict(), "model": plant.name, "wave": wave.describe(),
+                          "simulate_command": command}, indent=2, allow_nan=False))
+    else:
+        _print_design(plant, wave, result, command)
+    for note in result.warnings:
+        print(f"mbcontrol: warning: {note}", file=sys.stderr)
+    return 0
+
+
+def _simulate_command(args, result) -> str:
+    """The `mbcontrol simulate` command line that re-runs the design's simulation; numbers
+    in repr form, which round-trips a float exactly."""
+    import shlex
+    words = ["mbcontrol", "simulate", args.model]
+    for item in args.scene_param:
+        words += ["--scene-param", item]
+    words += ["--wave", args.wave]
+    if args.wave == "regular":
+        words += ["--height", repr(args.height), "--period", repr(args.period)]
+    else:
+        words += ["--hs", repr(args.hs), "--tp", repr(args.tp), "--seed", str(args.seed)]
+        if args.wave == "jonswap":
+            words += ["--gamma", repr(args.gamma)]
+    sim = result.simulation
+    if sim is not None:
+        words += ["--duration", repr(sim["duration_s"]), "--dt", repr(sim["dt_s"])]
+    words += ["--controller", result.name]
+    for key, value in result.parameters.items():
+        words += ["--set", f"{key}={value!r}"]
+    return shlex.join(words)
+
+
+def _power(value) -> str:
+    if value is None:
+        return "n/a"
+    for scale, unit in ((1e6, "MW"), (1e3, "kW"), (1.0, "W"), (1e-3, "mW")):
+        if abs(value) >= scale or scale == 1e-3:
+            return f"{value / scale:.4g} {unit}"
+
+
+def _print_design(plant, wave, result, command) -> None:
+    F = plant.units(f"{result.pto}__force")
+    X = plant.units(f"{result.pto}__position")
+    units = {"damping": f"{F} s/{X}", "stiffness": f"{F}/{X}", "force_max": F, "stroke_max": X,
+             "rate_max": f"{F}/s"}
+    sea = (f"a regular wave (H {wave.settings['height']:.6g} m, T {wave.settings['period']:.6g} s)"
+           if wave.kind == "regular" else
+           f"a {wave.kind.upper()} sea (Hs "
+           f"{wave.settings['hs']:.6g} m, Tp {wave.settings['tp']:.6g} s, seed "
+           f"{wave.settings['seed']})")
+    print(f"{plant.name}: {result.name} control of PTO {result.pto!r} designed for {sea}")
+    print("  parameters:")
+    for key, value in result.parameters.items():
+        print(f"    {key} = {value!r} {units.get(key, 's')}")
+    print(f"  predicted (linear theory): {_power(result.predicted_power_W)}")
+    if "simulated_power_W" in result.tuner:
+        print(f"  tuner's own simulation: {_power(result.tuner['simulated_power_W'])}")
+    if result.margins is not None:
+        print(f"  stability: {result.margins.message}")
+    b = result.bound
+    limits = f"|F| <= {b['force_max']:.4g} {F}, |x| <= {b['stroke_max']:.4g} {X}"
+    constrained = (_power(b["constrained_W"]) if b["constrained_W"] is not None
+                   else f"n/a ({b['constrained_reason']})")
+    print(f"  bounds: complex-conjugate {_power(b['complex_conjugate_W'])}; constrained "
+          f"({limits}) {constrained}")
+    m = result.metrics
+    if m is None:
+        print("  not simulated (see the warning)")
+    else:
+        sim = result.simulation
+        pct = result.percent_of_bound
+        share = ", ".join(f"{v:.1f} % of the {k.replace('_', '-')} bound"
+                          for k, v in pct.items() if v is not None)
+        print(f"  simulated ({sim['duration_s']:.4g} s, dt {sim['dt_s']:.4g} s, nonlinear plant): "
+              f"mean absorbed power {_power(m['mean_power_W'])} ({share})")
+        print(f"    max force {m['max_force']:.4g} {F}, max stroke {m['max_stroke']:.4g} {X}, "
+              f"peak/mean power {m['papr']:.3g}, samples outside the limits "
+              f"{100 * m['violation_fraction']:.3g} %")
+    print(f"  re-run: {command}")
 
 
 def _linearize(args) -> int:
@@ -205,26 +347,48 @@ def _linearize(args) -> int:
     return 0
 
 
-def _controller(args):
+def _controller(args, wave=None):
+    """The --controller with its --set settings. A controller that takes a `wave` (a
+    predictive controller's preview) is handed the simulated one, as `design` does."""
     if not args.controller:
         if args.set:
             raise ValueError("--set needs --controller")
         return None
-    from mbcontrol.controllers import make
+    import inspect
+
+    from mbcontrol.controllers import REGISTRY, make
+    cls = REGISTRY.get(args.controller)
+    signature = inspect.signature(cls).parameters if cls is not None else {}
     settings = {}
     for item in args.set:
-        key, value = _key_value(item, "--set")
+        key, value = _key_value(item, "--set", text=True)
+        # text only for a setting that is text (a choice), so a typo in a number is caught
+        if isinstance(value, str) and not _takes_text(signature.get(key)):
+            raise ValueError(f"--set {key}: expected a number, got {value!r}")
         settings[key] = value
+    if wave is not None and cls is not None and "wave" in inspect.signature(cls).parameters:
+        settings.setdefault("wave", wave)
     return make(args.controller, **settings)
 
 
-def _key_value(item: str, flag: str):
+def _takes_text(parameter) -> bool:
+    """Does a controller setting take text: a str default or a str annotation?"""
+    if parameter is None:
+        return False
+    return isinstance(parameter.default, str) or "str" in str(parameter.annotation)
+
+
+def _key_value(item: str, flag: str, text: bool = False):
+    """(key, float value); with text, a value that is not a number stays a string (a
+    controller's choice such as --set forecast=ar)."""
     if "=" not in item:
         raise ValueError(f"{flag} expects KEY=VALUE, got {item!r}")
     key, value = item.split("=", 1)
     try:
         return key.strip(), float(value)
     except ValueError:
+        if text and value.strip():
+            return key.strip(), value.strip()
         raise ValueError(f"{flag} {key}: expected a number, got {value!r}") from None
 
 

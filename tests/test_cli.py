@@ -17,7 +17,7 @@ def test_help_explains_commands(capsys):
         main(["--help"])
     assert exc.value.code == 0
     out = capsys.readouterr().out
-    for command in ("models", "hydro", "simulate", "linearize"):
+    for command in ("models", "hydro", "simulate", "linearize", "design"):
         assert command in out
 
 
@@ -71,6 +71,31 @@ def test_errors_are_clear(capsys):
     code, _, err = run(capsys, "simulate", "hinged_barge", "--height", "0.02", "--period", "1",
                        "--controller", "passive", "--set", "damping")
     assert code == 1 and "KEY=VALUE" in err
+    # text is taken only by a setting that is text (an MPC's forecast), not by a number
+    code, _, err = run(capsys, "simulate", "hinged_barge", "--height", "0.02", "--period", "1",
+                       "--controller", "passive", "--set", "damping=1.5x")
+    assert code == 1 and "--set damping: expected a number, got '1.5x'" in err
+
+
+def test_design_text_prints_parameters_margins_bounds_and_rerun(capsys):
+    code, out, _ = run(capsys, "design", "sphere", "--controller", "reactive", "--wave", "regular",
+                       "--height", "2.5", "--period", "9.6664", "--unconstrained", "--bounds", "off")
+    assert code == 0
+    assert "damping = " in out and "stiffness = " in out and "force_max = inf" in out
+    assert "stable closed loop" in out and "gain margin 1.344 at 0 rad/s" in out
+    assert "re-run: mbcontrol simulate sphere --wave regular --height 2.5 --period 9.6664" in out
+    assert "--controller reactive --set damping=" in out
+
+
+def test_design_errors_are_clear(capsys):
+    code, _, err = run(capsys, "design", "sphere", "--controller", "latching", "--wave", "jonswap",
+                       "--hs", "2", "--tp", "8")
+    assert code == 1 and "design 'latching'" in err and "regular wave" in err
+    code, _, err = run(capsys, "design", "sphere", "--controller", "pid", "--height", "2",
+                       "--period", "8")
+    assert code == 1 and "unknown controller 'pid'" in err and "passive, reactive" in err
+    code, _, err = run(capsys, "design", "sphere", "--controller", "passive", "--wave", "none")
+    assert code == 1 and "design needs a wave" in err
 
 
 @pytest.mark.parametrize("model", ["rm3", "sphere", "wavestar"])

@@ -7,6 +7,11 @@ tuning; theory's ranking reactive > latching > passive; convergence in the step.
 measured on the nonlinear plant in closed loop (here linear in heave) from the PTO's work over
 whole wave periods after the start-up (controllers.latching.steady_mean_power). Measured
 values in the comments are from one run on this machine.
+
+These tests are about the unconstrained theory, so their controllers and tuners are given
+force_max = inf (NO_LIMIT): by default a controller saturates at the scene PTO's force_max
+(2 MN on the sphere), which complex-conjugate control and the latching brake exceed in this
+wave. Saturation itself is tested in tests/test_limits.py.
 """
 import numpy as np
 import pytest
@@ -27,6 +32,7 @@ from mbcontrol.simulate import simulate
 T = 9.6664            # s, the regular wave of the brief (H 2.5 m); the sphere's T_n is 4.36 s
 SKIP, AVERAGE = 10, 5  # periods skipped (latching settles in ~8), periods averaged
 FULL_SCALE = (1e3, 1e7)  # N s/m: optimal_damping's default bounds are for tank models
+NO_LIMIT = {"force_max": np.inf}   # the unconstrained theory: no force saturation
 
 
 @pytest.fixture(scope="module")
@@ -47,17 +53,17 @@ def run(plant, wave, controller, dt, periods=SKIP + AVERAGE):
 @pytest.fixture(scope="module")
 def passive(plant, wave):
     damping, predicted = optimal_damping(plant, wave, bounds=FULL_SCALE)
-    _, power = run(plant, wave, make("passive", damping=damping), 0.01)
+    _, power = run(plant, wave, make("passive", damping=damping, **NO_LIMIT), 0.01)
     return damping, predicted, power
 
 
 @pytest.fixture(scope="module")
 def latching(plant, wave):
     """Tuned latching, simulated at three steps: {dt: (controller, dataset, power)}."""
-    latch_time, damping, tuned_power = optimal_latch_time(plant, wave)
+    latch_time, damping, tuned_power = optimal_latch_time(plant, wave, **NO_LIMIT)
     runs = {}
     for dt in (0.04, 0.02, 0.01):
-        controller = make("latching", damping=damping, latch_time=latch_time)
+        controller = make("latching", damping=damping, latch_time=latch_time, **NO_LIMIT)
         ds, power = run(plant, wave, controller, dt)
         runs[dt] = (controller, ds, power)
     return latch_time, damping, tuned_power, runs
@@ -89,7 +95,7 @@ def test_reactive_is_impedance_matching_and_reaches_the_bound(plant, wave):
     assert complex_conjugate_power(plant, wave) == pytest.approx(bound, rel=1e-6)
     stable, margin = closed_loop_stability(plant, damping, stiffness)
     assert stable and margin == pytest.approx(0.108, abs=0.01)   # measured 0.1076 1/s
-    controller = make("reactive", damping=damping, stiffness=stiffness)
+    controller = make("reactive", damping=damping, stiffness=stiffness, **NO_LIMIT)
     assert controller.casadi_law is not None                     # runs compiled
     _, power = run(plant, wave, controller, 0.01)
     # reference 1.3428 MW; measured 1.3436 MW (+0.06 %; +0.13 % at dt = 0.002 s: the fit)
@@ -119,7 +125,7 @@ def test_power_ranks_reactive_latching_passive(plant, wave, passive, latching):
     latch_time, _, tuned, runs = latching
     power_l = runs[0.01][2]
     _, power_r = run(plant, wave, make("reactive", **dict(zip(
-        ("damping", "stiffness"), reactive_tuning(plant, wave)[:2]))), 0.01)
+        ("damping", "stiffness"), reactive_tuning(plant, wave)[:2])), **NO_LIMIT), 0.01)
     # measured: passive 141.2 kW (FD 141.6 kW at 883 kN s/m), latching 829 kW (latch 2.58 s,
     # classical (T - T_n) / 2 = 2.65 s, damping 89 kN s/m), reactive 1.344 MW
     assert power_p == pytest.approx(predicted_p, rel=0.02)
@@ -157,17 +163,20 @@ def test_latching_converges_in_the_step_and_holds_still(plant, wave, latching):
 def test_declutching_gains_in_waves_shorter_than_natural_period(plant, wave):
     short = waves.regular(1.0, 3.0)        # T = 3 s < T_n = 4.36 s
     damping_p, _ = optimal_damping(plant, short, bounds=FULL_SCALE)
-    _, power_p = run(plant, short, make("passive", damping=damping_p), short.period / 500)
-    tau, damping, _ = optimal_declutch(plant, short)
-    _, power_d = run(plant, short, make("declutching", damping=damping, declutch_time=tau),
+    _, power_p = run(plant, short, make("passive", damping=damping_p, **NO_LIMIT),
                      short.period / 500)
+    tau, damping, _ = optimal_declutch(plant, short, **NO_LIMIT)
+    _, power_d = run(plant, short, make("declutching", damping=damping, declutch_time=tau,
+                                        **NO_LIMIT), short.period / 500)
     # measured: passive 1.33 kW; declutching 3.0 kW (tau 1.15 s = 0.38 T, damping 1.72 MN s/m)
     assert power_d > 1.5 * power_p
     # in the long wave (T > T_n) it loses: tau = 0.1 T, damping by the rule T / (T - 2 tau):
     # measured 0.82 x passive
     passive_damping = optimal_damping(plant, wave, bounds=FULL_SCALE)[0]
-    _, power_long = run(plant, wave, Declutching(passive_damping / 0.8, 0.1 * T), 0.02)
-    _, power_long_p = run(plant, wave, make("passive", damping=passive_damping), 0.02)
+    _, power_long = run(plant, wave, Declutching(passive_damping / 0.8, 0.1 * T, **NO_LIMIT),
+                        0.02)
+    _, power_long_p = run(plant, wave, make("passive", damping=passive_damping, **NO_LIMIT),
+                          0.02)
     assert power_long < power_long_p
 
 
@@ -182,7 +191,7 @@ def test_reactive_tuned_on_wrong_model_is_flagged_and_fails_cleanly(plant, wave)
     assert not stable and margin < -0.5         # measured -1.106 1/s: e-folds in 0.9 s
     with pytest.raises(SimulationError, match="diverged"):
         simulate(plant, wave, duration=60.0, dt=0.01,
-                 controller=make("reactive", damping=damping, stiffness=stiffness))
+                 controller=make("reactive", damping=damping, stiffness=stiffness, **NO_LIMIT))
 
 
 def test_parameters_by_name_and_describe():

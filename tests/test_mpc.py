@@ -7,6 +7,7 @@
 - the qpOASES path against the cvxpy/Clarabel path on the same QPs;
 - the Kalman filter's excitation estimate against the true excitation the simulation applied;
 - balanced truncation against Glover's error bound on a frequency grid.
+The WECCCOMP limits test of the MPC is in tests/test_wecccomp.py, with the other controllers.
 Measured numbers are in each test's docstring.
 """
 import warnings
@@ -21,15 +22,13 @@ from mbcontrol.controllers.estimation import ArPredictor
 from mbcontrol.controllers.mpc import CondensedQp, Mpc
 from mbcontrol.controllers.latching import steady_mean_power
 from mbcontrol.linearize import linearize
-from mbcontrol.metrics import pto_metrics, wecccomp_score
+from mbcontrol.metrics import pto_metrics
 from mbcontrol.plant import build_plant
 from mbcontrol.reduce import balanced_truncation
 from mbcontrol.simulate import simulate
 
 REGULAR = waves.regular(2.5, 9.6664)
 FORCE_MAX, STROKE_MAX = 2e6, 4.0
-WECCCOMP_SEAS = [(0.0208, 0.988, 1.0), (0.0625, 1.412, 1.0), (0.1042, 1.836, 1.0),
-                 (0.0208, 0.988, 3.3), (0.0625, 1.412, 3.3), (0.1042, 1.836, 3.3)]
 
 
 @pytest.fixture(scope="module")
@@ -192,26 +191,22 @@ def test_balanced_truncation_within_glover_bound():
         balanced_truncation(sys, 0)
 
 
-@pytest.mark.parametrize("sea", WECCCOMP_SEAS, ids=lambda s: f"Hs{s[0]}-Tp{s[1]}-g{s[2]}")
-def test_wavestar_mpc_respects_limits_in_the_wecccomp_seas(sea):
-    """WECCCOMP seas (ramp 5 Tp, length 100 Tp, EC scored after 25 s): MPC (Kalman, AR
-    forecast, electrical objective with efficiency 0.7, horizon 2 s, period 0.05 s) keeps
-    |F| <= 60 N and |z| <= 0.08 m and scores EC > 0."""
-    plant = _wavestar()
-    hs, tp, gamma = sea
-    wave = waves.irregular(hs, tp, gamma=gamma, seed=1, duration=100 * tp, ramp_time=5 * tp)
-    mpc, ds = _run(plant, wave, 105 * tp, 0.005, horizon_s=2.0, dt_s=0.05, forecast="ar")
-    score = wecccomp_score(ds, plant.scene.ptos[0])
-    assert score["max_force"] <= 60.0 * (1 + 1e-12)
-    assert score["max_stroke"] <= 0.08
-    assert score["EC"] > 0
-    assert mpc.stats["failures"] == 0
-
-
-_WAVESTAR = []
-
-
-def _wavestar():
-    if not _WAVESTAR:
-        _WAVESTAR.append(build_plant("wavestar"))
-    return _WAVESTAR[0]
+def test_hinged_barge_torque_limit_mpc_beats_saturated_linear_laws():
+    """The seed's hinged barge in its demo sea (JONSWAP Hs 3 cm, Tp 1.1 s) with the PTO torque
+    limited to 0.5 N m (the scene's rating is 5; the sea's optimal damper peaks at 0.91 N m):
+    every controller keeps |torque| <= 0.5 N m; MPC (Kalman, AR forecast) absorbs more than
+    that damper saturated at the same limit (measured: MPC 77.7 mW, passive 59.4 mW;
+    unconstrained complex-conjugate bound 119 mW)."""
+    from mbcontrol.controllers.passive import Passive, optimal_damping
+    plant = build_plant("hinged_barge")
+    sea = waves.irregular(0.03, 1.1, gamma=3.3, seed=1, duration=120.0)
+    damping, _ = optimal_damping(plant, sea)
+    runs = {"passive": Passive(damping, force_max=0.5),
+            "mpc": Mpc(horizon_s=1.1, dt_s=0.0275, force_max=0.5, wave=sea, forecast="ar")}
+    power = {}
+    for name, controller in runs.items():
+        ds = simulate(plant, sea, duration=120.0, dt=0.0055, controller=controller)
+        m = pto_metrics(ds, "hinge_pto", 20.0)
+        assert m["max_force"] <= 0.5 * (1 + 1e-12)
+        power[name] = m["mean_power_W"]
+    assert power["mpc"] > 1.2 * power["passive"] > 0

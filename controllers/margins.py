@@ -1,0 +1,228 @@
+"""Closed-loop stability margins of linear PTO laws on the linearised plant (python-control).
+
+A linear PTO law u = -K(s) y, with y = [x, v] the PTO's position and velocity (m, m/s or rad,
+rad/s) and u the PTO's whole force on its follower (N or N m), closes a negative-feedback loop
+around G(s), the plant's transfer from u to y. G is linearised about rest with no Coulomb
+friction and the PTO's own scene law zeroed (the controller owns the PTO force, as in
+closed-loop simulation; `reactive._base_params`). The loop transfer is L(s) = K(s) G(s)
+(SISO) and the closed loop's characteristic equation is 1 + L(s) = 0.
+
+Passive and reactive control, u = -(damping v + stiffness x), have K = [stiffness, damping]:
+L(s) = (damping + stiffness / s) G_v(s), with G_v = 1 / Z_i the PTO's intrinsic admittance. In
+phasors of exp(+i omega t), L(i omega) = Z_pto / Z_i with Z_pto = damping - i stiffness / omega
+(controllers.reactive). Two consequences the tests check by hand:
+
+- a damper on a passive device: Re Z_i >= 0 and damping >= 0 give Re L >= 0, so the Nyquist
+  curve never meets the negative real axis: infinite gain margin, phase margin >= 90 deg,
+  stable for any damping;
+- a spring: L(0) = stiffness / K, K the restoring stiffness the PTO sees (hydrostatics in
+  heave). A negative stiffness puts L(0) on the negative real axis: the gain margin is
+  K / |stiffness|, and stiffness < -K (L(0) < -1) leaves no net restoring force: unstable.
+
+Margins reported (`Margins`):
+
+- gain margin: the factor on K, nearest 1 in log, that puts L(i omega) on -1 where it crosses
+  the negative real axis (> 1: gains may grow that much; < 1: the loop is beyond -1 and the
+  gains must shrink by that factor to reach it); inf when there is no such crossing;
+- phase margin (deg, unsigned): the least phase change, lag or lead, that puts L(i omega) on
+  -1 where |L| = 1; inf when |L| never reaches 1. Unsigned because reactive control near
+  complex-conjugate matching has |L(i omega_wave)| = 1 at an angle -2 arg Z_i, close to
+  +-180 deg on either side, and the textbook sign (lag only) then reads "negative" for a
+  stable loop;
+- stability margin: min over omega >= 0 of |1 + L(i omega)| (omega = 0 and infinity
+  included), the distance of the Nyquist curve from -1, 1 / (peak sensitivity);
+- the closed-loop poles (reactive.closed_loop_stability for static laws): stable, and the
+  pole margin (1/s), minus the largest real part. The poles decide stability; the margins say
+  how far from the edge it is.
+
+Saturation (a controller's force_max) is not in these small-signal margins.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import control
+import numpy as np
+
+# a loop gain this small relative to the loop's peak is a zero of L, not a crossing of the
+# negative real axis (velocity feedback has L(0) = 0, which round-off puts at -1e-16)
+_ZERO_GAIN = 1e-9
+
+
+@dataclass(frozen=True)
+class Margins:
+    """Stability margins of one PTO's linear loop L(s) = K(s) G(s), negative feedback.
+
+    gain_margin: factor on K (inf: never crosses the negative real axis); phase_margin_deg:
+    unsigned, deg (inf: |L| never reaches 1); stability_margin: min |1 + L(i omega)|;
+    frequencies in rad/s (nan where there is none; 0 is a crossing at DC); gain_crossovers_rad_s
+    and phase_margins_deg: every |L| = 1 crossing and its margin; stable and pole_margin (1/s)
+    from the closed-loop poles; message: a sentence saying all that.
+    """
+    pto: str
+    law: str
+    gain_margin: float
+    phase_crossover_rad_s: float
+    phase_margin_deg: float
+    gain_crossover_rad_s: float
+    stability_margin: float
+    stability_margin_rad_s: float
+    gain_crossovers_rad_s: tuple
+    phase_margins_deg: tuple
+    stable: bool
+    pole_margin: float
+    message: str
+    loop: object = field(default=None, repr=False, compare=False)   # L(s), control.StateSpace
+
+    def to_dict(self) -> dict:
+        """JSON-ready: no L(s); inf and nan become None."""
+        out = {}
+        for key in ("pto", "law", "gain_margin", "phase_crossover_rad_s", "phase_margin_deg",
+                    "gain_crossover_rad_s", "stability_margin", "stability_margin_rad_s",
+                    "gain_crossovers_rad_s", "phase_margins_deg", "stable", "pole_margin",
+                    "message"):
+            value = getattr(self, key)
+            out[key] = [_finite(v) for v in value] if isinstance(value, tuple) else _finite(value)
+        return out
+
+
+def _finite(value):
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    if isinstance(value, (float, np.floating)):
+        return float(value) if math.isfinite(value) else None
+    return value
+
+
+def plant_loop(plant, *, pto: str | None = None, params=None) -> control.StateSpace:
+    """G(s): the linearised plant from the PTO force u (N or N m) to [position, velocity].
+
+    About rest, no Coulomb friction, the PTO's own scene law zeroed, other PTOs as `params`
+    sets them (default: free), as reactive.closed_loop_stability sees it.
+    """
+    from mbcontrol.linearize import linearize
+
+    from .reactive import _base_params
+    name = pto or plant.scene.ptos[0].name
+    base = _base_params(plant, name, params)
+    base[f"{name}__damping"] = 0.0
+    return linearize(plant, params=base, inputs=[f"u__{name}"],
+                     outputs=[f"{name}__position", f"{name}__velocity"])
+
+
+def _gains(law, pto: str):
+    """(label, K): K a 1x2 static gain [stiffness, damping] or an LTI system, u = -K y."""
+    if isinstance(law, (control.StateSpace, control.TransferFunction)):
+        if law.ninputs != 2 or law.noutputs != 1:
+            raise ValueError(f"margins: an LTI law K(s) maps [x, v] (2 inputs) to the PTO "
+                             f"force (1 output); got {law.ninputs} inputs, {law.noutputs} "
+                             f"outputs")
+        return "lti", law
+    if isinstance(law, dict):
+        label, settings = "reactive" if "stiffness" in law else "passive", law
+    else:
+        label = getattr(law, "name", type(law).__name__)
+        if label not in ("passive", "reactive"):
+            raise ValueError(f"margins: {label!r} is not a linear law (passive, reactive, a "
+                             f"dict of damping and stiffness, or an LTI K(s)); switching and "
+                             f"predictive controllers have no loop transfer")
+        settings = {"damping": law.damping, "stiffness": getattr(law, "stiffness", 0.0)}
+
+    def one(value):                # a number for all PTOs, or a dict by PTO name
+        return float(value.get(pto, 0.0) if isinstance(value, dict) else value)
+
+    return label, (one(settings.get("damping", 0.0)), one(settings.get("stiffness", 0.0)))
+
+
+def loop_margins(plant, law, *, pto: str | None = None, params=None) -> Margins:
+    """Gain, phase and stability margins and closed-loop poles of a linear PTO law.
+
+    law: a Passive or Reactive controller, a dict {"damping": N s/m, "stiffness": N/m} (or
+    N m s/rad, N m/rad), or an LTI K(s) from [x, v] to the force, u = -K(s) [x, v] (negative
+    feedback). pto: which PTO closes the loop (default the first); params: plant parameter
+    overrides, e.g. the other PTOs' damping and stiffness when their loops are closed too (the
+    default leaves them free). Never raises on an unstable loop: it says so in `stable` and
+    `message`.
+    """
+    from .reactive import closed_loop_stability
+    name = pto or plant.scene.ptos[0].name
+    G = plant_loop(plant, pto=name, params=params)
+    label, K = _gains(law, name)
+    if label == "lti":
+        L = control.series(G, control.ss(K))
+        poles = control.feedback(G, control.ss(K), sign=-1).poles()
+        pole_margin = -float(np.max(poles.real))
+        stable = pole_margin > 0
+    else:
+        damping, stiffness = K
+        Kg = np.array([[stiffness, damping]])
+        L = control.ss(G.A, G.B, Kg @ G.C, Kg @ G.D)
+        stable, pole_margin = closed_loop_stability(plant, damping, stiffness, pto=name,
+                                                    params=params)
+    gm, w180, pms, wcs, sm, wsm = _margins(L)
+    k = int(np.argmin(pms)) if pms else None
+    pm = pms[k] if pms else math.inf
+    wc = wcs[k] if pms else math.nan
+    message = _message(name, label, stable, pole_margin, gm, w180, pm, wc, sm, L)
+    return Margins(name, label, gm, w180, pm, wc, sm, wsm, tuple(wcs), tuple(pms),
+                   bool(stable), float(pole_margin), message, L)
+
+
+def _margins(L):
+    """(gm, w_gm, [pm], [w_c], sm, w_sm) of a SISO loop, from control.stability_margins with
+    the crossings python-control's polynomial method finds, checked on a frequency grid."""
+    gms, pms, sms, w180, wc, wstab = control.stability_margins(L, returnall=True)
+    poles = np.abs(np.linalg.eigvals(np.asarray(L.A))) if L.nstates else np.array([1.0])
+    poles = poles[poles > 0] if np.any(poles > 0) else np.array([1.0])
+    grid = np.logspace(np.log10(poles.min() / 100), np.log10(poles.max() * 100), 2000)
+    response = np.asarray(L(1j * grid)).ravel()
+    peak = float(np.max(np.abs(response)))
+    # gain margin: the crossings of the negative real axis with a loop gain that is not zero
+    w180 = np.atleast_1d(w180)
+    at = np.asarray(L(1j * w180)).ravel() if w180.size else np.zeros(0)
+    real = (at.real < 0) & (np.abs(at) > _ZERO_GAIN * peak)
+    gm, w_gm = math.inf, math.nan
+    if np.any(real):
+        candidates = 1.0 / np.abs(at[real])
+        j = int(np.argmin(np.abs(np.log(candidates))))
+        gm, w_gm = float(candidates[j]), float(w180[real][j])
+    # phase margins, unsigned: python-control's pm is angle - 180 in [-180, 180)
+    pm_list = [float(abs(p)) for p in np.atleast_1d(pms)]
+    wc_list = [float(w) for w in np.atleast_1d(wc)]
+    # stability margin: python-control's interior minima of |1 + L|, plus DC, infinity and
+    # the grid (which only guards: a grid point is never below the true minimum)
+    candidates = [(float(s), float(w)) for s, w in zip(np.atleast_1d(sms), np.atleast_1d(wstab))]
+    D = float(np.asarray(L.D).ravel()[0])
+    candidates.append((abs(1 + D), math.inf))
+    try:
+        dc = complex(np.asarray(L(0j)).ravel()[0])
+        if np.isfinite(dc):
+            candidates.append((abs(1 + dc), 0.0))
+    except (ZeroDivisionError, np.linalg.LinAlgError):
+        pass                                   # a pole at s = 0: |L(0)| is infinite
+    j = int(np.argmin(np.abs(1 + response)))
+    candidates.append((float(np.abs(1 + response[j])), float(grid[j])))
+    sm, w_sm = min(candidates)
+    return gm, w_gm, pm_list, wc_list, sm, w_sm
+
+
+def _message(pto, label, stable, pole_margin, gm, w_gm, pm, wc, sm, L) -> str:
+    gain = ("inf (never crosses the negative real axis)" if math.isinf(gm)
+            else f"{gm:.4g} at {w_gm:.4g} rad/s")
+    phase = "inf (|L| < 1 throughout)" if math.isinf(pm) else f"{pm:.3g} deg at {wc:.4g} rad/s"
+    text = (f"PTO {pto!r}, {label} law: gain margin {gain}; phase margin {phase}; "
+            f"min |1 + L| = {sm:.3g}")
+    if stable:
+        return (f"stable closed loop (slowest pole decays at {pole_margin:.3g} 1/s). " + text)
+    hint = ""
+    try:
+        dc = complex(np.asarray(L(0j)).ravel()[0])
+        if np.isfinite(dc) and dc.real < -1 and abs(dc.imag) < 1e-9 * abs(dc):
+            hint = (f" L(0) = {dc.real:.4g} < -1: the PTO's negative stiffness outweighs the "
+                    f"restoring stiffness it sees, so nothing holds the device at rest.")
+    except (ZeroDivisionError, np.linalg.LinAlgError):
+        pass
+    growth = (f"a pole with real part {-pole_margin:.3g} 1/s (grows e-fold in "
+              f"{1 / -pole_margin:.3g} s)" if pole_margin < 0 else "a pole on the imaginary axis")
+    return f"UNSTABLE closed loop: {growth}.{hint} {text}"
