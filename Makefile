@@ -36,6 +36,7 @@ bench: $(VENV)/.installed-test
 	    --tols 0.1 0.05 0.02 0.01 --out $(OUT)/bench/radiation_rm3
 	$(PY) benchmarks/scaling.py --n 2 4 8 16 --out $(OUT)/bench/scaling
 	$(PY) benchmarks/mpc.py --out $(OUT)/bench/mpc
+	$(PY) benchmarks/nmpc.py --out $(OUT)/bench/nmpc
 
 clean:
 	rm -rf $(OUT) .pytest_cache

@@ -7,11 +7,12 @@ from __future__ import annotations
 from .base import Controller
 from .latching import Declutching, Latching
 from .mpc import Mpc
+from .nmpc import Nmpc
 from .passive import Passive
 from .reactive import Reactive
 
 REGISTRY = {"passive": Passive, "reactive": Reactive, "latching": Latching,
-            "declutching": Declutching, "mpc": Mpc}
+            "declutching": Declutching, "mpc": Mpc, "nmpc": Nmpc}
 
 
 def make(name: str, **settings) -> Controller:

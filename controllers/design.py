@@ -53,7 +53,8 @@ MAX_BOUND_COMPONENTS = 150
 # the tuned parameters of each controller (the contract of make(name, **parameters))
 CONTRACT = {"passive": ("damping",), "reactive": ("damping", "stiffness"),
             "latching": ("damping", "latch_time"), "declutching": ("damping", "declutch_time"),
-            "mpc": ("horizon_s", "dt_s", "force_max", "stroke_max", "rate_max")}
+            "mpc": ("horizon_s", "dt_s", "force_max", "stroke_max", "rate_max"),
+            "nmpc": ("horizon_s", "dt_s", "force_max", "stroke_max", "rate_max")}
 MAX_HARMONICS = 25            # the constrained bound's QP stays < 0.1 s (0.07 s at 15)
 SETTLE_TIME_CONSTANTS = 12      # e^-12 = 6e-6: the start-up transient left in the window
 
@@ -268,7 +269,7 @@ def _tune(plant, wave, name, pto_obj, limits, model_params, notes):
     if model_params:
         raise ValueError("model_params: this controller is not tuned, so there is no model "
                          "to get wrong")
-    if name == "mpc":
+    if name in ("mpc", "nmpc"):
         # one wave period ahead in 40 steps: the horizon that reaches the constrained bound
         # on the sphere (tests/test_mpc.py) and a QP of real-time size
         own.setdefault("horizon_s", float(wave.period))
