@@ -45,6 +45,8 @@ import numpy as np
 
 from mbcontrol.errors import SimulationError
 
+from mbcontrol.results import jsonable
+
 from . import REGISTRY, make
 
 # above this many wave components the pseudo-spectral QP is skipped unless bounds="full": its
@@ -99,23 +101,7 @@ class DesignResult:
                "metrics": self.metrics, "percent_of_bound": self.percent_of_bound,
                "margins": None if self.margins is None else self.margins.to_dict(),
                "tuner": self.tuner, "simulation": self.simulation, "warnings": self.warnings}
-        return _jsonable(out)
-
-
-def _jsonable(obj):
-    if isinstance(obj, dict):
-        return {str(k): _jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_jsonable(v) for v in obj]
-    if isinstance(obj, np.ndarray):
-        return _jsonable(obj.tolist())
-    if isinstance(obj, (bool, np.bool_)):
-        return bool(obj)
-    if isinstance(obj, (int, np.integer)):
-        return int(obj)
-    if isinstance(obj, (float, np.floating)):
-        return float(obj) if math.isfinite(obj) else None
-    return obj
+        return jsonable(out)
 
 
 def design(plant, wave, name: str, *, pto: str | None = None, simulate_s: float | None = None,

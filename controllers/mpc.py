@@ -36,6 +36,8 @@ import warnings
 
 import numpy as np
 
+from mbcontrol.results import jsonable
+
 from .base import per_pto
 from .control_plant import build_control_plant
 from .estimation import ArPredictor, ExcitationKalman, wave_frequencies
@@ -195,8 +197,8 @@ class Mpc:
             stats.update(solve_ms_median=float(np.median(times)),
                          solve_ms_p95=float(np.percentile(times, 95)))
         return {"name": self.name, "horizon_s": self.horizon_s, "dt_s": self.dt_s,
-                "force_max": _jsonable(self.force_max), "stroke_max": _jsonable(self.stroke_max),
-                "rate_max": _jsonable(self.rate_max), "forecast": self.forecast,
+                "force_max": jsonable(self.force_max), "stroke_max": jsonable(self.stroke_max),
+                "rate_max": jsonable(self.rate_max), "forecast": self.forecast,
                 "estimator": self.estimator + (" (full-state oracle)" if self.uses_state else ""),
                 "solver": self.solver, "order": self.order, "soft_stroke": self.soft_stroke,
                 "period_s": self.period, "stats": stats}
@@ -383,7 +385,7 @@ class _CvxpyBackend:
 
     def __init__(self, form):
         import cvxpy as cp
-        n, m = form.n_var, form.A.shape[0]
+        n = form.n_var
         self.x = cp.Variable(n)
         self.g = cp.Parameter(n)
         w, V = np.linalg.eigh(form.H)
@@ -478,9 +480,3 @@ def _natural_frequency(cp) -> float:
 def _choice(what, value, allowed):
     if value not in allowed:
         raise ValueError(f"mpc: {what} must be one of {', '.join(allowed)}, got {value!r}")
-
-
-def _jsonable(value):
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    return value

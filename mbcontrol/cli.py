@@ -19,6 +19,7 @@ import sys
 import numpy as np
 
 from .errors import MbcontrolError
+from .results import jsonable
 
 
 DESIGN_HELP = """Tune a PTO controller for a sea, then check, bound and simulate it.
@@ -164,7 +165,7 @@ def _hydro(args) -> int:
               "n_omega": int(plant.hydro.omega.size), "radiation_states": int(rad.order),
               "fit_error": float(rad.fit_error),
               "max_pole_real_part": float(np.max(np.linalg.eigvals(rad.A).real)),
-              "report": _jsonable(rad.report)}
+              "report": jsonable(rad.report)}
     if args.json:
         print(json.dumps(report, indent=2))
     else:
@@ -401,20 +402,6 @@ def _print_summary(result: dict) -> None:
     for pto, values in result["ptos"].items():
         print(f"  {pto}: mean absorbed power {values['mean_power_W']:.4g} W, max force "
               f"{values['max_force']:.4g}, max stroke {values['max_stroke']:.4g}")
-
-
-def _jsonable(obj):
-    if isinstance(obj, dict):
-        return {str(k): _jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_jsonable(v) for v in obj]
-    if isinstance(obj, np.ndarray):
-        return _jsonable(obj.tolist())
-    if isinstance(obj, complex):
-        return [obj.real, obj.imag]
-    if isinstance(obj, np.generic):
-        return obj.item()
-    return obj
 
 
 if __name__ == "__main__":

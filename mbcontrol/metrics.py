@@ -17,6 +17,8 @@ import math
 
 import numpy as np
 
+from .results import jsonable
+
 _BODY_KEYS = {"Surge": "surge_amplitude_m", "Sway": "sway_amplitude_m",
               "Heave": "heave_amplitude_m", "Roll": "roll_amplitude_rad",
               "Pitch": "pitch_amplitude_rad", "Yaw": "yaw_amplitude_rad"}
@@ -135,15 +137,9 @@ def summary(ds, plant) -> dict:
     for body in plant.topology.bodies:
         bodies[body] = {key: 0.5 * float(np.ptp(ds[f"{body}__{dof}"].values[mask]))
                         for dof, key in _BODY_KEYS.items()}
-    ptos = {pto.name: _jsonable_limits(pto_metrics(ds, pto)) for pto in plant.scene.ptos}
+    ptos = {pto.name: jsonable(pto_metrics(ds, pto)) for pto in plant.scene.ptos}
     return {"model": ds.attrs["model"], "wave": json.loads(ds.attrs["wave"]),
             "duration_s": float(ds.attrs["duration_s"]), "dt_s": float(ds.attrs["dt_s"]),
             "wall_time_s": float(ds.attrs["wall_time_s"]), "method": ds.attrs["method"],
             "controller": json.loads(ds.attrs.get("controller", "null")),
             "dofs": dofs, "bodies": bodies, "ptos": ptos}
-
-
-def _jsonable_limits(metrics: dict) -> dict:
-    """JSON has no infinity: unlimited limits and an undefined PAPR become null."""
-    return {k: (None if isinstance(v, float) and not math.isfinite(v) else v)
-            for k, v in metrics.items()}

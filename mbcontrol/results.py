@@ -1,11 +1,34 @@
-"""Saving results: netCDF written to a temporary file and renamed, so nothing half-written."""
+"""Saving results: netCDF written to a temporary file and renamed, so nothing half-written;
+and `jsonable`, the one conversion of results to strict JSON."""
 from __future__ import annotations
 
+import math
 import os
 import tempfile
 from pathlib import Path
 
+import numpy as np
 import xarray as xr
+
+
+def jsonable(obj):
+    """Strict-JSON form of a result: NumPy scalars and arrays to Python, complex to [re, im],
+    infinite and nan floats (JSON has neither) to None."""
+    if isinstance(obj, dict):
+        return {str(k): jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [jsonable(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return jsonable(obj.tolist())
+    if isinstance(obj, (bool, np.bool_)):
+        return bool(obj)
+    if isinstance(obj, (int, np.integer)):
+        return int(obj)
+    if isinstance(obj, (float, np.floating)):
+        return float(obj) if math.isfinite(obj) else None
+    if isinstance(obj, (complex, np.complexfloating)):
+        return [jsonable(obj.real), jsonable(obj.imag)]
+    return obj
 
 
 def save_dataset(ds: xr.Dataset, path) -> Path:
