@@ -249,7 +249,6 @@ def reactive_tuning(plant, wave, pto: str | None = None, *, params=None,
         return constrained_tuning(plant, wave, pto=pto, params=params, force_max=force_max,
                                   stroke_max=stroke_max, efficiency=efficiency,
                                   exceedance=exceedance, min_margin=min_margin)
-    from scipy.optimize import minimize
 
     name = pto or plant.scene.ptos[0].name
     w, a = np.asarray(wave.omega, float), np.asarray(wave.amplitude, float)
@@ -274,13 +273,8 @@ def reactive_tuning(plant, wave, pto: str | None = None, *, params=None,
             stable, margin = closed_loop_stability(plant, c, k, pto=name, params=params)
             return -power(c, k) if stable and margin >= min_margin else 0.0
 
-        best = None
-        for start in ([np.log(c0), k0 / k_scale], [np.log(np.median(np.abs(Z))), 0.0]):
-            res = minimize(cost, start, method="Nelder-Mead",
-                           options={"xatol": 1e-4, "fatol": 1e-6 * abs(cost(start)) + 1e-9,
-                                    "maxiter": 400})
-            if best is None or res.fun < best.fun:
-                best = res
+        best = _multistart(cost, ([np.log(c0), k0 / k_scale], [np.log(np.median(np.abs(Z))), 0.0]),
+                           xatol=1e-4, fatol_rel=1e-6, fatol_abs=1e-9, maxiter=400)
         c, k = float(np.exp(best.x[0])), float(best.x[1] * k_scale)
     stable, margin = closed_loop_stability(plant, c, k, pto=name, params=params)
     if not stable:
@@ -309,7 +303,7 @@ def constrained_tuning(plant, wave, *, pto: str | None = None, params=None,
     infeasible or unstable pair as infinitely bad, so the result is never below the passive
     one in prediction. ValueError if no damping meets the limits.
     """
-    from scipy.optimize import minimize, minimize_scalar
+    from scipy.optimize import minimize_scalar
 
     from .passive import default_bounds
     name = pto or plant.scene.ptos[0].name
@@ -382,14 +376,22 @@ def constrained_tuning(plant, wave, *, pto: str | None = None, params=None,
         value, ok, _ = evaluate(c, k)
         return -float(value) if ok and margin(c, k) >= min_margin else np.inf
 
-    best = None
-    for start in starts:
-        res = minimize(cost, start, method="Nelder-Mead",
-                       options={"xatol": 1e-5, "fatol": 1e-9 * abs(cost(start)) + 1e-12,
-                                "maxiter": 600})
-        if best is None or res.fun < best.fun:
-            best = res
+    best = _multistart(cost, starts, xatol=1e-5, fatol_rel=1e-9, fatol_abs=1e-12, maxiter=600)
     c, k = float(np.exp(best.x[0])), float(best.x[1] * k_scale)
     if not np.isfinite(best.fun):
         raise ValueError(f"{plant.name}: no stable spring-damper meets the limits")
     return c, k, float(evaluate(c, k)[2]["power_W"])
+
+
+def _multistart(cost, starts, *, xatol, fatol_rel, fatol_abs, maxiter):
+    """The best Nelder-Mead result over the starts in (log damping, scaled stiffness); the
+    function tolerance is relative to the cost at each start."""
+    from scipy.optimize import minimize
+    best = None
+    for start in starts:
+        res = minimize(cost, start, method="Nelder-Mead",
+                       options={"xatol": xatol, "fatol": fatol_rel * abs(cost(start)) + fatol_abs,
+                                "maxiter": maxiter})
+        if best is None or res.fun < best.fun:
+            best = res
+    return best

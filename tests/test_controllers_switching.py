@@ -28,6 +28,7 @@ from mbcontrol.controllers.reactive import (closed_loop_stability, complex_conju
 from mbcontrol.errors import SimulationError
 from mbcontrol.plant import build_plant
 from mbcontrol.simulate import simulate
+from sphere_reference import heave_impedance
 
 T = 9.6664            # s, the regular wave of the brief (H 2.5 m); the sphere's T_n is 4.36 s
 SKIP, AVERAGE = 10, 5  # periods skipped (latching settles in ~8), periods averaged
@@ -71,15 +72,8 @@ def latching(plant, wave):
 
 def closed_form(plant, omega, amplitude):
     """(Z_i, complex-conjugate power) of a heaving body from the hydro data, exp(+i w t)."""
-    hyd = plant.hydro
-    w = hyd.omega
-    A = np.interp(omega, w, hyd.added_mass()[:, 0, 0])
-    B = np.interp(omega, w, hyd.radiation_damping()[:, 0, 0])
-    F = hyd.excitation_coefficients(0.0)[:, 0]
-    F = np.interp(omega, w, F.real) + 1j * np.interp(omega, w, F.imag)
-    m, K = plant.scene.bodies[0].mass, hyd.hydrostatic_stiffness()[0, 0]
-    Z = B + 1j * (omega * (m + A) - K / omega)
-    return Z, abs(F * amplitude) ** 2 / (8 * B)
+    Z, F = heave_impedance(plant, omega)
+    return Z, abs(F * amplitude) ** 2 / (8 * Z.real)
 
 
 def test_reactive_is_impedance_matching_and_reaches_the_bound(plant, wave):

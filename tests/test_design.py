@@ -26,6 +26,7 @@ from mbcontrol.controllers.margins import loop_margins
 from mbcontrol.controllers.reactive import intrinsic_impedance
 from mbcontrol.metrics import pto_metrics
 from mbcontrol.plant import build_plant
+from sphere_reference import heave_impedance
 
 H, T = 2.5, 9.6664     # m, s: the regular wave of the brief; the sphere's T_n is 4.36 s
 WAVE_ARGS = ["--wave", "regular", "--height", str(H), "--period", str(T)]
@@ -49,18 +50,6 @@ def passive(plant, wave):
 @pytest.fixture(scope="module")
 def reactive(plant, wave):
     return design(plant, wave, "reactive", limits=False)   # complex-conjugate control
-
-
-def heave_impedance(plant, omega):
-    """(Z_i, F per unit amplitude) of the heaving body from the hydro data, exp(+i w t)."""
-    hyd = plant.hydro
-    w = hyd.omega
-    A = np.interp(omega, w, hyd.added_mass()[:, 0, 0])
-    B = np.interp(omega, w, hyd.radiation_damping()[:, 0, 0])
-    F = hyd.excitation_coefficients(0.0)[:, 0]
-    F = np.interp(omega, w, F.real) + 1j * np.interp(omega, w, F.imag)
-    m, K = plant.scene.bodies[0].mass, hyd.hydrostatic_stiffness()[0, 0]
-    return B + 1j * (omega * (m + A) - K / omega), F
 
 
 # --- (a) design: linear theory, the nonlinear plant and the bound agree ---------------------
