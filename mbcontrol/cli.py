@@ -19,6 +19,7 @@ import sys
 import numpy as np
 
 from .errors import MbcontrolError
+from .integrators import METHODS
 from .results import jsonable
 
 
@@ -36,6 +37,23 @@ that re-runs that simulation (the parameters as --set KEY=VALUE).
 
 Example:
   mbcontrol design sphere --controller passive --wave regular --height 2.5 --period 9.6664
+"""
+
+
+BENCH_HELP = """Speed against accuracy for one model in one sea, measured on this machine.
+
+Runs every integration method over a ladder of steps (rk3, rk4, dopri5, exp-rk4: period/4
+down to period/256) or tolerances (cvodes, adams: rtol 1e-3..1e-7), and the radiation model
+at several fit tolerances (fewer states), and measures for each run:
+  error: max over joint coordinates of RMS(q - q_ref)/RMS(q_ref) after the ramp, q_ref a
+         converged dopri5 run (its own error is printed);
+  cost:  wall time of excitation synthesis + time-stepping (compilation excluded), one core.
+Writes work_precision.png, work_precision.csv and work_precision.nc to --out, prints the
+table, and names the cheapest setting within 1 % RMS. With --stability, adds each method's
+largest stable step (stability.csv).
+
+Example:
+  mbcontrol bench sphere --wave jonswap --hs 2.5 --tp 9.67 --duration 300
 """
 
 
@@ -75,8 +93,10 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--duration", type=float, default=None,
                    help="simulated time, s (default: 30 periods, or 600 s for irregular seas)")
     p.add_argument("--dt", type=float, default=0.01, help="time step, s (default 0.01)")
-    p.add_argument("--method", choices=("rk4", "cvodes"), default="rk4",
-                   help="rk4: compiled fixed step (default); cvodes: adaptive BDF")
+    p.add_argument("--method", choices=tuple(METHODS), default="rk4",
+                   help="\n".join(f"{m.name}: {m.description}" for m in METHODS.values()))
+    p.add_argument("--rtol", type=float, default=1e-8,
+                   help="relative tolerance of the adaptive methods (cvodes, adams)")
     p.add_argument("--controller", help="PTO controller by name (e.g. passive)")
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                    help="controller setting, repeatable (e.g. --set damping=2.0)")
@@ -109,6 +129,28 @@ def _parser() -> argparse.ArgumentParser:
                         "150 components; full: always both (slow for long seas); off: none")
     p.add_argument("--json", action="store_true", help="print the design as JSON")
     p.set_defaults(run=_design)
+
+    p = sub.add_parser("bench", help="speed against accuracy: work-precision chart and table of "
+                                     "every integration method and radiation order; stability "
+                                     "limits", description=BENCH_HELP,
+                       formatter_class=argparse.RawTextHelpFormatter)
+    _model_options(p)
+    _wave_options(p)
+    p.add_argument("--duration", type=float, default=None,
+                   help="record length, s (default: 600 s for a sea, 30 periods for a regular wave)")
+    p.add_argument("--methods", nargs="+", default=list(METHODS), choices=tuple(METHODS),
+                   metavar="METHOD", help=f"methods to chart (default: all of {', '.join(METHODS)})")
+    p.add_argument("--radiation-tols", nargs="*", type=float, default=[0.2, 0.1, 0.05, 0.02],
+                   metavar="TOL", help="radiation fit tolerances to chart (default 0.2 0.1 0.05 0.02;\n"
+                                       "new tolerances are fitted once and cached)")
+    p.add_argument("--stability", action="store_true",
+                   help="also find each method's largest stable step: linearised step map and\n"
+                        "simulated search, for the scene, a 5x tighter radiation fit, an end\n"
+                        "stop on the first PTO's joint and latching control")
+    p.add_argument("--repeats", type=int, default=3, help="timing repeats, best kept (3)")
+    p.add_argument("--out", default=None, help="folder for the PNG, CSV and netCDF "
+                                               "(default out/bench/MODEL)")
+    p.set_defaults(run=_bench)
 
     p = sub.add_parser("linearize", help="linearise about rest; poles, Bode plot")
     _model_options(p)
@@ -211,7 +253,8 @@ def _simulate(args) -> int:
     controller = _controller(args, wave)
     params = dict(_key_value(s, "--param") for s in args.param)
     ds = simulate(plant, wave, duration=duration, dt=args.dt, controller=controller,
-                  method=args.method, params=params or None, progress=not args.json)
+                  method=args.method, rtol=args.rtol, params=params or None,
+                  progress=not args.json)
     if args.out:
         from .results import save_dataset
         save_dataset(ds, args.out)
@@ -318,6 +361,20 @@ def _print_design(plant, wave, result, command) -> None:
               f"peak/mean power {m['papr']:.3g}, samples outside the limits "
               f"{100 * m['violation_fraction']:.3g} %")
     print(f"  re-run: {command}")
+
+
+def _bench(args) -> int:
+    from .bench_report import bench
+    plant = _plant(args)
+    duration = args.duration or (30 * args.period if args.wave == "regular" and args.period
+                                 else 600.0)
+    wave = _wave(args, plant, duration)
+    if wave is None:
+        raise ValueError("bench needs a wave: --wave regular|jonswap|pm")
+    bench(plant.scene, wave, duration=duration, methods=args.methods,
+          radiation_tols=args.radiation_tols, stability=args.stability,
+          repeats=args.repeats, out=args.out or f"out/bench/{plant.name}")
+    return 0
 
 
 def _linearize(args) -> int:

@@ -1,42 +1,235 @@
-"""Time-stepping of a ProcessPlant: compiled fixed-step RK4 and CVODES (BDF, adaptive).
+"""Time-stepping methods for a ProcessPlant, selectable by name (`METHODS`).
 
-RK4 takes the excitation at the start, middle and end of each step (sampled on a half-step
-grid), so a step is exact to O(h^4) for smooth excitation. Steps are chained by CasADi's
-mapaccum into chunks compiled to native code: a chunk of thousands of steps is one C call.
+Fixed-step methods run as compiled native code: steps are chained by CasADi's mapaccum into
+chunks of thousands of steps, one C call each, with no Python on the hot path.
+
+  rk4      classic Runge-Kutta, order 4 (the default)
+  rk3      Kutta's third-order method (a lower-order point for work-precision charts)
+  dopri5   Dormand-Prince 5th-order weights as a fixed-step method, 6 stages
+  exp-rk4  Lawson (integrating-factor) RK4: the linear radiation states are advanced
+           exactly, by exp(A_r tau) (a zero-order-hold-exact treatment of chi' = A_r chi),
+           the rigid-body part by RK4. Fast radiation poles then no longer limit the step.
+  cvodes   adaptive BDF with the exact Jacobian (implicit, for stiff cases); see simulate.py
+  adams    adaptive Adams-Moulton (CVODES, functional iteration: non-stiff, high order)
+
+The excitation is sampled at each method's stage times (`nodes`, fractions of the step), so a
+step sees w exactly where its stages need it; the phase of the sea is exact at every node.
 """
 from __future__ import annotations
 
 import hashlib
+from dataclasses import dataclass
 
 import casadi as ca
 import numpy as np
+import scipy.linalg
+from scipy.sparse.csgraph import connected_components
 
 from .compiled import compile_function
 
 CHUNK = 512         # steps per compiled call: long enough that Python overhead vanishes
 
 
-def rk4_step(plant, law=None) -> ca.Function:
-    """One RK4 step (x, u, w3, p, h) -> x_next; w3 = [w(t), w(t+h/2), w(t+h)] (n_w x 3).
+@dataclass(frozen=True)
+class Tableau:
+    """An explicit Runge-Kutta method: stage j evaluates f at x + h sum_i a[j][i] k_i and
+    t + c[j] h; the step is x + h sum_j b[j] k_j."""
+    a: tuple
+    b: tuple
+    c: tuple
 
-    With `law` (a CasADi Function y -> u), u is computed from the outputs at the start of the
-    step and held over it (zero-order hold at the step), replacing the u input.
+    @property
+    def nodes(self) -> tuple[float, ...]:
+        """Distinct stage times (fractions of the step) where the excitation is needed."""
+        return tuple(sorted(set(self.c) | {0.0}))
+
+
+RK4 = Tableau(a=((), (0.5,), (0.0, 0.5), (0.0, 0.0, 1.0)),
+              b=(1 / 6, 1 / 3, 1 / 3, 1 / 6), c=(0.0, 0.5, 0.5, 1.0))
+RK3 = Tableau(a=((), (0.5,), (-1.0, 2.0)), b=(1 / 6, 2 / 3, 1 / 6), c=(0.0, 0.5, 1.0))
+DOPRI5 = Tableau(
+    a=((), (1 / 5,), (3 / 40, 9 / 40), (44 / 45, -56 / 15, 32 / 9),
+       (19372 / 6561, -25360 / 2187, 64448 / 6561, -212 / 729),
+       (9017 / 3168, -355 / 33, 46732 / 5247, 49 / 176, -5103 / 18656)),
+    b=(35 / 384, 0.0, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84),
+    c=(0.0, 1 / 5, 3 / 10, 4 / 5, 8 / 9, 1.0))
+
+
+@dataclass(frozen=True)
+class Method:
+    name: str
+    order: int
+    kind: str                  # "explicit", "exponential" (fixed step) or "adaptive"
+    description: str
+    tableau: Tableau | None = None
+
+    @property
+    def fixed_step(self) -> bool:
+        return self.kind != "adaptive"
+
+    @property
+    def nodes(self) -> tuple[float, ...]:
+        return self.tableau.nodes if self.tableau else (0.0,)
+
+
+METHODS: dict[str, Method] = {m.name: m for m in (
+    Method("rk4", 4, "explicit", "classic Runge-Kutta, fixed step, compiled", RK4),
+    Method("rk3", 3, "explicit", "Kutta's third-order Runge-Kutta, fixed step, compiled", RK3),
+    Method("dopri5", 5, "explicit", "Dormand-Prince 5th-order weights, fixed step, compiled",
+           DOPRI5),
+    Method("exp-rk4", 4, "exponential", "Lawson RK4: radiation states exact (matrix "
+           "exponential), rigid bodies RK4; fixed step, compiled", RK4),
+    Method("cvodes", 5, "adaptive", "CVODES BDF (implicit, orders 1-5, exact Jacobian), "
+           "adaptive: the step follows rtol"),
+    Method("adams", 12, "adaptive", "CVODES Adams-Moulton (functional iteration, orders "
+           "1-12), adaptive: the step follows rtol"),
+)}
+
+
+def method(name: str) -> Method:
+    """The Method called `name`; ValueError listing the known ones otherwise."""
+    if name not in METHODS:
+        raise ValueError(f"unknown integration method {name!r}; expected one of "
+                         f"{', '.join(METHODS)}")
+    return METHODS[name]
+
+
+# --- the radiation split used by the exponential method -----------------------------------
+
+_SPLITS: dict = {}
+
+
+def radiation_split(plant):
+    """(first radiation state index, A_r, block sparsity of exp(A_r tau), block labels).
+
+    The plant's radiation states are the last n_r states with chi' = A_r chi + B_r nu_h; A_r
+    is in real modal form (1x1 and 2x2 blocks), so exp(A_r tau) has the same small blocks.
     """
-    nx, nu, nw, npar = plant.nx, len(plant.inputs), len(plant.disturbances), len(plant.p0)
-    x, u = ca.SX.sym("x", nx), ca.SX.sym("u", nu)
-    w3, p, h = ca.SX.sym("w3", nw, 3), ca.SX.sym("p", npar), ca.SX.sym("h")
-    if law is not None:
-        u_held = law(plant.h(x, ca.DM.zeros(nu), w3[:, 0], p))
-    else:
-        u_held = u
-    k1 = plant.f(x, u_held, w3[:, 0], p)
-    k2 = plant.f(x + h / 2 * k1, u_held, w3[:, 1], p)
-    k3 = plant.f(x + h / 2 * k2, u_held, w3[:, 1], p)
-    k4 = plant.f(x + h * k3, u_held, w3[:, 2], p)
-    x_next = x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
-    return ca.Function("rk4_step", [x, u, w3, p, h], [x_next, u_held],
-                       ["x", "u", "w3", "p", "h"], ["x_next", "u_applied"])
+    if id(plant) not in _SPLITS:
+        _SPLITS[id(plant)] = (_radiation_split(plant), plant)
+    return _SPLITS[id(plant)][0]
 
+
+def _radiation_split(plant):
+    A = plant.hydro.radiation_matrices()[0] if plant.hydro is not None else np.zeros((0, 0))
+    n_r = sum(1 for s in plant.states if s.startswith("radiation_"))
+    if A.shape[0] != n_r:
+        A = np.zeros((0, 0))
+    n, labels = connected_components(np.abs(A) + np.eye(A.shape[0]) > 0, directed=False) \
+        if A.size else (0, np.zeros(0, int))
+    pattern = labels[:, None] == labels[None, :]
+    rows, cols = np.nonzero(pattern.T)           # CasADi is column-major
+    sparsity = ca.Sparsity.triplet(A.shape[0], A.shape[0], cols.tolist(), rows.tolist())
+    return plant.nx - A.shape[0], A, sparsity, labels
+
+
+def radiation_exponential(A, labels, tau: float) -> np.ndarray:
+    """exp(A tau), block by block (exact zeros off the blocks); closed forms for the 1x1 and
+    2x2 blocks of a modal form (scipy's expm costs milliseconds per call, even on 2x2)."""
+    E = np.zeros_like(A)
+    for k in np.unique(labels):
+        idx = np.flatnonzero(labels == k)
+        block = A[np.ix_(idx, idx)] * tau
+        E[np.ix_(idx, idx)] = _expm_small(block)
+    return E
+
+
+def _expm_small(M: np.ndarray) -> np.ndarray:
+    if M.shape == (1, 1):
+        return np.exp(M)
+    if M.shape != (2, 2):
+        return scipy.linalg.expm(M)
+    # exp(M) = e^{m} (cosh(d) I + sinh(d)/d (M - m I)), m = tr/2, d^2 = det-free discriminant
+    m = 0.5 * (M[0, 0] + M[1, 1])
+    S = M - m * np.eye(2)
+    d = np.sqrt(complex(S[0, 0] ** 2 + S[0, 1] * S[1, 0]))
+    sinhc = np.sinh(d) / d if abs(d) > 1e-8 else 1.0 + d * d / 6
+    return (np.exp(m) * (np.cosh(d) * np.eye(2) + sinhc * S)).real
+
+
+# --- one step -------------------------------------------------------------------------------
+
+def _symbols(plant, n_nodes):
+    nx, nu, nw, npar = plant.nx, len(plant.inputs), len(plant.disturbances), len(plant.p0)
+    return (ca.SX.sym("x", nx), ca.SX.sym("u", nu), ca.SX.sym("W", nw, n_nodes),
+            ca.SX.sym("p", npar), ca.SX.sym("h"))
+
+
+def _held_input(plant, law, x, u, W, p):
+    """With `law` (a CasADi Function y -> u), u comes from the outputs at the start of the step
+    and is held over it (zero-order hold at the step); otherwise the u input is used."""
+    if law is None:
+        return u
+    return law(plant.h(x, ca.DM.zeros(len(plant.inputs)), W[:, 0], p))
+
+
+def step_function(plant, method_name: str = "rk4", law=None) -> ca.Function:
+    """One fixed step (x, u, W, p, h, *extras) -> (x_next, u_applied).
+
+    W (n_w x len(nodes)) is the excitation at t + c h for each node c of the method; extras
+    are the method's step-size-dependent matrices (`step_extras`), inputs so that compiled
+    code depends on the plant's structure, not on h.
+    """
+    m = method(method_name)
+    if not m.fixed_step:
+        raise ValueError(f"{method_name!r} is adaptive: it has no fixed step")
+    tab = m.tableau
+    x, u, W, p, h = _symbols(plant, len(tab.nodes))
+    u_held = _held_input(plant, law, x, u, W, p)
+    column = {c: i for i, c in enumerate(tab.nodes)}
+
+    def f(xs, c):
+        return plant.f(xs, u_held, W[:, column[c]], p)
+
+    if m.kind == "explicit":
+        k = []
+        for a_j, c_j in zip(tab.a, tab.c):
+            k.append(f(x + h * sum((a * ki for a, ki in zip(a_j, k) if a != 0), ca.SX(0)),
+                       c_j))
+        x_next = x + h * sum((b * kj for b, kj in zip(tab.b, k) if b != 0), ca.SX(0))
+        extras = []
+    else:                                    # Lawson RK4 on x' = L x + N(x), L = diag(0, A_r)
+        start, A, sparsity, _ = radiation_split(plant)
+        E_half, E_full = ca.SX.sym("E_half", sparsity), ca.SX.sym("E_full", sparsity)
+        extras = [E_half, E_full]
+
+        def E(M, v):                         # exp(L tau) v: identity on q and s
+            return ca.vertcat(v[:start], ca.mtimes(M, v[start:]))
+
+        lin = ca.DM(A)
+
+        def N(xs, c):
+            fx = f(xs, c)
+            return ca.vertcat(fx[:start], fx[start:] - ca.mtimes(lin, xs[start:]))
+
+        k1 = N(x, 0.0)
+        k2 = N(E(E_half, x + h / 2 * k1), 0.5)
+        k3 = N(E(E_half, x) + h / 2 * k2, 0.5)
+        k4 = N(E(E_full, x) + h * E(E_half, k3), 1.0)
+        x_next = E(E_full, x) + h / 6 * (E(E_full, k1) + 2 * E(E_half, k2 + k3) + k4)
+    return ca.Function(f"{m.name.replace('-', '_')}_step", [x, u, W, p, h, *extras],
+                       [x_next, u_held])
+
+
+def rk4_step(plant, law=None) -> ca.Function:
+    """One RK4 step (x, u, w3, p, h) -> (x_next, u_applied); w3 = w at t, t + h/2, t + h."""
+    return step_function(plant, "rk4", law)
+
+
+def step_extras(plant, method_name: str, dt: float) -> list[np.ndarray]:
+    """The numeric values of a method's extra step inputs at step dt (nonzeros, column-major)."""
+    if METHODS[method_name].kind != "exponential":
+        return []
+    _, A, sparsity, labels = radiation_split(plant)
+    out = []
+    for tau in (dt / 2, dt):
+        E = radiation_exponential(A, labels, tau)
+        rows, cols = sparsity.get_triplet()
+        out.append(np.ascontiguousarray(E[rows, cols]))   # nonzeros, column-major order
+    return out
+
+
+# --- chunks of steps, compiled --------------------------------------------------------------
 
 _CHUNKS: dict = {}
 
@@ -47,66 +240,110 @@ def chunk_length(n: int) -> int:
     return CHUNK if n >= CHUNK else 1 << max(0, int(n - 1).bit_length())
 
 
-def _chunk_function(plant, law, compiled: bool, length: int) -> ca.Function:
+def chunk_symbolic(plant, method_name, law, length: int) -> ca.Function:
+    """`length` steps as one Function (x, U, W, p, h, *extras) -> (X, U_applied), not compiled.
+
+    U (nu x length), W (nw x nodes*length), X (nx x length): step k's columns are k, or
+    k*nodes .. k*nodes + nodes - 1; p, h and extras are shared by all steps.
+    """
+    step = step_function(plant, method_name, law)
+    # mapaccum feeds x_next back as x; the other inputs are given per step (or broadcast)
+    steps = step.mapaccum("steps", length, [0], [0])
+    n_nodes = len(METHODS[method_name].nodes)
+    x, U = ca.MX.sym("x", plant.nx), ca.MX.sym("U", len(plant.inputs), length)
+    W = ca.MX.sym("W", len(plant.disturbances), n_nodes * length)
+    p, h = ca.MX.sym("p", len(plant.p0)), ca.MX.sym("h")
+    # repeated inside the function so that callers pass them once (the zero-copy buffer
+    # interface needs full inputs)
+    extras = [ca.MX.sym(f"e{i}", step.sparsity_in(5 + i)) for i in range(step.n_in() - 5)]
+    X, U_applied = steps(x, U, W, ca.repmat(p, 1, length), ca.repmat(h, 1, length),
+                         *[ca.repmat(e, 1, length) for e in extras])
+    return ca.Function("chunk", [x, U, W, p, h, *extras], [X, U_applied])
+
+
+def law_key(law):
+    """A law is keyed by its content: controllers rebuild it on reset, code need not
+    recompile."""
+    return None if law is None else hashlib.sha256(law.serialize().encode()).hexdigest()
+
+
+def _chunk_function(plant, method_name, law, compiled: bool, length: int) -> ca.Function:
     """The compiled chunk of `length` steps of a plant (and law), built once per process."""
-    # a law is keyed by its content: controllers rebuild it on reset, code need not recompile
-    law_key = None if law is None else hashlib.sha256(law.serialize().encode()).hexdigest()
-    key = (id(plant), law_key, compiled, length)
+    key = (id(plant), method_name, law_key(law), compiled, length)
     if key not in _CHUNKS:
-        step = rk4_step(plant, law)
-        # mapaccum feeds x_next back as x; the other inputs are given per step (or broadcast)
-        steps = step.mapaccum("rk4_steps", length, ["x"], ["x_next"])
-        # parameters and step size are shared by all steps: repeat them inside the function
-        # so that callers pass them once (the zero-copy buffer interface needs full inputs)
-        x, U = ca.MX.sym("x", plant.nx), ca.MX.sym("U", len(plant.inputs), length)
-        W = ca.MX.sym("W", len(plant.disturbances), 3 * length)
-        p, h = ca.MX.sym("p", len(plant.p0)), ca.MX.sym("h")
-        X, U_applied = steps(x, U, W, ca.repmat(p, 1, length), ca.repmat(h, 1, length))
-        chunk = ca.Function("rk4_chunk", [x, U, W, p, h], [X, U_applied])
+        chunk = chunk_symbolic(plant, method_name, law, length)
         # keep the plant alive so that its id stays unique while cached
         _CHUNKS[key] = (compile_function(chunk, enabled=compiled), plant)
     return _CHUNKS[key][0]
 
 
+def prepare(plant, n: int, method_name: str = "rk4", law=None, compiled=True) -> None:
+    """Build and compile what run_fixed_step will need for n steps (so timings exclude it)."""
+    _chunk_function(plant, method_name, law, compiled, chunk_length(n))
+
+
 def prepare_rk4(plant, n: int, law=None, compiled=True) -> None:
-    """Build and compile what run_rk4 will need for n steps (so timings exclude it)."""
-    _chunk_function(plant, law, compiled, chunk_length(n))
+    prepare(plant, n, "rk4", law, compiled)
 
 
-def run_rk4(plant, x0, U, W_half, p, dt, law=None, compiled=True, on_chunk=None):
+_COEFFICIENTS: dict = {}
+
+
+def excitation_at_nodes(plant, wave, n: int, dt: float, nodes) -> np.ndarray:
+    """Excitation (n, len(nodes), n_w) at t_i + c dt for every step i and node c."""
+    from .waves import excitation_at_offsets
+    nw = len(plant.disturbances)
+    if wave is None or nw == 0:
+        return np.zeros((n, len(nodes), nw))
+    key = (id(plant), wave.direction)
+    if key not in _COEFFICIENTS:         # the data's coefficients: selected once per plant
+        _COEFFICIENTS[key] = (plant.hydro.excitation_coefficients(wave.direction), plant)
+    try:
+        return excitation_at_offsets(wave, plant.hydro.omega, _COEFFICIENTS[key][0], n, dt,
+                                     nodes)
+    except ValueError as exc:
+        from .errors import HydroError
+        raise HydroError(f"{plant.hydro.source}: {exc}") from None
+
+
+def run_fixed_step(plant, x0, U, W_nodes, p, dt, method_name="rk4", law=None, compiled=True,
+                   on_chunk=None):
     """Integrate n steps; returns states (n+1, nx) and the inputs actually applied (n, nu).
 
-    U: (n, nu) inputs held over each step (ignored with a law); W_half: (2n+1, nw) excitation
-    on the half-step grid. `on_chunk(i_end, X)` is called after each chunk (progress, checks)
-    and may raise to stop.
+    U: (n, nu) inputs held over each step (ignored with a law); W_nodes: (n, n_nodes, nw)
+    excitation at the method's nodes. `on_chunk(i_end, X)` is called after each chunk
+    (progress, checks) and may raise to stop.
     """
     n, nu, nx = U.shape[0], len(plant.inputs), plant.nx
     length = chunk_length(n)
-    chunk = _chunk_function(plant, law, compiled, length)
-    # CasADi matrices are column-major, so a C-ordered (steps, ...) block is exactly the
-    # (..., steps) matrix a mapaccum input or output expects: no copies on the hot path.
-    W3 = np.ascontiguousarray(np.stack([W_half[0:-1:2], W_half[1::2], W_half[2::2]], axis=1))
+    chunk = _chunk_function(plant, method_name, law, compiled, length)
+    # CasADi matrices are column-major, so a C-ordered (steps, nodes, nw) block is exactly the
+    # (nw, nodes * steps) matrix the chunk expects: no copies on the hot path.
+    W_nodes = np.ascontiguousarray(W_nodes, dtype=float)
     U = np.ascontiguousarray(U, dtype=float)
     X = np.empty((n + 1, nx))
     U_applied = np.empty((n, nu))
     X[0] = x0
     p = np.ascontiguousarray(p, dtype=float)
     h = np.array([dt], dtype=float)
+    extras = step_extras(plant, method_name, dt)
     buffer, _ = chunk.buffer()
     buffer.set_arg(3, memoryview(p))
     buffer.set_arg(4, memoryview(h))
+    for i, e in enumerate(extras):
+        buffer.set_arg(5 + i, memoryview(e))
     for start in range(0, n, length):
         stop = min(start + length, n)
         if stop - start == length:
-            x_in, U_c, W_c = X[start], U[start:stop], W3[start:stop]
+            x_in, U_c, W_c = X[start], U[start:stop], W_nodes[start:stop]
             X_out, U_out = X[start + 1:stop + 1], U_applied[start:stop]
         else:                               # a short last chunk: pad, then copy back
             m = stop - start
             x_in = X[start].copy()
             U_c = np.zeros((length, nu))
             U_c[:m] = U[start:stop]
-            W_c = np.zeros((length,) + W3.shape[1:])
-            W_c[:m] = W3[start:stop]
+            W_c = np.zeros((length,) + W_nodes.shape[1:])
+            W_c[:m] = W_nodes[start:stop]
             X_out, U_out = np.empty((length, nx)), np.empty((length, nu))
         x_in = np.ascontiguousarray(x_in)
         buffer.set_arg(0, memoryview(x_in))
@@ -120,6 +357,12 @@ def run_rk4(plant, x0, U, W_half, p, dt, law=None, compiled=True, on_chunk=None)
         if on_chunk is not None:
             on_chunk(stop, X[:stop + 1])
     return X, U_applied
+
+
+def run_rk4(plant, x0, U, W_half, p, dt, law=None, compiled=True, on_chunk=None):
+    """RK4 with the excitation on the half-step grid W_half (2n+1, nw) (kept for callers)."""
+    W3 = np.stack([W_half[0:-1:2], W_half[1::2], W_half[2::2]], axis=1)
+    return run_fixed_step(plant, x0, U, W3, p, dt, "rk4", law, compiled, on_chunk)
 
 
 _OUTPUT_MAPS: dict = {}
@@ -158,23 +401,27 @@ def outputs(plant, X, U, W, p, compiled=True) -> np.ndarray:
     return Y
 
 
-def cvodes_integrator(plant, wave_terms, t_grid, rtol=1e-8, atol=1e-10) -> ca.Function:
+def cvodes_integrator(plant, wave_terms, t_grid, rtol=1e-8, atol=1e-10,
+                      lmm: str = "bdf") -> ca.Function:
     """CVODES over t_grid with the excitation an explicit function of time.
 
     wave_terms = (omega (m,), Fc (nw, m), Fs (nw, m), ramp_time): w(t) = ramp(t) *
-    (Fc cos(omega t) + Fs sin(omega t)); parameters of the integrator: [u; p].
+    (Fc cos(omega t) + Fs sin(omega t)); parameters of the integrator: [u; p]. lmm "bdf"
+    (Newton iteration with the exact Jacobian) or "adams" (functional iteration).
     """
     omega, Fc, Fs, ramp_time = wave_terms
-    nu, npar = len(plant.inputs), len(plant.p0)
+    nu = len(plant.inputs)
     x, t = ca.SX.sym("x", plant.nx), ca.SX.sym("t")
-    up = ca.SX.sym("up", nu + npar)
+    up = ca.SX.sym("up", nu + len(plant.p0))
     w = ca.mtimes(ca.DM(Fc), ca.cos(ca.DM(omega) * t)) + ca.mtimes(ca.DM(Fs),
                                                                   ca.sin(ca.DM(omega) * t))
     if ramp_time > 0:
         w *= ca.if_else(t < ramp_time, 0.5 * (1 - ca.cos(np.pi * t / ramp_time)), 1.0)
     ode = plant.f(x, up[:nu], w, up[nu:])
     dae = {"x": x, "t": t, "p": up, "ode": ode}
-    opts = {"reltol": rtol, "abstol": atol, "max_num_steps": 200000}
+    opts = {"reltol": rtol, "abstol": atol, "max_num_steps": 200000,
+            "linear_multistep_method": lmm,
+            "nonlinear_solver_iteration": "newton" if lmm == "bdf" else "functional"}
     return ca.integrator("cvodes", "cvodes", dae, float(t_grid[0]), list(t_grid[1:]), opts)
 
 

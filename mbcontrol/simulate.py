@@ -1,8 +1,13 @@
 """Open- and closed-loop simulation of a ProcessPlant, results as an xarray.Dataset.
 
-Methods: "rk4" (compiled fixed step, the default) and "cvodes" (adaptive BDF with the
-excitation an explicit function of time). A controller is sampled with a zero-order hold at
+Methods (mbcontrol.integrators.METHODS): fixed-step "rk4" (the default), "rk3", "dopri5" and
+"exp-rk4" run as compiled native code; "cvodes" (BDF) and "adams" are adaptive, with the
+excitation an explicit function of time. A controller is sampled with a zero-order hold at
 its period; a controller that offers a CasADi law with period dt runs inside compiled code.
+
+Every run is audited before its result is returned: a non-finite or absurd state (checked
+during the run, chunk by chunk) or a mechanical energy beyond what the waves and PTOs put in
+raises SimulationError naming the time, the step and a remedy.
 """
 from __future__ import annotations
 
@@ -21,55 +26,119 @@ from .errors import SimulationError
 
 def simulate(plant, wave=None, *, duration: float, dt: float = 0.01, controller=None,
              method: str = "rk4", x0=None, params=None, compiled: bool = True,
-             rtol: float = 1e-8, progress: bool = False) -> xr.Dataset:
+             rtol: float = 1e-8, progress: bool = False, audit: bool = True) -> xr.Dataset:
     """Simulate `plant` in `wave` (None: still water) for `duration` s with step `dt` s.
 
-    params: a dict of parameter overrides or a full vector. With a controller, the PTO force
-    is the controller's command alone: the scene's PTO damping and stiffness are zeroed
-    unless params sets them. Returns a Dataset over time with every plant output, the
-    applied inputs u, the excitation w, the wave elevation `eta` and the states, plus
-    provenance in attrs (wall_time_s is the time-stepping alone).
+    method: a name in mbcontrol.integrators.METHODS. For fixed-step methods dt is the step;
+    for the adaptive ones ("cvodes", "adams") dt is the output (and controller) grid and
+    rtol sets the accuracy. params: a dict of parameter overrides or a full vector. With a
+    controller, the PTO force is the controller's command alone: the scene's PTO damping and
+    stiffness are zeroed unless params sets them. audit: check the energy balance (see
+    `energy_audit`). Returns a Dataset over time with every plant output, the applied
+    inputs u, the excitation w, the wave elevation `eta` and the states, plus provenance in
+    attrs: wall_time_s is the excitation synthesis and the time-stepping (compilation and
+    the output evaluation excluded; output_time_s is the latter).
     """
     if duration <= 0 or dt <= 0 or dt > duration:
         raise ValueError(f"expected 0 < dt <= duration, got dt={dt}, duration={duration}")
+    spec = integrators.method(method)
     n = int(round(duration / dt))
     t = np.arange(n + 1) * dt
     p = _parameters(plant, params, controller)
     x0 = plant.x0() if x0 is None else np.asarray(x0, float)
-    W_half = plant.excitation(wave, np.arange(2 * n + 1) * dt / 2) if wave is not None \
-        else np.zeros((2 * n + 1, len(plant.disturbances)))
     if controller is not None:
         controller.reset(plant)
-    if method == "rk4":
+    if spec.kind == "explicit":
         _warn_stiff(plant, dt)
     bar = _progress_bar(progress, n)
-    check = _divergence_check(plant, dt, bar)
+    check = _divergence_check(plant, dt, method, bar)
 
     # a controller with a CasADi law held for one step runs inside the compiled code
-    law = controller.casadi_law(plant) if controller is not None and method == "rk4" else None
+    law = controller.casadi_law(plant) if controller is not None and spec.fixed_step else None
     embedded = controller is None or (law is not None and _period(controller, dt) == dt)
-    if method == "rk4":                  # compile first: wall_time_s is the stepping alone
+    if spec.fixed_step:                  # compile first: wall_time_s excludes it
         steps = n if embedded else _steps_per_period(_period(controller, dt), dt)
-        integrators.prepare_rk4(plant, steps, law if embedded else None, compiled)
+        integrators.prepare(plant, steps, method, law if embedded else None, compiled)
     start = time.perf_counter()
-    if method == "rk4":
-        X, U = _run_rk4(plant, controller, law if embedded else None, embedded, x0, W_half, p,
-                        dt, n, compiled, check)
-    elif method == "cvodes":
-        X, U = _run_cvodes(plant, wave, controller, x0, p, dt, n, rtol, check)
+    if spec.fixed_step:
+        W_nodes = integrators.excitation_at_nodes(plant, wave, n, dt, spec.nodes)
+        X, U = _run_fixed(plant, method, controller, law if embedded else None, embedded, x0,
+                          W_nodes, p, dt, n, compiled, check)
     else:
-        raise ValueError(f"unknown method {method!r}; expected 'rk4' or 'cvodes'")
+        X, U = _run_cvodes(plant, wave, controller, x0, p, dt, n, rtol, check, method)
     wall = time.perf_counter() - start
     if bar is not None:
         bar.close()
 
-    W = W_half[::2]
+    start = time.perf_counter()
+    W = plant.excitation(wave, t) if wave is not None \
+        else np.zeros((n + 1, len(plant.disturbances)))
     U_full = np.vstack([U, _last_command(plant, controller, t[-1], X[-1], U, W[-1], p)])
     Y = integrators.outputs(plant, X, U_full, W, p, compiled=compiled)
+    output_wall = time.perf_counter() - start
+    if audit:
+        energy_audit(plant, t, Y, method, dt)
     eta = wave.elevation(t) if wave is not None else np.zeros_like(t)
     ds = _dataset(plant, t, X, U_full, W, Y, eta, wave, controller, method, dt, p, wall)
+    ds.attrs["output_time_s"] = output_wall
+    if not spec.fixed_step:
+        ds.attrs["rtol"] = rtol
     ds.attrs["moorings"] = json.dumps(mooring_report(plant, ds))
     return ds
+
+
+ENERGY_MARGIN = 2.0     # a run may not end up with more than twice the energy put in
+
+
+def energy_budget(plant, t, Y):
+    """(E - E_0, W_in) per sample (J): the mechanical energy gained, and the work the waves and
+    the PTOs put in, W_in = int (P_exc + sum max(0, -P_pto)) dt (trapezoid).
+
+    Radiation (passive, starting at rest), friction, drag and mooring damping only remove
+    energy, so a faithful solution has E - E_0 <= W_in (up to its integration error).
+    None when the plant has a catenary mooring (its energy is not in the plant's audit).
+    """
+    col = {name: i for i, name in enumerate(plant.outputs)}
+    if "energy" not in col or any(m.kind == "catenary" for m in plant.scene.moorings):
+        return None        # a catenary's elastic and gravity energy is not in the audit
+    power_in = Y[:, col["excitation_power"]].copy()
+    for pto in plant.scene.ptos:
+        power_in += np.maximum(0.0, -Y[:, col[f"{pto.name}__power"]])
+    work = np.concatenate([[0.0], np.cumsum(0.5 * (power_in[1:] + power_in[:-1])
+                                             * np.diff(t))])
+    return Y[:, col["energy"]] - Y[0, col["energy"]], work
+
+
+def energy_audit(plant, t, Y, method: str, dt: float) -> None:
+    """Raise SimulationError at the first sample whose energy gain exceeds ENERGY_MARGIN times
+    the work put in so far (plus a floor: 5 % of the record's input, half the initial energy), or whose outputs are not finite: the signature of an unstable step, not physics."""
+    bad = np.flatnonzero(~np.isfinite(Y).all(axis=1))
+    budget = energy_budget(plant, t, Y)
+    if budget is not None:
+        gain, work = budget
+        energy0 = abs(Y[0, plant.outputs.index("energy")])
+        work_so_far = np.maximum.accumulate(np.maximum(work, 0.0))
+        # the floor forgives what a faithful solution shows: kinematic O(q^3) mismatches
+        # between loads and potentials early in the ramp (0.1 % of the record's work on
+        # wavestar), a mooring table extrapolated beyond its envelope (not quite
+        # conservative), integration error on a free decay. An unstable step grows energy
+        # geometrically, by orders of magnitude, and outgrows the floor within a few steps.
+        allowed = ENERGY_MARGIN * work_so_far + 0.05 * work_so_far[-1] + 0.5 * energy0 \
+            + 1e-12
+        with np.errstate(invalid="ignore"):
+            bad = np.union1d(bad, np.flatnonzero(gain > allowed))
+    if bad.size == 0:
+        return
+    i = int(bad[0])
+    detail = "non-finite outputs" if not np.isfinite(Y[i]).all() else (
+        f"mechanical energy grew by {gain[i]:.4g} J while the waves and PTOs had put in "
+        f"{work[i]:.4g} J")
+    raise SimulationError(
+        f"{plant.name}: simulation diverged at t = {t[i]:.4g} s (step {i}, dt = {dt} s, "
+        f"method {method!r}): {detail}. Remedy: a smaller dt (try {dt / 4:g} s), "
+        f"method='exp-rk4' when fast radiation poles limit the step, method='cvodes' for "
+        f"stiff loads (end stops, friction, latching), or `mbcontrol bench {plant.name} "
+        f"--stability` for each method's largest stable step")
 
 
 def mooring_report(plant, ds) -> dict:
@@ -139,27 +208,28 @@ def _parameters(plant, params, controller) -> np.ndarray:
     return plant.params(**overrides)
 
 
-def _run_rk4(plant, controller, law, embedded, x0, W_half, p, dt, n, compiled, check):
+def _run_fixed(plant, method, controller, law, embedded, x0, W_nodes, p, dt, n, compiled,
+               check):
     nu = len(plant.inputs)
     if embedded:
-        return integrators.run_rk4(plant, x0, np.zeros((n, nu)), W_half, p, dt, law=law,
-                                   compiled=compiled, on_chunk=check)
+        return integrators.run_fixed_step(plant, x0, np.zeros((n, nu)), W_nodes, p, dt, method,
+                                          law=law, compiled=compiled, on_chunk=check)
     m = _steps_per_period(_period(controller, dt), dt)
     X, U = np.empty((n + 1, plant.nx)), np.empty((n, nu))
     X[0], u_prev = x0, np.zeros(nu)
     for i in range(0, n, m):
         k = min(m, n - i)
-        y = np.asarray(plant.h(X[i], u_prev, W_half[2 * i], p)).ravel()
+        y = np.asarray(plant.h(X[i], u_prev, W_nodes[i, 0], p)).ravel()
         u_prev = _command(controller, i * dt, y, X[i], nu)
         U[i:i + k] = u_prev
-        Xk, _ = integrators.run_rk4(plant, X[i], U[i:i + k], W_half[2 * i:2 * (i + k) + 1], p,
-                                    dt, compiled=compiled)
+        Xk, _ = integrators.run_fixed_step(plant, X[i], U[i:i + k], W_nodes[i:i + k], p, dt,
+                                           method, compiled=compiled)
         X[i + 1:i + k + 1] = Xk[1:]
         check(i + k, X[:i + k + 1])
     return X, U
 
 
-def _run_cvodes(plant, wave, controller, x0, p, dt, n, rtol, check):
+def _run_cvodes(plant, wave, controller, x0, p, dt, n, rtol, check, method="cvodes"):
     nu = len(plant.inputs)
     terms = integrators.wave_terms(plant, wave) if wave is not None and plant.disturbances \
         else (np.zeros(0), np.zeros((len(plant.disturbances), 0)),
@@ -175,11 +245,13 @@ def _run_cvodes(plant, wave, controller, x0, p, dt, n, rtol, check):
             u_prev = _command(controller, i * dt, y, X[i], nu)
         U[i:i + k] = u_prev
         grid = (i + np.arange(k + 1)) * dt
-        integrator = integrators.cvodes_integrator(plant, terms, grid, rtol=rtol, atol=rtol * 1e-3)
+        integrator = integrators.cvodes_integrator(plant, terms, grid, rtol=rtol,
+                                                   atol=rtol * 1e-3,
+                                                   lmm="adams" if method == "adams" else "bdf")
         try:
             out = integrator(x0=X[i], p=np.concatenate([u_prev, p]))
         except RuntimeError as exc:
-            raise SimulationError(f"CVODES failed between t = {grid[0]:.4g} s and "
+            raise SimulationError(f"{plant.name}: CVODES ({method}) failed between t = {grid[0]:.4g} s and "
                                   f"{grid[-1]:.4g} s: {str(exc)[:200]}; remedy: loosen rtol or "
                                   f"check the model for stiffness or bad parameters") from None
         X[i + 1:i + k + 1] = np.asarray(out["xf"]).T
@@ -224,7 +296,7 @@ def _euler_pitch_states(plant) -> dict:
             if j.type == "free" and len(j.dofs) == 6}
 
 
-def _divergence_check(plant, dt, bar):
+def _divergence_check(plant, dt, method, bar):
     """Stop with a clear SimulationError on the first non-finite or absurd state, or when a free
     body's Euler pitch nears ±90°, where its kinematics q' = K(q) s are singular."""
     pitch, checked = _euler_pitch_states(plant), [0]
@@ -250,10 +322,12 @@ def _divergence_check(plant, dt, bar):
         worst = plant.states[int(np.nanargmax(np.where(np.isfinite(X[i]), np.abs(X[i]),
                                                        np.inf)))]
         raise SimulationError(
-            f"{plant.name}: simulation diverged at t = {i * dt:.4g} s (step {i}, dt = {dt} s); "
-            f"state {worst!r} became non-finite or exceeded 1e8. Remedy: a smaller dt "
-            f"(try {dt / 4:g} s), method='cvodes', or check stiff loads (friction "
-            f"velocity_scale, mooring stiffness)")
+            f"{plant.name}: simulation diverged at t = {i * dt:.4g} s (step {i}, dt = {dt} s, "
+            f"method {method!r}); state {worst!r} became non-finite or exceeded 1e8. Remedy: a "
+            f"smaller dt (try {dt / 4:g} s), method='exp-rk4' when fast radiation poles limit "
+            f"the step, method='cvodes' for stiff loads (end stops, friction velocity_scale, "
+            f"mooring stiffness), or `mbcontrol bench {plant.name} --stability` for each "
+            f"method's largest stable step")
     return check
 
 

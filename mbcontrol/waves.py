@@ -199,6 +199,47 @@ def excitation_series(wave: Wave, omega_data, force_data, t) -> np.ndarray:
     return ramp(t, wave.ramp_time)[:, None] * series
 
 
+def excitation_at_offsets(wave: Wave, omega_data, force_data, n: int, dt: float,
+                          offsets) -> np.ndarray:
+    """Excitation (n, len(offsets), n_dof) at t = (i + c) dt, i < n, for each offset c.
+
+    The integrators' stage times: one interpolation of the coefficients, then an FFT per
+    offset (a phase shift of the weights), so a 600 s record costs milliseconds.
+    """
+    coeffs = interpolate_complex(np.asarray(omega_data, float), np.asarray(force_data),
+                                 wave.omega)
+    weights = (wave.amplitude * np.exp(-1j * wave.phase))[:, None] * coeffs
+    out = np.empty((n, len(offsets), weights.shape[1]))
+    for j, c in enumerate(offsets):
+        t = (np.arange(n) + c) * dt
+        series = _synthesise_uniform(wave, weights, n, dt, c * dt)
+        if series is None:
+            series = _synthesise(wave, weights, t)
+        out[:, j] = ramp(t, wave.ramp_time)[:, None] * series
+    return out
+
+
+def _synthesise_uniform(wave: Wave, weights, n: int, step: float, t0: float = 0.0):
+    """The sum at t0 + k step, k < n, by FFT; None when the wave is not on a grid the FFT
+    can use (then the caller sums directly)."""
+    if wave.d_omega is None or n < 2:
+        return None
+    if t0 != 0.0:            # shift the phases to the grid's first time
+        weights = weights * np.exp(-1j * wave.omega * t0)[:, None]
+    n_fft = int(round(2 * np.pi / (wave.d_omega * step)))
+    if abs(n_fft * wave.d_omega * step - 2 * np.pi) > 1e-9:
+        return None
+    k = np.rint(wave.omega / wave.d_omega).astype(int)
+    if k.max() >= n_fft // 2:
+        return None
+    spectrum = np.zeros((n_fft, weights.shape[1]), dtype=complex)
+    spectrum[k] = weights
+    # numpy's fft sums x_k exp(-2 pi i k n / N) = exp(-i omega_k t_n): our convention
+    period = np.fft.fft(spectrum, axis=0).real
+    # the sum is exactly periodic in n_fft samples: longer records wrap around
+    return period[np.arange(n) % n_fft]
+
+
 def interpolate_complex(omega_data, values, omega) -> np.ndarray:
     """Linear interpolation of complex values (n_omega_data, ...) to omega; no extrapolation."""
     lo, hi = omega_data[0], omega_data[-1]
@@ -218,18 +259,10 @@ def interpolate_complex(omega_data, values, omega) -> np.ndarray:
 def _synthesise(wave: Wave, weights, t) -> np.ndarray:
     """Re sum_i weights_i exp(-i omega_i t) at times t: FFT on a uniform grid when possible."""
     uniform_t = t.size > 2 and np.allclose(np.diff(t), t[1] - t[0], rtol=1e-9, atol=1e-12)
-    if wave.d_omega is not None and uniform_t and t[0] == 0.0:
-        step = t[1] - t[0]
-        n_fft = int(round(2 * np.pi / (wave.d_omega * step)))
-        if abs(n_fft * wave.d_omega * step - 2 * np.pi) < 1e-9:
-            k = np.rint(wave.omega / wave.d_omega).astype(int)
-            if k.max() < n_fft // 2:
-                spectrum = np.zeros((n_fft, weights.shape[1]), dtype=complex)
-                spectrum[k] = weights
-                # numpy's fft sums x_k exp(-2 pi i k n / N) = exp(-i omega_k t_n): our convention
-                period = np.fft.fft(spectrum, axis=0).real
-                # the sum is exactly periodic in n_fft samples: longer records wrap around
-                return period[np.arange(t.size) % n_fft]
+    if uniform_t:
+        fast = _synthesise_uniform(wave, weights, t.size, t[1] - t[0], t[0])
+        if fast is not None:
+            return fast
     out = np.zeros((t.size, weights.shape[1]))
     for start in range(0, t.size, 4096):        # bounded memory for long records
         block = t[start:start + 4096]
