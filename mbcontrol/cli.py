@@ -9,6 +9,8 @@ Examples:
   mbcontrol linearize hinged_barge --bode bode.png --json
   mbcontrol design sphere --controller reactive --wave regular --height 2.5 --period 9.6664
   mbcontrol design sphere --controller passive --wave jonswap --hs 2.5 --tp 8 --json
+  mbcontrol bench rm3 --wave jonswap --hs 2.5 --tp 8 --stability
+  mbcontrol fidelity sphere --wave jonswap --hs 2.5 --tp 9.67 --tol 0.01
 """
 from __future__ import annotations
 
@@ -151,6 +153,19 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--out", default=None, help="folder for the PNG, CSV and netCDF "
                                                "(default out/bench/MODEL)")
     p.set_defaults(run=_bench)
+
+    p = sub.add_parser("fidelity", help="the cheapest model that meets an error tolerance in a sea "
+                                        "(fidelity='auto'): what it dropped and what that cost",
+                       formatter_class=argparse.RawTextHelpFormatter)
+    _model_options(p)
+    _wave_options(p)
+    p.add_argument("--tol", type=float, default=0.01,
+                   help="largest relative RMS error against the full model, over body motions\n"
+                        "and PTO velocity and power (default 0.01)")
+    p.add_argument("--duration", type=float, default=None,
+                   help="comparison record, s (default: the ramp plus 40 peak periods)")
+    p.add_argument("--out", help="write the candidate table to this netCDF file")
+    p.set_defaults(run=_fidelity)
 
     p = sub.add_parser("linearize", help="linearise about rest; poles, Bode plot")
     _model_options(p)
@@ -374,6 +389,21 @@ def _bench(args) -> int:
     bench(plant.scene, wave, duration=duration, methods=args.methods,
           radiation_tols=args.radiation_tols, stability=args.stability,
           repeats=args.repeats, out=args.out or f"out/bench/{plant.name}")
+    return 0
+
+
+def _fidelity(args) -> int:
+    from .fidelity import auto
+    plant = _plant(args)
+    duration = args.duration
+    wave = _wave(args, plant, duration or 600.0)
+    if wave is None:
+        raise ValueError("fidelity needs a wave: --wave regular|jonswap|pm")
+    report = auto(plant.scene, wave, tol=args.tol, duration=duration, progress=True)
+    print(report)
+    if args.out:
+        from .results import save_dataset
+        save_dataset(report.to_dataset(), args.out)
     return 0
 
 
