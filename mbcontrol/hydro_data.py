@@ -139,6 +139,12 @@ class HydroModel:
 def load_hydro_model(scene: Scene, dofs, tol: float | None = None) -> HydroModel:
     """Body-frame data for `dofs` (from scene.hydro.file, or a cached BEM run) and its fit."""
     tol = scene.hydro.radiation_tol if tol is None else tol
+    source, data = load_hydro_data(scene, dofs)
+    return fit_hydro_model(data, dofs, tol, source, scene.hydro.fit_omega_max)
+
+
+def load_hydro_data(scene: Scene, dofs) -> tuple[str, xr.Dataset]:
+    """(source, body-frame BEM dataset) holding at least `dofs`, without a radiation fit."""
     # a precomputed file wins; a scene that also gives BEM frequencies falls back to a (cached)
     # BEM run when the file is absent, e.g. for a parameter value nobody precomputed
     if scene.hydro.file and (Path(scene.hydro.file).exists() or not scene.hydro.omega):
@@ -147,8 +153,19 @@ def load_hydro_model(scene: Scene, dofs, tol: float | None = None) -> HydroModel
     else:
         source, data = _run_bem(scene, dofs)
     _check_dofs(data, dofs, source)
-    fit = _fit_cached(data, tuple(dofs), tol, source, scene.hydro.fit_omega_max)
-    return HydroModel(tuple(dofs), data, fit, source, scene.hydro.fit_omega_max)
+    return source, data
+
+
+def fit_hydro_model(data: xr.Dataset, dofs, tol: float | None, source: str,
+                    fit_omega_max: float = np.inf) -> HydroModel:
+    """A HydroModel of `data` on `dofs`, its radiation fitted to `tol` (cached on disk).
+
+    For callers that change the data first (e.g. mbcontrol.fidelity drops the coupling between
+    bodies): the cache key is the data itself, so a changed dataset never serves an old fit.
+    """
+    _check_dofs(data, dofs, source)
+    fit = _fit_cached(data, tuple(dofs), tol, source, fit_omega_max)
+    return HydroModel(tuple(dofs), data, fit, source, fit_omega_max)
 
 
 def _run_bem(scene: Scene, dofs):

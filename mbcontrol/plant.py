@@ -77,14 +77,26 @@ class ProcessPlant:
 
 
 def build_plant(scene: Scene | str, hydro: HydroModel | None = None, *,
-                radiation_tol: float | None = None, radiation: bool = True) -> ProcessPlant:
+                radiation_tol: float | None = None, radiation: bool = True,
+                fidelity=None) -> ProcessPlant:
     """Assemble the process plant of a scene (a Scene, a scene file or a catalogue name).
 
     Hydrodynamics come from `hydro` or the scene's hydro.file; the radiation model is fitted
     to `radiation_tol` (default: the scene's) on the DOFs the joints can move. With
     radiation=False the plant has no radiation states: w is then the whole wave load on the
     hydro DOFs (excitation minus radiation memory), as a direct-convolution reference needs.
+    fidelity: a mbcontrol.fidelity.Fidelity (simplified models, e.g. auto(...).fidelity);
+    freeze="auto" needs the waves: use mbcontrol.fidelity.plant_for for it.
     """
+    if fidelity is not None:
+        from .fidelity import Fidelity, FidelityError, plant_for
+        if radiation_tol is not None or not radiation:
+            raise FidelityError("build_plant: give the radiation tolerance as "
+                                "Fidelity.radiation_tol, and radiation=False without a fidelity")
+        if not isinstance(fidelity, Fidelity):
+            raise FidelityError(f"build_plant: fidelity: expected a mbcontrol.fidelity.Fidelity, "
+                                f"got {type(fidelity).__name__}")
+        return plant_for(scene, fidelity, hydro=hydro)
     scene = load_scene(scene) if not isinstance(scene, Scene) else scene
     topo = build_topology(scene)
     tree = topo.tree
