@@ -127,3 +127,11 @@ def test_simulate_issue4_models(capsys, model, scene_param, sea):
         model, 1 if scene_param == "N=2" else 3)
     for pto in result["ptos"].values():
         assert pto["mean_power_W"] > 0 and pto["max_stroke"] > 0
+
+
+def test_fidelity_command_reports_the_choice(capsys, tmp_path):
+    code, out, _ = run(capsys, "fidelity", "sphere", "--wave", "jonswap", "--hs", "2.5",
+                       "--tp", "9.67", "--tol", "0.01", "--duration", "120",
+                       "--out", str(tmp_path / "fidelity.nc"))
+    assert code == 0 and "fidelity for sphere" in out and "chosen" in out
+    assert (tmp_path / "fidelity.nc").stat().st_size > 0
