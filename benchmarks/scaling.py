@@ -22,7 +22,7 @@ import numpy as np
 
 from mbcontrol import waves
 from mbcontrol.hydro_data import load_hydro_model
-from mbcontrol.integrators import prepare_rk4
+from mbcontrol.integrators import prepare
 from mbcontrol.plant import active_hydro_dofs, build_plant
 from mbcontrol.scene import load_scene
 from mbcontrol.simulate import simulate
@@ -45,7 +45,7 @@ def measure(n: int, repeats: int = 3) -> dict:
         os.environ["MBCONTROL_CACHE"] = fresh
         try:
             t0 = time.perf_counter()
-            prepare_rk4(plant, steps)
+            prepare(plant, steps, "rk4")
             t_compile = time.perf_counter() - t0
         finally:
             if previous is None:

@@ -282,10 +282,6 @@ def prepare(plant, n: int, method_name: str = "rk4", law=None, compiled=True) ->
     _chunk_function(plant, method_name, law, compiled, chunk_length(n))
 
 
-def prepare_rk4(plant, n: int, law=None, compiled=True) -> None:
-    prepare(plant, n, "rk4", law, compiled)
-
-
 _COEFFICIENTS: dict = {}
 
 
@@ -357,12 +353,6 @@ def run_fixed_step(plant, x0, U, W_nodes, p, dt, method_name="rk4", law=None, co
         if on_chunk is not None:
             on_chunk(stop, X[:stop + 1])
     return X, U_applied
-
-
-def run_rk4(plant, x0, U, W_half, p, dt, law=None, compiled=True, on_chunk=None):
-    """RK4 with the excitation on the half-step grid W_half (2n+1, nw) (kept for callers)."""
-    W3 = np.stack([W_half[0:-1:2], W_half[1::2], W_half[2::2]], axis=1)
-    return run_fixed_step(plant, x0, U, W3, p, dt, "rk4", law, compiled, on_chunk)
 
 
 _OUTPUT_MAPS: dict = {}

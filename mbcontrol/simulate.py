@@ -111,7 +111,9 @@ def energy_budget(plant, t, Y):
 
 def energy_audit(plant, t, Y, method: str, dt: float) -> None:
     """Raise SimulationError at the first sample whose energy gain exceeds ENERGY_MARGIN times
-    the work put in so far (plus a floor: 5 % of the record's input, half the initial energy), or whose outputs are not finite: the signature of an unstable step, not physics."""
+    the work put in so far (plus a floor: 5 % of the record's input, half the initial
+    energy), or whose outputs are not finite: the signature of an unstable step, not physics.
+    """
     bad = np.flatnonzero(~np.isfinite(Y).all(axis=1))
     budget = energy_budget(plant, t, Y)
     if budget is not None:
