@@ -71,8 +71,12 @@ def simulate(plant, wave=None, *, duration: float, dt: float = 0.01, controller=
         bar.close()
 
     start = time.perf_counter()
-    W = plant.excitation(wave, t) if wave is not None \
-        else np.zeros((n + 1, len(plant.disturbances)))
+    if wave is None:
+        W = np.zeros((n + 1, len(plant.disturbances)))
+    elif spec.fixed_step:             # the steps' start nodes already hold w(t_0..t_n-1)
+        W = np.vstack([W_nodes[:, 0], plant.excitation(wave, t[-1:])])
+    else:
+        W = plant.excitation(wave, t)
     U_full = np.vstack([U, _last_command(plant, controller, t[-1], X[-1], U, W[-1], p)])
     Y = integrators.outputs(plant, X, U_full, W, p, compiled=compiled)
     output_wall = time.perf_counter() - start

@@ -85,14 +85,13 @@ def work_precision(scene, wave, *, duration: float, methods=("rk3", "rk4", "dopr
     check = simulate(plant, wave, duration=duration, dt=dt_ref / 2, method="dopri5")
     ref_error = coordinate_error(ref, check, after, plant.n_q)
 
-    jobs = [(plant, m, dt, None, None) for m in methods if METHODS[m].fixed_step
-            for dt in steps]
-    jobs += [(plant, m, steps[-1], rtol, None) for m in methods
-             if not METHODS[m].fixed_step for rtol in rtols]
+    jobs = [(m, dt, None) for m in methods if METHODS[m].fixed_step for dt in steps]
+    jobs += [(m, steps[-1], rtol) for m in methods if not METHODS[m].fixed_step
+             for rtol in rtols]
     bar = _bar(progress, len(jobs) + len(radiation_tols))
     rows = []
-    for p, method, dt, rtol, _ in jobs:
-        rows.append(_measure(run, p, method, dt, rtol, ref, after, duration, plant.n_q,
+    for method, dt, rtol in jobs:
+        rows.append(_measure(run, plant, method, dt, rtol, ref, after, duration, plant.n_q,
                              scene.hydro.radiation_tol))
         _tick(bar)
     # radiation orders: the finest stable step of radiation_method, a cruder model each
