@@ -13,9 +13,9 @@ import time
 import numpy as np
 
 from mbcontrol import waves
-from mbcontrol.batch import simulate_batch
+from mbcontrol.sim import simulate_batch
 from mbcontrol.plant import build_plant
-from mbcontrol.simulate import simulate
+from mbcontrol.sim import simulate
 
 
 def main(argv=None) -> int:

@@ -35,9 +35,9 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from mbcontrol import hydro as bem
-from mbcontrol.compiled import compile_function
-from mbcontrol.integrators import step_function, wave_terms
-from mbcontrol.plant import _selector, build_plant
+from mbcontrol.sim.compiled import compile_function
+from mbcontrol.sim.integrators import step_function, wave_terms
+from mbcontrol.plant import dof_selector, build_plant
 
 KERNEL_DECAY = 1e-4      # truncate K where every entry stays below this fraction of its peak
 KERNEL_MAX_S = 30.0      # ... and at most this long (s)
@@ -61,7 +61,7 @@ def radiation_free(scene):
     plant = build_plant(scene, radiation=False)
     tree = plant.topology.tree
     q, s = ca.SX.sym("q", tree.n_q), ca.SX.sym("s", tree.n_s)
-    select = _selector(plant.topology, list(plant.hydro.dofs))
+    select = dof_selector(plant.topology, list(plant.hydro.dofs))
     nu = ca.Function("nu", [ca.vertcat(q, s)], [ca.mtimes(select, ca.mtimes(tree.P(q).T, s))])
     return plant, nu
 

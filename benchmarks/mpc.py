@@ -23,9 +23,9 @@ import numpy as np
 
 from mbcontrol import waves
 from mbcontrol.controllers.mpc import Mpc
-from mbcontrol.metrics import pto_metrics
+from mbcontrol.analysis import pto_metrics
 from mbcontrol.plant import build_plant
-from mbcontrol.simulate import simulate
+from mbcontrol.sim import simulate
 
 MODEL, ORDER, HORIZON_STEPS, DT_S = "rm3", 30, 40, 0.2
 FORCE_MAX, STROKE_MAX = 2e6, 2.0

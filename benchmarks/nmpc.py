@@ -30,11 +30,10 @@ import numpy as np
 
 from mbcontrol import waves
 from mbcontrol.controllers.nmpc import Nmpc
-from mbcontrol.metrics import pto_metrics
+from mbcontrol.analysis import pto_metrics
 from mbcontrol.plant import build_plant
-from mbcontrol.scene import catalogue_dir
-from mbcontrol.scene_parse import parse_scene
-from mbcontrol.simulate import simulate
+from mbcontrol.scene import catalogue_dir, parse_scene
+from mbcontrol.sim import simulate
 
 T = 9.6664                                   # s
 FORCE_MAX, STROKE_MAX = 2e6, 4.0             # N, m

@@ -20,9 +20,9 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from mbcontrol import plotting, waves
-from mbcontrol.integrators import wave_terms
+from mbcontrol.sim.integrators import wave_terms
 from mbcontrol.plant import build_plant
-from mbcontrol.simulate import simulate
+from mbcontrol.sim import simulate
 
 SIGNALS = ("hinge", "barge2__Heave")
 

@@ -21,12 +21,12 @@ from pathlib import Path
 import numpy as np
 
 from mbcontrol import waves
-from mbcontrol.hydro_data import load_hydro_model
-from mbcontrol.integrators import prepare
+from mbcontrol.hydro import load_hydro_model
+from mbcontrol.sim.integrators import prepare
 from mbcontrol.plant import active_hydro_dofs, build_plant
 from mbcontrol.scene import load_scene
-from mbcontrol.simulate import simulate
-from mbcontrol.topology import build_topology
+from mbcontrol.sim import simulate
+from mbcontrol.multibody import build_topology
 
 DURATION, DT = 600.0, 0.01
 

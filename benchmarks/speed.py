@@ -14,7 +14,7 @@ states), of RMS(y - y_ref) / RMS(y_ref) over the record after the wave ramp, y_r
 reference of the SAME equations, interpolated to the run's samples (cubic spline).
 
 mbcontrol (this toolbox): simulate(plant, sea, duration, dt, method) over
-  - method: every fixed-step method in mbcontrol.integrators.METHODS, dt on a geometric ladder
+  - method: every fixed-step method in mbcontrol.sim.METHODS, dt on a geometric ladder
     Tp/8 ... Tp/256 (ratio 2^(1/4)), coarse to fine: the first dt that meets 1 % is the
     method's cheapest; a run that diverges (SimulationError) is recorded as unstable; a ladder
     stops early at an error floor (a finer step gains < 20 %: model error, no step meets it);
@@ -50,7 +50,7 @@ the two sides, to show that both solve the same physics (per coordinate below th
 Output: the table on stdout, progress on stderr; in --out: speed_summary.csv (one row per
 model), speed_trials.csv (every setting tried, both sides) and speed.png (real-time factors
 and work-precision). First run: compiling each (model, method) takes from seconds to a
-minute; the compiled code is cached (see mbcontrol.compiled), later runs skip it.
+minute; the compiled code is cached (see mbcontrol.sim.compiled), later runs skip it.
 
 Examples:
   python benchmarks/speed.py                                   # all models, 600 s (~8-12 min)
@@ -59,13 +59,10 @@ Examples:
 from __future__ import annotations
 
 import argparse
-import csv
-import json
 import os
 import sys
 import time
 import warnings
-from dataclasses import dataclass, field
 from pathlib import Path
 
 # one core, as the compiled code: a multi-threaded BLAS in the baseline's convolution would
@@ -74,149 +71,31 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
 import numpy as np
-from scipy.interpolate import CubicSpline
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import convolution_baseline as conv
+from speed_cases import (ADAPTIVE, ADAPTIVE_OUTPUT, ADAPTIVE_RTOLS, BASELINE_LADDER, BASELINE_RTOLS,
+                         CASES, CRUDE_RADIATION_METHODS, DT_LADDER, FLOOR_RATIO, RADIATION_TOLS,
+                         REF_CONV, REF_SS, REPEAT_UNDER_S, TOL, Case, Result, Trial, converged,
+                         coordinate_errors, grid_step, log)
+from speed_report import chart, print_table, write_csv
 
 from mbcontrol import waves
 from mbcontrol.errors import SimulationError
 from mbcontrol.plant import build_plant
 from mbcontrol.scene import load_scene
-from mbcontrol.simulate import simulate
+from mbcontrol.sim import simulate
 
 try:
-    from mbcontrol.integrators import METHODS
+    from mbcontrol.sim import METHODS
 except ImportError:                          # before the method registry existed: RK4 only
     METHODS = {"rk4": None}
-
-TOL = 0.01                   # the accuracy every setting must meet (relative RMS)
-RTF_TARGET = 20_000          # x real time, for the one- and two-body models
-SPEEDUP_TARGET = 50          # x faster than the baseline, every model
-RADIATION_TOLS = (None, 0.05, 0.1)           # None: the scene's own radiation_tol
-CRUDE_RADIATION_METHODS = ("rk4", "exp-rk4")  # methods tried with the cruder radiation fits
-ADAPTIVE = ("cvodes", "adams")
-DT_LADDER = [8 * 2 ** (j / 4) for j in range(21)]      # Tp/8 ... Tp/256
-ADAPTIVE_RTOLS = (1e-3, 1e-4, 1e-5, 1e-6, 1e-7)
-ADAPTIVE_OUTPUT = 20                                   # output grid Tp/20 for adaptive methods
-BASELINE_LADDER = [10 * 2 ** (j / 2) for j in range(9)]  # Tp/10 ... Tp/160
-BASELINE_RTOLS = (1e-3, 1e-5)
-REF_SS = 320                 # toolbox reference: RK4 at Tp/320 (checked against Tp/160)
-REF_CONV = 160               # convolution reference: Tp/160 (checked against Tp/80)
-REF_TARGET = TOL / 10        # a reference is halved in step until its check is below this
-REF_MAX = 1280               # ... down to Tp/REF_MAX
-FLOOR_RATIO = 0.8            # a step ladder stops when 2^(1/4) finer steps gain less than this
-REPEAT_UNDER_S = 5.0                         # repeat a timing only when a run is shorter
-ERROR_MEASURE = ("max over joint coordinates of RMS(y - y_ref)/RMS(y_ref) after the wave "
-                 "ramp; y_ref a converged reference of the same equations")
-
-
-@dataclass(frozen=True)
-class Case:
-    """A benchmark model: catalogue name, scene parameters, sea state, whether the real-time
-    target applies."""
-    scene: str
-    params: dict | None
-    hs: float
-    tp: float
-    rtf_target: bool
-    label: str = ""
-
-    @property
-    def name(self) -> str:
-        return self.label or self.scene
-
-
-CASES = {
-    "sphere": Case("sphere", None, 2.5, 9.67, True),
-    "rm3": Case("rm3", None, 2.5, 8.0, True),
-    "hinged_barge": Case("hinged_barge", None, 0.03, 1.1, True),
-    "barge_chain": Case("barge_chain", {"N": 8}, 0.03, 1.1, False, "barge_chain N=8"),
-}
-
-
-@dataclass
-class Trial:
-    """One setting tried: side ("mbcontrol" | "baseline"), its parameters and the outcome."""
-    model: str
-    side: str
-    method: str
-    step: float | None = None        # dt or delta (s); the output grid for adaptive methods
-    rtol: float | None = None
-    radiation_tol: float | None = None
-    states: int = 0
-    record_s: float = 0.0            # simulated seconds of the timed run
-    error: float = np.nan
-    wall_s: float = np.nan
-    runs: int = 0
-    worst: str = ""                  # the coordinate with the largest error
-    status: str = "ok"               # ok | unstable | failed: ... | skipped: ...
-    chosen: bool = False
-    extrapolated: bool = False       # timed on a shorter record than asked for
-    note: str = ""
-
-    @property
-    def rtf(self) -> float:
-        return self.record_s / self.wall_s if self.wall_s > 0 else np.nan
-
-    @property
-    def meets(self) -> bool:
-        return self.status == "ok" and self.error <= TOL
-
-
-@dataclass
-class Result:
-    case: Case
-    toolbox: Trial | None = None
-    baseline: Trial | None = None
-    model_diff: float = np.nan
-    ss_check: float = np.nan         # toolbox reference vs its check (the 2x coarser step)
-    conv_check: float = np.nan       # convolution reference vs its check
-    ss_k: int = REF_SS               # the references' steps: Tp/ss_k, Tp/conv_k
-    conv_k: int = REF_CONV
-    trials: list = field(default_factory=list)
-    ss_reference: tuple | None = None   # (t, q) of the toolbox's converged reference
-    model_diff_by_coordinate: dict = field(default_factory=dict)
-
-
-def log(message: str) -> None:
-    print(message, file=sys.stderr, flush=True)
-
-
-def coordinate_errors(t, q, t_ref, q_ref, after: float) -> np.ndarray:
-    """Per column of q: RMS(q - q_ref)/RMS(q_ref) for t >= after, the reference interpolated
-    to t by a cubic spline."""
-    mask = t >= after
-    ref = CubicSpline(t_ref, q_ref)(t[mask])
-    return np.sqrt(np.mean((q[mask] - ref) ** 2, axis=0) / np.mean(ref ** 2, axis=0))
-
-
-def coordinate_error(t, q, t_ref, q_ref, after: float) -> float:
-    """The error measure: the largest of :func:`coordinate_errors`."""
-    return float(np.max(coordinate_errors(t, q, t_ref, q_ref, after)))
-
-
-def converged(run_at, k: int, after: float):
-    """A reference run_at(k) -> (t, q) at step Tp/k, checked against Tp/(k/2); the step is
-    halved while their difference exceeds REF_TARGET. Returns (k, ((t, q), difference))."""
-    coarse, fine = run_at(k // 2), run_at(k)
-    diff = coordinate_error(*coarse, *fine, after)
-    while diff > REF_TARGET and 2 * k <= REF_MAX:
-        k, coarse, fine = 2 * k, fine, run_at(2 * k)
-        diff = coordinate_error(*coarse, *fine, after)
-    return k, (fine, diff)
 
 
 def _measure(trial, t, q, ref, after, names) -> None:
     errors = coordinate_errors(t, q, *ref, after)
     trial.error, trial.worst = float(errors.max()), names[int(np.argmax(errors))]
-
-
-def grid_step(sea, target: float) -> float:
-    """The step nearest `target` that divides the sea's repeat period (FFT synthesis)."""
-    repeat = 2 * np.pi / sea.d_omega
-    return repeat / max(1, round(repeat / target))
 
 
 def _coordinates(plant, ds) -> tuple[np.ndarray, np.ndarray]:
@@ -460,168 +339,10 @@ def main(argv=None) -> int:
                       max(args.search_duration, sea.ramp_time + 10 * case.tp),
                       args.baseline_budget, result)
         results.append(result)
-    _write_csv(results, out)
-    _chart(results, out / "speed.png")
-    _print_table(results, args, time.perf_counter() - t0)
+    write_csv(results, out)
+    chart(results, out / "speed.png")
+    print_table(results, args, time.perf_counter() - t0)
     return 0
-
-
-def _setting(trial: Trial | None, side: str) -> str:
-    if trial is None:
-        return "none met 1 %"
-    if side == "mbcontrol":
-        step = f"rtol {trial.rtol:g}" if trial.rtol is not None else f"dt {trial.step:.4g}"
-        return f"{trial.method}, {step}, {trial.radiation_tol:g}"
-    return f"{trial.step:.4g}, {trial.rtol:g}"
-
-
-def _print_table(results, args, elapsed):
-    print(f"Real-time factors at 1 % RMS accuracy, {args.duration:.0f} s JONSWAP seas (gamma 3.3, "
-          f"seed {args.seed}); one core, best of {args.repeat} for mbcontrol")
-    print(f"error: {ERROR_MEASURE} (mbcontrol: RK4 at Tp/{REF_SS} of the full model; baseline: "
-          f"its convolution equations by RK4 at Tp/{REF_CONV}; either halved in step until it "
-          f"moves less than {REF_TARGET:g} from the 2x coarser step)")
-    head = (f"{'model':16s} {'states':>6s}  {'toolbox (method, dt, rad.tol)':34s} {'rms err':>8s} "
-            f"{'RTF':>10s} | {'baseline (delta, rtol)':22s} {'rms err':>8s} {'RTF':>8s} | "
-            f"{'speed-up':>9s} | {'SS vs conv':>10s}")
-    print(head)
-    print("-" * len(head))
-    for r in results:
-        tb, bl = r.toolbox, r.baseline
-        states = f"{tb.states}" if tb else "-"
-        tb_err = f"{tb.error:.1e}" if tb else "-"
-        tb_rtf = f"{tb.rtf:,.0f}" if tb else "-"
-        bl_err = f"{bl.error:.1e}" if bl else "-"
-        bl_rtf = (f"{bl.rtf:,.1f}" + ("*" if bl.extrapolated else "")) if bl else "-"
-        speedup = f"{tb.rtf / bl.rtf:,.0f}x" if tb and bl else "-"
-        print(f"{r.case.name:16s} {states:>6s}  {_setting(tb, 'mbcontrol'):34s} {tb_err:>8s} "
-              f"{tb_rtf:>10s} | {_setting(bl, 'baseline'):22s} {bl_err:>8s} {bl_rtf:>8s} | "
-              f"{speedup:>9s} | {r.model_diff:10.1e}")
-    print()
-    print(f"targets: >= {RTF_TARGET:,}x real time (sphere, rm3, hinged_barge) and >= "
-          f"{SPEEDUP_TARGET}x faster than the baseline (every model)")
-    for r in results:
-        tb, bl = r.toolbox, r.baseline
-        parts = []
-        if r.case.rtf_target:
-            ok = tb is not None and tb.rtf >= RTF_TARGET
-            parts.append(f"real time {'MET' if ok else 'MISSED'} "
-                         f"({tb.rtf:,.0f}x)" if tb else "real time MISSED (no setting met 1 %)")
-        if tb and bl:
-            ratio = tb.rtf / bl.rtf
-            parts.append(f"speed-up {'MET' if ratio >= SPEEDUP_TARGET else 'MISSED'} "
-                         f"({ratio:,.0f}x)")
-        else:
-            parts.append("speed-up not measured (a side met no setting)")
-        print(f"  {r.case.name:16s} " + "; ".join(parts))
-    print()
-    print("references converged: " + "; ".join(
-        f"{r.case.name} mbcontrol {r.ss_check:.0e} (Tp/{r.ss_k}), convolution "
-        f"{r.conv_check:.0e} (Tp/{r.conv_k})" for r in results) +
-        " (difference to the 2x coarser step)")
-    print("largest error in: " + "; ".join(
-        f"{r.case.name} mbcontrol {r.toolbox.worst if r.toolbox else '-'}, baseline "
-        f"{r.baseline.worst if r.baseline else '-'}" for r in results))
-    for r in results:
-        diff = sorted(r.model_diff_by_coordinate.items(), key=lambda kv: -kv[1])
-        if len(diff) > 1:
-            print(f"SS vs conv, {r.case.name}: {diff[0][0]} {diff[0][1]:.1e}, the other "
-                  f"coordinates <= {diff[1][1]:.1e}")
-    extrapolated = [r for r in results if r.baseline and r.baseline.extrapolated]
-    for r in extrapolated:
-        print(f"* {r.case.name}: baseline timed on a {r.baseline.record_s:.0f} s record and "
-              f"EXTRAPOLATED to {args.duration:.0f} s (constant cost per step once the "
-              f"{r.baseline.note.split('kernel ')[-1]} kernel is filled)")
-    print("SS vs conv: the two converged references compared with the same measure (state-"
-          "space radiation fit vs direct convolution of the BEM kernel)")
-    print(f"wrote {Path(args.out) / 'speed_summary.csv'}, speed_trials.csv, speed.png "
-          f"({elapsed / 60:.1f} min)")
-
-
-def _write_csv(results, out: Path) -> None:
-    fields = ["model", "side", "method", "step_s", "rtol", "radiation_tol", "states", "record_s",
-              "rms_error", "worst_coordinate", "wall_s", "runs", "rtf", "status", "chosen",
-              "note"]
-    with open(out / "speed_trials.csv", "w", newline="") as fh:
-        writer = csv.writer(fh)
-        writer.writerow(fields)
-        for r in results:
-            for t in r.trials:
-                writer.writerow([t.model, t.side, t.method, t.step, t.rtol, t.radiation_tol,
-                                 t.states, t.record_s, t.error, t.worst, t.wall_s, t.runs, t.rtf,
-                                 t.status, t.chosen, t.note])
-    summary = ["model", "toolbox_method", "toolbox_dt_s", "toolbox_rtol", "radiation_tol",
-               "states", "toolbox_rms_error", "toolbox_rtf", "baseline_delta_s", "baseline_rtol",
-               "baseline_rms_error", "baseline_rtf", "baseline_record_s", "speedup",
-               "model_difference_ss_vs_conv", "model_difference_by_coordinate",
-               "toolbox_worst_coordinate", "baseline_worst_coordinate", "reference_check_toolbox",
-               "reference_check_convolution", "rtf_target", "speedup_target", "error_measure"]
-    with open(out / "speed_summary.csv", "w", newline="") as fh:
-        writer = csv.writer(fh)
-        writer.writerow(summary)
-        for r in results:
-            tb, bl = r.toolbox, r.baseline
-            writer.writerow([
-                r.case.name, tb.method if tb else "", tb.step if tb else "",
-                tb.rtol if tb and tb.rtol is not None else "", tb.radiation_tol if tb else "",
-                tb.states if tb else "", tb.error if tb else "", tb.rtf if tb else "",
-                bl.step if bl else "", bl.rtol if bl else "", bl.error if bl else "",
-                bl.rtf if bl else "", bl.record_s if bl else "",
-                tb.rtf / bl.rtf if tb and bl else "", r.model_diff,
-                json.dumps(r.model_diff_by_coordinate), tb.worst if tb else "",
-                bl.worst if bl else "", r.ss_check, r.conv_check,
-                RTF_TARGET if r.case.rtf_target else "", SPEEDUP_TARGET, ERROR_MEASURE])
-
-
-def _chart(results, path: Path) -> None:
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from mbcontrol import plotting
-
-    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(13, 5))
-    names = [r.case.name for r in results]
-    x = np.arange(len(results))
-    tb = [r.toolbox.rtf if r.toolbox else np.nan for r in results]
-    bl = [r.baseline.rtf if r.baseline else np.nan for r in results]
-    ax1.bar(x - 0.2, tb, 0.4, label="mbcontrol (cheapest setting at 1 %)")
-    ax1.bar(x + 0.2, bl, 0.4, label="solve_ivp + direct convolution (cheapest at 1 %)")
-    for i, r in enumerate(results):
-        if r.toolbox and r.baseline:
-            ax1.annotate(f"{tb[i] / bl[i]:,.0f}x", (x[i], tb[i]), ha="center", va="bottom",
-                         fontsize=8)
-    ax1.axhline(RTF_TARGET, ls="--", c="k", lw=0.8, label=f"target {RTF_TARGET:,}x")
-    ax1.set_yscale("log")
-    ax1.set_ylim(1.0, 10 ** np.ceil(np.log10(np.nanmax(tb + [RTF_TARGET])) + 1.5))
-    ax1.set_xticks(x, names, fontsize=8)
-    ax1.set_ylabel("real-time factor (simulated s per wall s)")
-    ax1.set_title("real-time factor at 1 % RMS accuracy")
-    ax1.legend(fontsize=7)
-    default_tol = {r.case.name: r.trials[0].radiation_tol for r in results if r.trials}
-    markers = {"rk4": "o", "rk3": "v", "dopri5": "D", "exp-rk4": "s", "cvodes": "^",
-               "adams": "P"}
-    for i, r in enumerate(results):
-        color = f"C{i}"
-        for t in r.trials:
-            if t.status != "ok" or not np.isfinite(t.error) or t.error <= 0:
-                continue
-            marker = "x" if t.side == "baseline" else markers.get(t.method, "o")
-            crude = t.side == "mbcontrol" and t.radiation_tol != default_tol.get(r.case.name)
-            ax2.loglog(t.rtf, t.error, marker, color=color, ms=9 if t.chosen else 4,
-                       mfc="none" if crude else color, alpha=0.8)
-        ax2.plot([], [], "o", color=color, label=r.case.name)
-    for method, marker in markers.items():
-        ax2.plot([], [], marker, color="grey", label=method)
-    ax2.plot([], [], "x", color="grey", label="baseline")
-    ax2.axhline(TOL, ls="--", c="k", lw=0.8)
-    ax2.set_xlabel("real-time factor")
-    ax2.set_ylabel("relative RMS error (max over coordinates)")
-    ax2.set_title("every setting tried (large: chosen; hollow: cruder radiation fit)")
-    ax2.grid(True, which="both", alpha=0.3)
-    ax2.legend(fontsize=7, ncol=2)
-    plotting.save(fig, path)
-    plt.close(fig)
 
 
 if __name__ == "__main__":

@@ -57,10 +57,11 @@ from mbcontrol import waves
 from mbcontrol.controllers.latching import (Declutching, Latching, natural_period,
                                             optimal_declutch)
 from mbcontrol.controllers.passive import Passive, optimal_damping
-from mbcontrol.controllers.reactive import Reactive, intrinsic_impedance, reactive_tuning
-from mbcontrol.metrics import pto_metrics, wecccomp_score
+from mbcontrol.controllers.impedance import intrinsic_impedance
+from mbcontrol.controllers.reactive import Reactive, reactive_tuning
+from mbcontrol.analysis.metrics import pto_metrics, wecccomp_score
 from mbcontrol.plant import build_plant
-from mbcontrol.simulate import simulate
+from mbcontrol.sim import simulate
 
 MODEL = "wavestar"
 RAMP_PERIODS = 5          # ramp, Tp

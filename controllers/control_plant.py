@@ -75,8 +75,7 @@ def default_measurements(plant) -> list[str]:
 def build_control_plant(plant, dt: float, *, ptos=None, measured=None, order=None,
                         params=None) -> ControlPlant:
     """Linearise, reduce (order: states kept, None = all) and discretise `plant` at dt s."""
-    from mbcontrol.linearize import linearize
-    from mbcontrol.reduce import balanced_truncation
+    from mbcontrol.analysis import balanced_truncation, linearize
 
     ptos = list(ptos or [p.name for p in plant.scene.ptos])
     measured = list(measured or default_measurements(plant))

@@ -10,12 +10,12 @@
 2. what linear theory predicts it absorbs (W; passive and reactive only: the frequency-domain
    solution straight from the BEM data), and for the linear laws their stability margins on
    the linearised plant (controllers.margins);
-3. what any controller could absorb (mbcontrol.bounds): the complex-conjugate bound and the
+3. what any controller could absorb (mbcontrol.analysis.bounds): the complex-conjugate bound and the
    pseudo-spectral bound under the PTO's force and stroke limits (in a regular wave with the
    force's harmonics inside the hydro data's band: a saturating or switching controller's
    force is not sinusoidal; in a sea on the sea's own frequency grid);
-4. what the nonlinear plant does in closed loop (mbcontrol.simulate), scored by
-   mbcontrol.metrics over its analysis window (last 10 periods of a regular wave, after the
+4. what the nonlinear plant does in closed loop (mbcontrol.sim.simulate), scored by
+   mbcontrol.analysis.metrics over its analysis window (last 10 periods of a regular wave, after the
    ramp in a sea), and its share of the bounds.
 
 Limits: with limits=True the scene PTO's finite force_max (N or N m) and stroke_max (m or
@@ -44,7 +44,6 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from mbcontrol.errors import SimulationError
-
 from mbcontrol.results import jsonable
 
 from . import REGISTRY, make
@@ -160,8 +159,8 @@ def design(plant, wave, name: str, *, pto: str | None = None, simulate_s: float 
     metrics = simulation = ds = None
     percent = {"complex_conjugate": None, "constrained": None}
     if margins is None or margins.stable:
-        from mbcontrol.metrics import pto_metrics, summary
-        from mbcontrol.simulate import simulate
+        from mbcontrol.analysis import pto_metrics, summary
+        from mbcontrol.sim import simulate
         duration = simulate_s if simulate_s is not None else _duration(wave, margins)
         if default_dt and getattr(controller, "period", None):
             dt = controller.period / math.ceil(controller.period / dt - 1e-9)
@@ -299,7 +298,7 @@ def _bounds(plant, wave, pto, limit_values, mode) -> dict:
     if not mode:
         out["constrained_reason"] = "bounds not requested"
         return out
-    from mbcontrol.bounds import complex_conjugate_bound, pseudo_spectral_bound
+    from mbcontrol.analysis import complex_conjugate_bound, pseudo_spectral_bound
     try:
         cc = complex_conjugate_bound(plant, wave, pto)
     except ValueError as exc:          # NotPassiveError, a wave outside the data, ...

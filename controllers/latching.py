@@ -27,7 +27,7 @@ unit circle for 0 < r < 1.4). The brake dissipates -u v, which is counted in the
 a real brake's would be; it vanishes with h (the tests measure its share).
 
 Force limit: every command, brake and damper alike, is saturated to +-force_max (N or N m;
-None: the scene PTO's force_max, inf: none; controllers.passive.force_limits). A saturated
+None: the scene PTO's force_max, inf: none; controllers.limits.force_limits). A saturated
 brake cannot hold the body: it slips while "latched" and the brake keeps estimating the rest
 of the force from the velocity change under the force it really applied.
 """
@@ -36,7 +36,8 @@ from __future__ import annotations
 import numpy as np
 
 from .base import per_pto, signal_indices
-from .passive import force_limits, limits_report, saturate
+from .impedance import intrinsic_impedance
+from .limits import force_limits, limits_report, saturate
 
 
 class _Switching:
@@ -162,7 +163,7 @@ def _port_inertia(plant, names) -> np.ndarray:
     """Inertia each PTO force meets at once (kg or kg m^2): 1 / (dv/dt per unit u), from the
     plant's exact Jacobians at rest (mass plus infinite-frequency added mass for a heaving
     body). Couplings between PTOs are left to the brake's estimate of the other forces."""
-    from mbcontrol.linearize import linearize
+    from mbcontrol.analysis import linearize
     sys = linearize(plant, inputs=[f"u__{n}" for n in names],
                     outputs=[f"{n}__velocity" for n in names])
     gain = np.diag(np.asarray(sys.C) @ np.asarray(sys.B))
@@ -177,8 +178,8 @@ def _port_inertia(plant, names) -> np.ndarray:
 
 def mean_power(ds, pto: str, start: float = 0.0, end: float | None = None) -> float:
     """Mean absorbed power (W) over [start, end) s, from the work the PTO does
-    (mbcontrol.metrics.step_power). For an irregular sea use start = the ramp time."""
-    from mbcontrol.metrics import pto_metrics
+    (mbcontrol.analysis.metrics.step_power). For an irregular sea use start = the ramp time."""
+    from mbcontrol.analysis import pto_metrics
     return pto_metrics(ds, pto, start, end)["mean_power_W"]
 
 
@@ -197,7 +198,6 @@ def steady_mean_power(ds, pto: str, period: float, skip_periods: int = 5) -> flo
 def natural_period(plant, *, pto: str | None = None, params=None) -> float:
     """Undamped natural period (s) of the PTO's coordinate with no PTO force: where the
     intrinsic reactance Im Z_i(omega) = omega (m + A(omega)) - K / omega changes sign."""
-    from .reactive import intrinsic_impedance
     hyd = plant.hydro
     omega = np.linspace(max(hyd.omega[0], 0.05), hyd.omega[-1], 800)
     X = intrinsic_impedance(plant, omega, pto=pto, params=params)[0].imag
@@ -210,7 +210,7 @@ def natural_period(plant, *, pto: str | None = None, params=None) -> float:
 
 
 def _simulated_power(plant, wave, controller, pto, dt, periods, skip) -> float:
-    from mbcontrol.simulate import simulate
+    from mbcontrol.sim import simulate
     T = wave.period
     ds = simulate(plant, wave, duration=(skip + periods) * T, dt=dt, controller=controller)
     return steady_mean_power(ds, pto, T, skip)
@@ -249,7 +249,6 @@ def optimal_latch_time(plant, wave, *, damping: float | None = None, pto: str | 
     (N or N m; None: the scene PTO's, as Latching's default), so the tuning sees the brake
     the device has.
     """
-    from .reactive import intrinsic_impedance
     name = pto or plant.scene.ptos[0].name
     T = _regular(wave, "optimal_latch_time")
     dt = T / 500 if dt is None else dt
@@ -287,7 +286,6 @@ def optimal_declutch(plant, wave, *, damping: float | None = None, pto: str | No
     in log damping (x 1/4..4) at the best tau. dt: simulation step, default T / 500.
     force_max: the simulated controllers' force limit (None: the scene PTO's).
     """
-    from .reactive import intrinsic_impedance
     name = pto or plant.scene.ptos[0].name
     T = _regular(wave, "optimal_declutch")
     dt = T / 500 if dt is None else dt

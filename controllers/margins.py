@@ -4,7 +4,7 @@ A linear PTO law u = -K(s) y, with y = [x, v] the PTO's position and velocity (m
 rad/s) and u the PTO's whole force on its follower (N or N m), closes a negative-feedback loop
 around G(s), the plant's transfer from u to y. G is linearised about rest with no Coulomb
 friction and the PTO's own scene law zeroed (the controller owns the PTO force, as in
-closed-loop simulation; `reactive._base_params`). The loop transfer is L(s) = K(s) G(s)
+closed-loop simulation; `reactive.base_params`). The loop transfer is L(s) = K(s) G(s)
 (SISO) and the closed loop's characteristic equation is 1 + L(s) = 0.
 
 Passive and reactive control, u = -(damping v + stiffness x), have K = [stiffness, damping]:
@@ -101,11 +101,11 @@ def plant_loop(plant, *, pto: str | None = None, params=None) -> control.StateSp
     About rest, no Coulomb friction, the PTO's own scene law zeroed, other PTOs as `params`
     sets them (default: free), as reactive.closed_loop_stability sees it.
     """
-    from mbcontrol.linearize import linearize
+    from mbcontrol.analysis import linearize
 
-    from .reactive import _base_params
+    from .impedance import base_params
     name = pto or plant.scene.ptos[0].name
-    base = _base_params(plant, name, params)
+    base = base_params(plant, name, params)
     base[f"{name}__damping"] = 0.0
     return linearize(plant, params=base, inputs=[f"u__{name}"],
                      outputs=[f"{name}__position", f"{name}__velocity"])
@@ -145,7 +145,7 @@ def loop_margins(plant, law, *, pto: str | None = None, params=None) -> Margins:
     default leaves them free). Never raises on an unstable loop: it says so in `stable` and
     `message`.
     """
-    from .reactive import closed_loop_stability
+    from .impedance import closed_loop_stability
     name = pto or plant.scene.ptos[0].name
     G = plant_loop(plant, pto=name, params=params)
     label, K = _gains(law, name)

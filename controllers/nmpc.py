@@ -10,7 +10,7 @@ oracle: `uses_state = True`, see controllers.base), the optimal-control problem
 
 and applies u_0 (zero-order hold). x_p is the PTO position (plant.h): the first sum is the
 work the PTO absorbs with its force held over each step, exact for a zero-order hold (as
-mbcontrol.metrics counts it). R (`force_penalty`, W/N^2) charges a loss R u^2, e.g. a
+mbcontrol.analysis.metrics counts it). R (`force_penalty`, W/N^2) charges a loss R u^2, e.g. a
 generator's copper loss; a small default keeps the optimum unique. The stroke limit is soft
 (slack with an L1 + quadratic cost) so that the problem is always feasible; the L1 weight
 makes it an exact penalty: no planned overshoot whenever one can be avoided.
@@ -37,7 +37,7 @@ import time
 import casadi as ca
 import numpy as np
 
-from mbcontrol.integrators import rk4_step
+from mbcontrol.sim.integrators import rk4_step
 
 from .base import signal_indices
 

@@ -6,56 +6,17 @@ force_max, inf: no limit), in the Python path and in the compiled CasADi law ali
 saturated damper still absorbs power but no longer bounds the stroke: the stroke limit is met
 by tuning, `optimal_damping(..., force_max=, stroke_max=)`, which keeps the predicted force and
 stroke peaks of the linear frequency-domain solution within the limits (the peak statistic is
-documented in `controllers.reactive.fd_statistics`); the WECCCOMP tests verify it by simulation.
+documented in `controllers.impedance.fd_statistics`); the WECCCOMP tests verify it by simulation.
 """
 from __future__ import annotations
-
-import math
 
 import casadi as ca
 import numpy as np
 
 from .base import per_pto, signal_indices
-
-
-def force_limits(plant, force_max=None) -> np.ndarray:
-    """Per-PTO force limit (N or N m, > 0, inf: none), scene order.
-
-    force_max None: each scene PTO's own force_max; a number: that limit on every PTO; a dict
-    by PTO name: those PTOs' limits, the others keep their scene limit.
-    """
-    ptos = plant.scene.ptos
-    limits = np.array([p.force_max for p in ptos], float)
-    if isinstance(force_max, dict):
-        per_pto(plant, force_max, "force_max")          # rejects unknown PTO names
-        limits = np.array([float(force_max.get(p.name, p.force_max)) for p in ptos])
-    elif force_max is not None:
-        limits = np.full(len(ptos), float(force_max))
-    if not np.all(limits > 0):                           # NaN fails too
-        raise ValueError(f"{plant.name}: force_max must be > 0 (inf: none), got {limits}")
-    return limits
-
-
-def saturate(u: np.ndarray, limits: np.ndarray) -> np.ndarray:
-    """u clipped to +-limits (inf limits leave u unchanged)."""
-    return np.clip(u, -limits, limits)
-
-
-def casadi_saturate(u, limits: np.ndarray):
-    """The CasADi expression of `saturate`: fmin/fmax on the PTOs with a finite limit only,
-    so a law without limits is the very expression it was before limits existed."""
-    if np.all(np.isinf(limits)):
-        return u
-    return ca.vertcat(*[u[i] if math.isinf(f) else ca.fmin(ca.fmax(u[i], -f), f)
-                        for i, f in enumerate(limits)])
-
-
-def limits_report(limits) -> list | None:
-    """describe()'s view of the force limits: one per PTO, None where there is none (JSON
-    has no infinity); None before reset."""
-    if limits is None:
-        return None
-    return [float(f) if math.isfinite(f) else None for f in limits]
+from .impedance import default_bounds
+from .limits import casadi_saturate, force_limits, limits_report, saturate
+from .tuning import constrained_tuning
 
 
 class Passive:
@@ -115,7 +76,7 @@ def optimal_damping(plant, wave, *, pto: str | None = None, params=None, bounds=
 
     Limits (keyword-only; None: unconstrained, the search above): force_max (N or N m) and
     stroke_max (m or rad) bound the predicted peaks of the PTO force and position in `wave`,
-    as `controllers.reactive.fd_statistics` predicts them (a regular wave: its amplitudes; a
+    as `controllers.impedance.fd_statistics` predicts them (a regular wave: its amplitudes; a
     sea: the Rice level the record exceeds with probability <~ `exceedance`). The search is
     then a log grid over `bounds`, refined by Brent's method inside the feasible set or by
     bisection to its edge. A damper lowers the stroke and raises the force, so limits that
@@ -123,7 +84,6 @@ def optimal_damping(plant, wave, *, pto: str | None = None, params=None, bounds=
     the PTO efficiency times this mechanical power: the optimum is the same for both.)
     """
     if force_max is not None or stroke_max is not None:
-        from .reactive import constrained_tuning
         c, _, power = constrained_tuning(plant, wave, pto=pto, params=params, passive=True,
                                          bounds=bounds, force_max=force_max,
                                          stroke_max=stroke_max, exceedance=exceedance)
@@ -152,11 +112,3 @@ def optimal_damping(plant, wave, *, pto: str | None = None, params=None, bounds=
     return float(np.exp(result.x)), -float(result.fun)
 
 
-def default_bounds(plant, wave, name: str, params) -> tuple[float, float]:
-    """1e-3 to 1e3 times |Z_i| (N s/m or N m s/rad) at the wave's most energetic component."""
-    from mbcontrol.bounds import pto_thevenin
-    k = int(np.argmax(wave.amplitude))
-    scale = float(np.abs(pto_thevenin(plant, wave.omega[k:k + 1], pto=name,
-                                      direction=wave.direction, params=params,
-                                      check_passive=False).impedance[0]))
-    return 1e-3 * scale, 1e3 * scale

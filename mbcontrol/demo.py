@@ -15,11 +15,10 @@ from pathlib import Path
 import numpy as np
 
 from . import plotting, waves
-from .analysis import frequency_domain_response, regular_wave_amplitudes, statespace_response
-from .linearize import linearize
-from .metrics import summary
+from .analysis import (frequency_domain_response, linearize, regular_wave_amplitudes,
+                       statespace_response, summary)
 from .plant import build_plant
-from .simulate import simulate
+from .sim import simulate
 
 MODEL = "hinged_barge"
 NO_COULOMB = {"hinge_friction__coulomb": 0.0}
@@ -75,7 +74,7 @@ def main(argv=None) -> int:
     from mbcontrol.controllers.reactive import Reactive, reactive_tuning
     limit = plant.scene.ptos[0].force_max
     c_r, k_r, p_r = reactive_tuning(plant, sea, force_max=limit)
-    from mbcontrol.bounds import complex_conjugate_bound
+    from mbcontrol.analysis import complex_conjugate_bound
     bound = complex_conjugate_bound(plant, sea).power
     report["design"].update(reactive_damping=c_r, reactive_stiffness=k_r,
                             reactive_predicted_power_W=p_r, torque_limit=limit,

@@ -30,7 +30,7 @@ def bem_inputs(scene, panel_size: float | None = None) -> dict:
     import numpy as np
 
     from mbcontrol.hydro import BemBody
-    from mbcontrol.hydro_data import geometry_dict
+    from mbcontrol.hydro import geometry_dict
 
     h = scene.hydro
     bodies = [BemBody(name=b.name, geometry=geometry_dict(b.geometry), cog=b.cog, mass=b.mass,

@@ -11,8 +11,8 @@ TOUR = [
            "radiation state-space model → nonlinear process plant → linear control plant → "
            "closed loop. Every number below is computed when the notebook runs."),
     ("code", "import numpy as np\nfrom mbcontrol import waves\nfrom mbcontrol.scene import "
-             "load_scene\nfrom mbcontrol.plant import build_plant\nfrom mbcontrol.linearize "
-             "import linearize\nfrom mbcontrol.simulate import simulate\nfrom "
+             "load_scene\nfrom mbcontrol.plant import build_plant\nfrom mbcontrol.analysis.linearize "
+             "import linearize\nfrom mbcontrol.sim import simulate\nfrom "
              "mbcontrol.analysis import frequency_domain_response, statespace_response\n"
              "from mbcontrol.controllers import make"),
     ("md", "## The scene\nTwo 0.6 m barges: barge 1 pivots on a fixed post, barge 2 is hinged "
@@ -54,13 +54,13 @@ CONTROLLERS = [
            "complex-conjugate bound and the constrained (2 MN, 4 m) pseudo-spectral bound."),
     ("code", "import numpy as np\nimport matplotlib\nmatplotlib.use('Agg')\n"
              "import matplotlib.pyplot as plt\nfrom mbcontrol import waves\n"
-             "from mbcontrol.plant import build_plant\nfrom mbcontrol.simulate import simulate\n"
-             "from mbcontrol.bounds import complex_conjugate_bound, pseudo_spectral_bound\n"
+             "from mbcontrol.plant import build_plant\nfrom mbcontrol.sim import simulate\n"
+             "from mbcontrol.analysis import complex_conjugate_bound, pseudo_spectral_bound\n"
              "from mbcontrol.controllers import make\n"
              "from mbcontrol.controllers.passive import optimal_damping\n"
              "from mbcontrol.controllers.reactive import reactive_tuning\n"
              "from mbcontrol.controllers.latching import optimal_latch_time, steady_mean_power\n"
-             "from mbcontrol.metrics import pto_metrics\n"
+             "from mbcontrol.analysis import pto_metrics\n"
              "plant = build_plant('sphere')\nwave = waves.regular(2.5, 9.6664)\n"
              "F_MAX, Z_MAX = 2e6, 4.0"),
     ("md", "## Bounds\nThe constrained bound lets the force hold the wave's harmonics inside the "
@@ -119,8 +119,8 @@ WORK_PRECISION = [
            "time-stepping, one core, compilation excluded. The same chart comes from "
            "`mbcontrol bench rm3 --wave jonswap --hs 2.5 --tp 8`."),
     ("code", "import numpy as np\nimport matplotlib.pyplot as plt\nfrom mbcontrol import waves\n"
-             "from mbcontrol import workprecision as wp\nfrom mbcontrol.plant import build_plant\n"
-             "from mbcontrol.stability import linear_stability_limit\n"
+             "from mbcontrol.studies import workprecision as wp\nfrom mbcontrol.plant import build_plant\n"
+             "from mbcontrol.sim import linear_stability_limit\n"
              "sea = waves.irregular(2.5, 8.0, gamma=3.3, seed=1, duration=300)\n"
              "ds = wp.work_precision('rm3', sea, duration=300, methods=('rk3', 'rk4', 'dopri5', "
              "'exp-rk4', 'cvodes'),\n                       rtols=(1e-4, 1e-6), "

@@ -68,8 +68,7 @@ def test_linearisation_matches_frequency_domain(name):
     Measure: amplitude error |(|H_ss| - |H_fd|)| relative to the coordinate's peak |H_fd| over
     the band (a response notch makes a per-frequency ratio meaningless), within 2 % (issue 4),
     and the per-frequency ratio within 2 % wherever the response is at least half its peak."""
-    from mbcontrol.analysis import frequency_domain_response, statespace_response
-    from mbcontrol.linearize import linearize
+    from mbcontrol.analysis import frequency_domain_response, linearize, statespace_response
 
     plant = build_plant(name)
     linear_only = {n: 0.0 for n in plant.parameters if n.endswith("__coulomb")}  # no Coulomb in FD

@@ -11,12 +11,14 @@ time convention e^{-iωt}, excitation per unit wave amplitude at the n-frame ori
 - ``displaced_volume``, ``waterplane_area``, ``mass`` (body); ``center_of_buoyancy``, ``cog`` (body, xyz)
 """
 from ._io import read_netcdf, write_netcdf_atomic
+from .baseline import fit_radiation_hankel
 from .bem import cache_key, compute, matrix
 from .frames import dof_map, shift_matrix, skew, to_body_frames, zup_to_ned
 from .geometry import RIGID_DOFS, BemBody, hull_mesh, lid_mesh, validate_body
-from .radiation import RadiationModel, convolution_force, fit_radiation, impulse_response, kernel_data
+from .model import HydroModel, fit_hydro_model, geometry_dict, load_hydro_data, load_hydro_model
 from .passivity import PassivityReport, absorbed_energy, enforce_passivity, passivity_test
-from .baseline import fit_radiation_hankel
+from .radiation import (RadiationModel, convolution_force, fit_radiation, impulse_response,
+                        kernel_data)
 
 __all__ = [
     "read_netcdf", "write_netcdf_atomic",
@@ -24,4 +26,5 @@ __all__ = [
     "to_body_frames", "dof_map", "shift_matrix", "skew", "zup_to_ned",
     "RadiationModel", "fit_radiation", "impulse_response", "convolution_force", "kernel_data",
     "PassivityReport", "passivity_test", "enforce_passivity", "absorbed_energy", "fit_radiation_hankel",
+    "HydroModel", "load_hydro_model", "load_hydro_data", "fit_hydro_model", "geometry_dict",
 ]

@@ -29,7 +29,8 @@ from mbcontrol.hydro import _io
 from mbcontrol.hydro.frames import to_body_frames, zup_to_ned
 from mbcontrol.hydro.geometry import RIGID_DOFS
 
-from .checks import body_name_list, build_dataset, clean, finish_attrs
+from .checks import clean
+from .layout import body_name_list, build_dataset, finish_attrs
 
 _FREQ_DIMS = ("omega", "freq", "period", "wavenumber", "wavelength")
 

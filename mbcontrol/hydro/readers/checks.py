@@ -1,8 +1,9 @@
-"""Layout, validation and cleaning shared by the hydrodynamic data readers.
+"""Validation and cleaning shared by the hydrodynamic data readers.
 
-Every reader builds its result with :func:`build_dataset` (the data-frame layout that
-:func:`mbcontrol.hydro.bem.compute` assembles before :func:`~mbcontrol.hydro.to_body_frames`)
-and passes it through :func:`clean`, which checks and repairs it the same way for every format.
+Every reader builds its result with :func:`~mbcontrol.hydro.readers.layout.build_dataset` (the
+data-frame layout that :func:`mbcontrol.hydro.bem.compute` assembles before
+:func:`~mbcontrol.hydro.to_body_frames`) and passes it through :func:`clean`, which checks and
+repairs it the same way for every format.
 
 Scales. Added mass and damping mix units (kg, kg m, kg m²), so every relative measure below is
 taken on the scaled matrix S = D^{-1/2} X D^{-1/2}, with D = diag(s_k): s_k is the largest
@@ -11,161 +12,22 @@ S is dimensionless and its largest diagonal entry over the frequency range is 1.
 """
 from __future__ import annotations
 
-import re
 import warnings
 
 import numpy as np
 import xarray as xr
 
-from mbcontrol.errors import HydroError
-from mbcontrol.hydro.bem import _UNITS as BODY_FRAME_UNITS
-from mbcontrol.hydro.frames import split_dof
-from mbcontrol.hydro.geometry import RIGID_DOFS
+from ...errors import HydroError
+from ..frames import split_dof
+from .damping import repair_negative_damping
+from .layout import MAT, HydroCleaningWarning, fmt_omega, force_first, kind_scales, set_force_first
 
-MAT = ("radiating_dof", "influenced_dof")
-WRENCH = ("wave_direction", "omega", "influenced_dof")
-MATRIX_LAYOUT = "X[radiating_dof, influenced_dof]; force_i = -sum_j X[j, i] * motion_j"
-TIME_CONVENTION = "exp(-i omega t)"
-DATA_FRAME = "BEM data frame: z up, x forward, y port, origin on the undisturbed free surface"
-# the body-frame units of bem.py, with positions in the data frame (before to_body_frames)
-UNITS = {**{k: v for k, v in BODY_FRAME_UNITS.items() if k != "mass"},
-         "center_of_buoyancy": "m (data frame, z up)", "cog": "m (data frame, z up)",
-         "reference_point": "m (data frame, z up)"}
 # Defaults of clean(); documented there.
 ASYM_TOL = 1e-3
 DIAG_TOL = 1e-6
 EIG_TOL = 1e-3
 MAX_INTERP_RUN = 3
 END_ZERO_TOL = 1e-2
-
-
-class HydroCleaningWarning(UserWarning):
-    """A reader changed data values (negative damping repaired, large asymmetry forced away)."""
-
-
-# ----------------------------------------------------------------------------- names
-def sanitize_name(name: str, fallback: str) -> str:
-    """A body name usable in DOF and signal names: letters, digits and single underscores."""
-    s = re.sub(r"[^0-9A-Za-z_]+", "_", str(name).strip())
-    s = re.sub(r"_{2,}", "_", s).strip("_")
-    return s or fallback
-
-
-def body_name_list(found: list[str], n: int, body_names, path) -> tuple[list[str], list[str]]:
-    """Final body names (``body_names`` if given, else ``found``), sanitised and distinct, plus notes."""
-    notes = []
-    if body_names is not None:
-        names = [str(b) for b in body_names]
-        if len(names) != n:
-            raise HydroError(f"{path}: body_names has {len(names)} name(s) {names}; the file holds {n} "
-                             "bod(y/ies): expected one name per body, in file order")
-    else:
-        names = list(found) if len(found) == n else [f"body{k + 1}" for k in range(n)]
-        if len(found) != n:
-            notes.append(f"body names not found for all {n} bodies in the file; named body1..body{n}")
-    out = []
-    for k, b in enumerate(names):
-        s = sanitize_name(b, f"body{k + 1}")
-        while s in out:
-            s = f"{s}_{k + 1}"
-        if s != b:
-            notes.append(f"body name {b!r} sanitised to {s!r} (no dots, no '__')")
-        out.append(s)
-    return out, notes
-
-
-def dof_names(bodies: list[str]) -> list[str]:
-    return [f"{b}__{d}" for b in bodies for d in RIGID_DOFS]
-
-
-# ----------------------------------------------------------------------------- layout
-def build_dataset(*, bodies, dofs, omega, A, B, K, exc, headings, A0=None, Ainf=None, fk=None, diff=None,
-                  volume, cob, ref, cog=None, awp=None, rho, g, depth, source, notes=()) -> xr.Dataset:
-    """The data-frame dataset of the readers from arrays in force-first layout.
-
-    Matrices are given as X[..., i_force, j_motion] (A, B: (nω, n, n); K, A0, Ainf: (n, n));
-    wrenches as F[heading, ω, i] (complex, e^{-iωt}, per m of wave amplitude); points (nb, 3)
-    in the data frame (z up). A0/Ainf None -> NaN. Values must already be dimensional SI.
-    """
-    n = len(dofs)
-    nan = np.full((n, n), np.nan)
-    f2m = lambda x: np.swapaxes(np.asarray(x, dtype=float), -1, -2)  # noqa: E731  force-first -> (rad, inf)
-    data = {
-        "added_mass": (("omega",) + MAT, f2m(A)),
-        "radiation_damping": (("omega",) + MAT, f2m(B)),
-        "added_mass_zero": (MAT, f2m(nan if A0 is None else A0)),
-        "added_mass_inf": (MAT, f2m(nan if Ainf is None else Ainf)),
-        "hydrostatic_stiffness": (MAT, f2m(K)),
-        "excitation_force": (WRENCH, np.asarray(exc, dtype=complex)),
-        "displaced_volume": (("body",), np.asarray(volume, dtype=float)),
-        "center_of_buoyancy": (("body", "xyz"), np.asarray(cob, dtype=float)),
-        "reference_point": (("body", "xyz"), np.asarray(ref, dtype=float)),
-    }
-    if fk is not None:
-        data["froude_krylov_force"] = (WRENCH, np.asarray(fk, dtype=complex))
-    if diff is not None:
-        data["diffraction_force"] = (WRENCH, np.asarray(diff, dtype=complex))
-    if cog is not None:
-        data["cog"] = (("body", "xyz"), np.asarray(cog, dtype=float))
-    if awp is not None:
-        data["waterplane_area"] = (("body",), np.asarray(awp, dtype=float))
-    ds = xr.Dataset(data, coords={"omega": np.asarray(omega, dtype=float), "radiating_dof": list(dofs),
-                                  "influenced_dof": list(dofs), "wave_direction": np.asarray(headings, float),
-                                  "body": list(bodies), "xyz": ["x", "y", "z"]})
-    notes = list(notes)
-    for name, arr in (("added_mass_zero", A0), ("added_mass_inf", Ainf)):
-        if arr is None:
-            ds[name].attrs["note"] = "NaN: not in the file"
-            notes.append(f"{name}: not in the file, stored as NaN")
-    return finish_attrs(ds, rho=rho, g=g, depth=depth, source=source, notes=notes)
-
-
-def finish_attrs(ds, *, rho, g, depth, source, notes) -> xr.Dataset:
-    for v, u in UNITS.items():
-        if v in ds:
-            ds[v].attrs["units"] = u
-    ds["reference_point"].attrs["long_name"] = "point the body's matrices and wrenches refer to"
-    ds["omega"].attrs.update(units="rad/s", long_name="wave angular frequency")
-    ds["wave_direction"].attrs.update(units="rad", long_name="data-frame heading waves travel to, +x towards +y")
-    ds.attrs.update({
-        "rho": float(rho), "g": float(g), "depth": float(depth), "source": str(source),
-        "time_convention": TIME_CONVENTION, "frame": DATA_FRAME, "matrix_layout": MATRIX_LAYOUT,
-        "excitation_reference": "unit wave amplitude, elevation positive up, at the data-frame origin",
-        "notes": list(notes),
-    })
-    return ds
-
-
-# ----------------------------------------------------------------------------- helpers
-def _fmt_w(w: float) -> str:
-    if w == 0:
-        return "ω = 0"
-    if not np.isfinite(w):
-        return f"ω = {w}"
-    return f"ω = {w:.6g} rad/s (T = {2 * np.pi / w:.6g} s)"
-
-
-def _kind_scales(dofs, diag_abs_max) -> np.ndarray:
-    """Per-DOF scale s_k: the largest |X_kk| among DOFs of the same kind (translation / rotation)."""
-    rot = np.array([split_dof(d)[1] in ("Roll", "Pitch", "Yaw") for d in dofs])
-    d = np.asarray(diag_abs_max, dtype=float)
-    s = np.zeros(len(dofs))
-    for mask in (rot, ~rot):
-        if mask.any():
-            s[mask] = np.nanmax(d[mask]) if np.any(np.isfinite(d[mask])) else 0.0
-    pos = s[s > 0]
-    return np.where(s > 0, s, pos.max() if pos.size else 1.0)
-
-
-def _force_first(da: xr.DataArray) -> np.ndarray:
-    return da.transpose(..., "influenced_dof", "radiating_dof").values
-
-
-def _set_force_first(ds, name, x):
-    da = ds[name]
-    new = da.transpose(..., "influenced_dof", "radiating_dof").copy(data=x).transpose(*da.dims)
-    new.attrs = dict(da.attrs)
-    ds[name] = new
 
 
 # ----------------------------------------------------------------------------- checks
@@ -215,11 +77,11 @@ def _check_omega(ds, src, notes):
         hit = np.where(w == value)[0]
         if hit.size:
             if hit.size > 1:
-                raise HydroError(f"{src}: duplicate frequency {_fmt_w(value)} ({hit.size} times)")
+                raise HydroError(f"{src}: duplicate frequency {fmt_omega(value)} ({hit.size} times)")
             a = ds["added_mass"].isel(omega=int(hit[0]))
             if target not in ds or not np.any(np.isfinite(ds[target].values)):
                 ds[target] = a.drop_vars("omega").transpose(*MAT)
-                notes.append(f"{target}: taken from the {_fmt_w(value)} entry of the frequency list")
+                notes.append(f"{target}: taken from the {fmt_omega(value)} entry of the frequency list")
             ds = ds.isel(omega=np.where(w != value)[0])
             w = np.asarray(ds["omega"].values, dtype=float)
     bad = ~np.isfinite(w) | (w <= 0)
@@ -229,7 +91,7 @@ def _check_omega(ds, src, notes):
         raise HydroError(f"{src}: missing frequencies: no finite ω > 0 in the file")
     uniq, counts = np.unique(w, return_counts=True)
     if np.any(counts > 1):
-        raise HydroError(f"{src}: duplicate frequency {_fmt_w(float(uniq[counts > 1][0]))} "
+        raise HydroError(f"{src}: duplicate frequency {fmt_omega(float(uniq[counts > 1][0]))} "
                          f"({int(counts[counts > 1][0])} times); expected each frequency once")
     if np.any(np.diff(w) < 0):
         ds = ds.sortby("omega")
@@ -300,7 +162,7 @@ def _check_finite(ds, src, notes):
             continue
         if not np.all(np.isfinite(ds[name].values)):
             w, where = _first_bad(ds[name])
-            at = f" at {_fmt_w(w)}" if w is not None else ""
+            at = f" at {fmt_omega(w)}" if w is not None else ""
             raise HydroError(f"{src}: {name} has NaN or infinite values{at} ({where}); "
                              f"expected finite numbers — missing or corrupt data in the file")
     for name in ("added_mass_zero", "added_mass_inf"):
@@ -322,10 +184,10 @@ def _symmetry(ds, src, record, notes, *, tol, force):
     families = {"added_mass": ("added_mass", "added_mass_zero", "added_mass_inf"),
                 "radiation_damping": ("radiation_damping",)}
     for fam, names in families.items():
-        mats = {v: _force_first(ds[v]) for v in names if v in ds and np.all(np.isfinite(ds[v].values))}
+        mats = {v: force_first(ds[v]) for v in names if v in ds and np.all(np.isfinite(ds[v].values))}
         diag = np.max([np.abs(np.diagonal(x, axis1=-2, axis2=-1)).reshape(-1, len(dofs)).max(0)
                        for x in mats.values()], axis=0)
-        s = np.sqrt(_kind_scales(dofs, diag))
+        s = np.sqrt(kind_scales(dofs, diag))
         for v, x in mats.items():
             S = x / np.outer(s, s)
             diff = np.abs(S - np.swapaxes(S, -1, -2))
@@ -335,7 +197,7 @@ def _symmetry(ds, src, record, notes, *, tol, force):
             flat = np.unravel_index(int(np.argmax(diff)), diff.shape)
             i, j = flat[-2], flat[-1]
             w = float(ds["omega"].values[flat[0]]) if x.ndim == 3 else None
-            where = (f"{dofs[i]} / {dofs[j]}" + (f" at {_fmt_w(w)}" if w is not None else ""))
+            where = (f"{dofs[i]} / {dofs[j]}" + (f" at {fmt_omega(w)}" if w is not None else ""))
             vals = (x[flat], x[flat[:-2] + (j, i)])
             info = {"max_relative_asymmetry": worst, "where": where, "values": [float(vals[0]), float(vals[1])]}
             if worst > tol:
@@ -346,130 +208,13 @@ def _symmetry(ds, src, record, notes, *, tol, force):
                     raise HydroError(msg + " — pass force_symmetric=True to symmetrise it anyway")
                 warnings.warn(msg + "; symmetrised because force_symmetric=True", HydroCleaningWarning, stacklevel=4)
                 info["forced"] = True
-            _set_force_first(ds, v, 0.5 * (x + np.swapaxes(x, -1, -2)))
+            set_force_first(ds, v, 0.5 * (x + np.swapaxes(x, -1, -2)))
             record.setdefault("symmetrised", {})[v] = info
         done = [record["symmetrised"][v]["max_relative_asymmetry"] for v in names
                 if v in record.get("symmetrised", {})]
         if done:
             notes.append(f"{fam} family symmetrised (X + Xᵀ)/2; largest relative asymmetry {max(done):.3g} "
                          "(scaled by the largest diagonal of the same DOF kind)")
-
-
-def _nearest_psd(X, scale):
-    """Nearest positive semi-definite matrix to X (Frobenius norm of the scaled matrix), exactly symmetric."""
-    lam, vec = np.linalg.eigh(0.5 * (X + X.T) / scale)
-    P = (vec * np.clip(lam, 0.0, None)) @ vec.T
-    return 0.5 * (P + P.T) * scale
-
-
-def _flag_damping(Ss, diag_tol, eig_tol):
-    """Per frequency: flagged?, set of offending DOF indices, min scaled eigenvalue."""
-    out = []
-    for S in Ss:
-        d = np.diagonal(S)
-        off = set(np.where(d < -diag_tol)[0].tolist())
-        lam, vec = np.linalg.eigh(0.5 * (S + S.T))
-        neg = lam < -eig_tol
-        for k in np.where(neg)[0]:
-            off |= set(np.where(vec[:, k] ** 2 >= 0.1)[0].tolist())
-        out.append((bool(off), off, float(lam[0])))
-    return out
-
-
-def _negative_damping(ds, src, record, notes, *, diag_tol, eig_tol, max_run, end_zero_tol, mode):
-    dofs = [str(d) for d in ds["radiating_dof"].values]
-    w = np.asarray(ds["omega"].values, dtype=float)
-    B = _force_first(ds["radiation_damping"]).copy()
-    s = np.sqrt(_kind_scales(dofs, np.abs(np.diagonal(B, axis1=1, axis2=2)).max(0)))
-    scale = np.outer(s, s)
-    flags = _flag_damping(B / scale, diag_tol, eig_tol)
-    bad = np.array([f[0] for f in flags])
-    if not bad.any():
-        return ds
-    if mode == "error":
-        k = int(np.argmax(bad))
-        raise HydroError(f"{src}: negative radiation damping at {int(bad.sum())} frequencies, first {_fmt_w(w[k])} "
-                         f"(DOFs {[dofs[i] for i in sorted(flags[k][1])]}, min scaled eigenvalue "
-                         f"{flags[k][2]:.3g}); expected B(ω) positive semi-definite")
-    n = len(w)
-    runs, k = [], 0
-    while k < n:
-        if bad[k]:
-            k1 = k
-            while k1 + 1 < n and bad[k1 + 1]:
-                k1 += 1
-            runs.append((k, k1))
-            k = k1 + 1
-        else:
-            k += 1
-    changes = []
-    for k0, k1 in runs:
-        idx = list(range(k0, k1 + 1))
-        off = sorted(set().union(*(flags[i][1] for i in idx)))
-        before = min(flags[i][2] for i in idx)
-        interior = k0 > 0 and k1 < n - 1
-        small = max(abs(B[i, j, j] / scale[j, j]) for i in idx for j in off) <= end_zero_tol
-        still = lambda: any(f[0] for f in _flag_damping(B[idx] / scale, diag_tol, eig_tol))  # noqa: E731
-        if interior and len(idx) <= max_run:
-            lo, hi = k0 - 1, k1 + 1
-            for rows_only in (True, False):
-                for i in idx:
-                    t = (w[i] - w[lo]) / (w[hi] - w[lo])
-                    interp = (1 - t) * B[lo] + t * B[hi]
-                    if rows_only:
-                        Bi = B[i]  # a view: row/column assignment without advanced-index transposition
-                        Bi[off, :] = interp[off, :]
-                        Bi[:, off] = interp[:, off]
-                    else:
-                        B[i] = interp
-                if not still():
-                    break
-                off = list(range(len(dofs)))  # rows/columns alone were not enough: whole matrices
-            method = ("linear interpolation in ω from the neighbouring frequencies ("
-                      + ("rows and columns of these DOFs)" if len(off) < len(dofs) else "whole matrix)"))
-        elif not interior and small:
-            for i in idx:
-                Bi = B[i]
-                Bi[off, :] = 0.0
-                Bi[:, off] = 0.0
-            method = ("set to 0 (rows and columns of these DOFs): the run touches the end of the frequency range "
-                      f"and |B_kk| there is below {end_zero_tol:g} of its scale, consistent with B -> 0")
-        else:
-            method = None
-        if method is None or still():
-            if mode != "project":
-                why = ("cannot be repaired from neighbouring frequencies" if method is None else
-                       f"remains after {method.split(' (')[0]}")
-                where = ("over the end of the range, where B is not small" if not interior else
-                         f"over {len(idx)} consecutive frequencies" + (f" (more than {max_run})"
-                                                                      if len(idx) > max_run else ""))
-                raise HydroError(
-                    f"{src}: negative radiation damping {where}: {_fmt_w(w[k0])} to {_fmt_w(w[k1])}, DOFs "
-                    f"{[dofs[j] for j in off]}, min scaled eigenvalue {before:.3g}; expected B(ω) positive "
-                    f"semi-definite. It {why} — pass negative_damping='project' to use the nearest positive "
-                    "semi-definite matrix there, or fix the BEM run")
-            for i in idx:
-                B[i] = _nearest_psd(B[i], scale)
-            off = list(range(len(dofs)))
-            method = ("nearest positive semi-definite matrix (negative eigenvalues of the scaled B set to 0)"
-                      if method is None else method + ", then nearest positive semi-definite matrix")
-        changes.append({"omega": [float(w[i]) for i in idx], "dofs": [dofs[j] for j in off],
-                        "method": method, "min_scaled_eigenvalue_before": before})
-    _set_force_first(ds, "radiation_damping", B)
-    record["negative_damping"] = changes
-    nw = sum(len(c["omega"]) for c in changes)
-    runs_txt = [f"{c['omega'][0]:.4g}" + (f"..{c['omega'][-1]:.4g}" if len(c["omega"]) > 1 else "") for c in changes]
-    touched = sorted({d for c in changes for d in c["dofs"]}, key=dofs.index)
-    kinds = {}
-    for c in changes:
-        key = c["method"].split(" (")[0].split(":")[0]
-        kinds[key] = kinds.get(key, 0) + len(c["omega"])
-    text = (f"negative radiation damping repaired at {nw} frequencies (ω = {', '.join(runs_txt)} rad/s; DOFs "
-            f"{touched}; " + "; ".join(f"{k}: {v}" for k, v in kinds.items())
-            + "); details in attrs['cleaning']['negative_damping']")
-    notes.append(text)
-    warnings.warn(f"{src}: {text}", HydroCleaningWarning, stacklevel=4)
-    return ds
 
 
 # ----------------------------------------------------------------------------- public
@@ -521,8 +266,8 @@ def clean(ds: xr.Dataset, *, source: str, asym_tol: float = ASYM_TOL, force_symm
         ds = _crop(ds, src, omega_range, notes)
     ds = _check_finite(ds, src, notes)
     _symmetry(ds, src, record, notes, tol=float(asym_tol), force=bool(force_symmetric))
-    ds = _negative_damping(ds, src, record, notes, diag_tol=float(diag_tol), eig_tol=float(eig_tol),
-                           max_run=int(max_interp_run), end_zero_tol=float(end_zero_tol), mode=negative_damping)
+    ds = repair_negative_damping(ds, src, record, notes, diag_tol=float(diag_tol), eig_tol=float(eig_tol),
+                                 max_run=int(max_interp_run), end_zero_tol=float(end_zero_tol), mode=negative_damping)
     ds.attrs["notes"] = notes
     ds.attrs["cleaning"] = record
     ds.attrs.setdefault("source", src)

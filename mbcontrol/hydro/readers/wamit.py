@@ -26,7 +26,8 @@ import numpy as np
 
 from mbcontrol.errors import HydroError
 
-from .checks import body_name_list, build_dataset, clean, dof_names
+from .checks import clean
+from .layout import body_name_list, build_dataset, dof_names
 
 _F = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[EeDd][-+]?\d+)?|[-+]?(?:nan|NaN|NAN|inf|Inf|Infinity)"
 _FLOAT = re.compile(_F)

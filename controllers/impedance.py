@@ -1,0 +1,159 @@
+"""What a PTO sees in linear theory: its intrinsic impedance and equivalent excitation, the
+frequency-domain statistics of a damper-spring law, and the stability of its closed loop.
+
+Phasors exp(+i omega t), as in `mbcontrol.analysis` and python-control (see
+`controllers.reactive` for the conventions of Z_i and the PTO impedance).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+
+def base_params(plant, pto: str, params=None) -> dict:
+    """Parameters of the plant as a controller sees it: no Coulomb friction (linear theory
+    cannot hold it) and every PTO's own law zeroed (in closed loop the controller owns it)."""
+    base = dict(params or {})
+    for friction in plant.scene.frictions:
+        base.setdefault(f"{friction.name}__coulomb", 0.0)
+    for other in plant.scene.ptos:
+        if other.name != pto:
+            base.setdefault(f"{other.name}__damping", 0.0)
+            base.setdefault(f"{other.name}__stiffness", 0.0)
+    base.setdefault(f"{pto}__stiffness", 0.0)
+    return base
+
+
+def intrinsic_impedance(plant, omega, *, pto: str | None = None, params=None,
+                        direction: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """(Z_i, F_eq) at each omega (rad/s), exp(+i omega t): the PTO's Thevenin equivalent.
+
+    Z_i (N s/m or N m s/rad): the impedance the PTO sees (everything but the PTO: inertia,
+    added mass, radiation damping, restoring, the other PTOs as set by params); F_eq (N per m
+    of wave amplitude): the force that drives it, so that with a PTO impedance Z_pto the PTO
+    velocity is F_eq / (Z_i + Z_pto). Read off two FD solutions (mbcontrol.analysis) with
+    different PTO damping c: V(c) = F_eq / (Z_i + c) is exact for a linear model, for any
+    number of bodies.
+    """
+    from mbcontrol.analysis import frequency_domain_response
+    name = pto or plant.scene.ptos[0].name
+    omega = np.atleast_1d(np.asarray(omega, float))
+    base = base_params(plant, name, params)
+
+    def velocity(c: float) -> np.ndarray:
+        return frequency_domain_response(plant, omega, direction=direction,
+                                         params={**base, f"{name}__damping": c},
+                                         outputs=[f"{name}__velocity"])[:, 0]
+
+    v0 = velocity(0.0)
+    # first pass with a unit damper (exact, but poorly conditioned if |Z_i| >> 1), then
+    # again with a damper of the size of Z_i, which keeps V0 - Vc well away from round-off
+    Z = None
+    for c in (1.0, None):
+        c = c if c is not None else float(np.median(np.abs(Z)))
+        vc = velocity(c)
+        Z = c * vc / (v0 - vc)
+    return Z, v0 * Z
+
+
+def complex_conjugate_power(plant, wave, *, pto: str | None = None, params=None) -> float:
+    """The upper bound of mean absorbed power in `wave` (W): sum |F_eq a|^2 / (8 Re Z_i)."""
+    Z, F = intrinsic_impedance(plant, wave.omega, pto=pto, params=params,
+                               direction=wave.direction)
+    return float(np.sum(np.abs(F * wave.amplitude) ** 2 / (8 * Z.real)))
+
+
+def closed_loop_stability(plant, damping: float, stiffness: float, *, pto: str | None = None,
+                          params=None) -> tuple[bool, float]:
+    """Is the linearised plant stable under u = -(damping v + stiffness x)? (stable, margin).
+
+    margin (1/s): minus the largest real part of the closed-loop poles (python-control); > 0
+    when stable, the decay rate of the slowest mode. Linearised about rest, with no Coulomb
+    friction and the PTO's own law zeroed, as in closed-loop simulation.
+    """
+    margin = margin_function(plant, pto or plant.scene.ptos[0].name, params)(damping, stiffness)
+    return margin > 0, margin
+
+
+def margin_function(plant, name: str, params=None):
+    """(damping, stiffness) -> stability margin (1/s), from one linearisation."""
+    import control
+
+    from mbcontrol.analysis import linearize
+    base = base_params(plant, name, params)
+    base[f"{name}__damping"] = 0.0
+    sys = linearize(plant, params=base, inputs=[f"u__{name}"],
+                    outputs=[f"{name}__position", f"{name}__velocity"])
+
+    def margin(damping: float, stiffness: float) -> float:
+        gain = np.array([[float(stiffness), float(damping)]])     # u = -gain @ [x, v]
+        return -float(np.max(control.feedback(sys, gain, sign=-1).poles().real))
+    return margin
+
+
+def fd_statistics(Z, F, wave, damping, stiffness, *, efficiency: float | None = None,
+                  exceedance: float = 0.01) -> dict:
+    """Linear-theory statistics of u = -(damping v + stiffness x) in `wave` (exp(+i omega t)).
+
+    Z, F: intrinsic_impedance at wave.omega. damping (N s/m) and stiffness (N/m) broadcast
+    (arrays give arrays). Per component j the PTO velocity is V_j = F_j a_j / (Z_j + c - i k /
+    omega_j), its position X_j = V_j / (i omega_j), its force U_j = -(c V_j + k X_j). Keys:
+
+    - power_W: mean absorbed power sum c |V_j|^2 / 2 (W);
+    - electrical_W: mean electrical power with `efficiency` eta, eta P when absorbing and P /
+      eta when the PTO drives the body (as metrics.electrical_power); None: power_W. A regular
+      wave's P(t) = A + B cos(2 omega t) is split exactly; in a sea P = -u v with u and v jointly
+      Gaussian, E|P| = s_u s_v (2 / pi)(sqrt(1 - r^2) + r asin r) (r their correlation);
+    - stroke_peak (m), force_peak (N): a regular wave's amplitudes |X a|, |U a|; in a sea the
+      level b that the record of length T (the wave's repeat period 2 pi / d_omega) crosses,
+      upwards or downwards, with expected count `exceedance` by Rice's formula,
+      2 (T / T_z) exp(-b^2 / 2 s^2) = exceedance, b = s sqrt(2 ln(2 T / (T_z exceedance))):
+      a peak factor b / s of 4.5 for 150 zero-crossing periods and the default 1 % (T_z =
+      2 pi s / s', the mean zero-crossing period from the spectral moments). The chance that
+      the record's largest value exceeds b is at most about `exceedance`: Rice counts
+      crossings, and they come in clusters (tests/test_limits.py measures 2-3 % of random-phase
+      records at exceedance 10 %);
+    - stroke_std, force_std: standard deviations (m, N).
+    """
+    w, a = np.asarray(wave.omega, float), np.asarray(wave.amplitude, float)
+    c = np.asarray(damping, float)[..., None]
+    k = np.asarray(stiffness, float)[..., None]
+    V = F * a / (Z + c - 1j * k / w)
+    X = V / (1j * w)
+    U = -(c * V + k * X)
+    power = np.sum(0.5 * c * np.abs(V) ** 2, axis=-1)
+    var = {name: 0.5 * np.sum(np.abs(z) ** 2, axis=-1) for name, z in
+           (("x", X), ("v", V), ("u", U), ("du", w * U))}
+    s_x, s_v, s_u = (np.sqrt(var[n]) for n in ("x", "v", "u"))
+    if w.size == 1:
+        stroke, force = np.sqrt(2) * s_x, np.sqrt(2) * s_u           # amplitudes
+        half = s_u * s_v                                             # B = |U| |V| / 2
+        with np.errstate(divide="ignore", invalid="ignore"):
+            theta = np.arccos(np.clip(np.where(half > 0, -power / half, -1.0), -1, 1))
+        positive = (power * theta + half * np.sin(theta)) / np.pi   # E[max(P, 0)]
+    else:
+        record = 2 * np.pi / (wave.d_omega or np.min(np.diff(np.sort(w))))
+
+        def peak(s, s_rate):
+            crossings = record * s_rate / (np.pi * np.maximum(s, 1e-300))   # 2 T / T_z
+            return s * np.sqrt(2 * np.log(np.maximum(crossings / exceedance, 1.0)))
+        stroke, force = peak(s_x, s_v), peak(s_u, np.sqrt(var["du"]))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            r = np.clip(np.where(s_u * s_v > 0, -power / (s_u * s_v), 0.0), -1, 1)
+        mean_abs = s_u * s_v * (2 / np.pi) * (np.sqrt(1 - r ** 2) + r * np.arcsin(r))
+        positive = 0.5 * (power + mean_abs)
+    if efficiency is None:
+        electrical = power
+    else:
+        electrical = efficiency * positive + (power - positive) / efficiency
+    return {"power_W": power, "electrical_W": electrical, "stroke_peak": stroke,
+            "force_peak": force, "stroke_std": s_x, "force_std": s_u}
+
+
+def default_bounds(plant, wave, name: str, params) -> tuple[float, float]:
+    """1e-3 to 1e3 times |Z_i| (N s/m or N m s/rad) at the wave's most energetic component."""
+    from mbcontrol.analysis import pto_thevenin
+    k = int(np.argmax(wave.amplitude))
+    scale = float(np.abs(pto_thevenin(plant, wave.omega[k:k + 1], pto=name,
+                                      direction=wave.direction, params=params,
+                                      check_passive=False).impedance[0]))
+    return 1e-3 * scale, 1e3 * scale

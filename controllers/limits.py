@@ -1,0 +1,50 @@
+"""PTO force limits shared by every controller: per-PTO limits, saturation (numeric and
+CasADi) and their report."""
+from __future__ import annotations
+
+import math
+
+import casadi as ca
+import numpy as np
+
+from .base import per_pto
+
+
+def force_limits(plant, force_max=None) -> np.ndarray:
+    """Per-PTO force limit (N or N m, > 0, inf: none), scene order.
+
+    force_max None: each scene PTO's own force_max; a number: that limit on every PTO; a dict
+    by PTO name: those PTOs' limits, the others keep their scene limit.
+    """
+    ptos = plant.scene.ptos
+    limits = np.array([p.force_max for p in ptos], float)
+    if isinstance(force_max, dict):
+        per_pto(plant, force_max, "force_max")          # rejects unknown PTO names
+        limits = np.array([float(force_max.get(p.name, p.force_max)) for p in ptos])
+    elif force_max is not None:
+        limits = np.full(len(ptos), float(force_max))
+    if not np.all(limits > 0):                           # NaN fails too
+        raise ValueError(f"{plant.name}: force_max must be > 0 (inf: none), got {limits}")
+    return limits
+
+
+def saturate(u: np.ndarray, limits: np.ndarray) -> np.ndarray:
+    """u clipped to +-limits (inf limits leave u unchanged)."""
+    return np.clip(u, -limits, limits)
+
+
+def casadi_saturate(u, limits: np.ndarray):
+    """The CasADi expression of `saturate`: fmin/fmax on the PTOs with a finite limit only,
+    so a law without limits is the very expression it was before limits existed."""
+    if np.all(np.isinf(limits)):
+        return u
+    return ca.vertcat(*[u[i] if math.isinf(f) else ca.fmin(ca.fmax(u[i], -f), f)
+                        for i, f in enumerate(limits)])
+
+
+def limits_report(limits) -> list | None:
+    """describe()'s view of the force limits: one per PTO, None where there is none (JSON
+    has no infinity); None before reset."""
+    if limits is None:
+        return None
+    return [float(f) if math.isfinite(f) else None for f in limits]

@@ -1,0 +1,251 @@
+"""The MPC's quadratic programme: condensed (states eliminated), scaled, built once, solved
+by qpOASES (real-time path) or cvxpy/Clarabel (prototyping path); see `controllers.mpc`."""
+from __future__ import annotations
+
+import numpy as np
+
+
+class CondensedQp:
+    """The MPC's QP in the forces alone (states eliminated), scaled to O(1) and built once.
+
+    Variables (scaled): U / F_s (N nu, step-major) and, with a finite stroke limit and
+    soft_stroke, slacks s / L_s (N nu). F_s: the force limit (or L_s / lambda_max(G) if
+    unlimited); L_s: the stroke limit (or 1 m). solve(z0, D, u_prev, warm) -> (U (N, nu) or
+    None, status).
+    """
+
+    def __init__(self, cp, N: int, limits: dict, *, efficiency, loss_damping,
+                 force_penalty: float, stroke_penalty: float, soft_stroke: bool, solver: str):
+        nu, nz = len(cp.ptos), cp.nz
+        self.N, self.nu, self.solver = N, nu, solver
+        # prediction of the positions at the ends of steps 1..N
+        powers = [np.eye(nz)]
+        for _ in range(N):
+            powers.append(cp.Ad @ powers[-1])
+        Phi = np.vstack([cp.Cp @ powers[k] for k in range(1, N + 1)])          # (N nu, nz)
+        Psi = np.zeros((N * nu, N * nu))
+        Om = np.zeros((N * nu, N * cp.nd))
+        for k in range(1, N + 1):
+            for j in range(k):
+                Psi[(k - 1) * nu:k * nu, j * nu:(j + 1) * nu] = cp.Cp @ powers[k - 1 - j] @ cp.Bu
+                Om[(k - 1) * nu:k * nu, j * cp.nd:(j + 1) * cp.nd] = cp.Cp @ powers[k - 1 - j] @ cp.Bd
+        L = np.eye(N * nu) - np.eye(N * nu, k=-nu)       # P -> increments
+        E = np.zeros((N * nu, nu))
+        E[:nu] = np.eye(nu)
+        G = L @ Psi
+        Gs = 0.5 * (G + G.T)
+        lam = float(np.max(np.linalg.eigvalsh(Gs)))
+        if lam <= 0:
+            raise ValueError("mpc: the control plant absorbs no energy from the PTO (energy "
+                             "Hessian not positive); check the PTO and the model")
+        self.passivity_defect = float(max(-np.min(np.linalg.eigvalsh(Gs)) / lam, 0.0))
+        force, stroke, rate = limits["force"], limits["stroke"], limits["rate"]
+        Ls = float(np.max(stroke)) if np.all(np.isfinite(stroke)) else 1.0
+        Fs = float(np.max(force)) if np.all(np.isfinite(force)) else Ls / lam
+        r = force_penalty * lam
+        # electrical power with efficiency eta: P_e = a P - (1/eta - eta)/2 |P|, a = (eta +
+        # 1/eta)/2, and |P| <= (F^2/c + c v^2)/2 for any c > 0 (equal at |F| = c |v|): a
+        # concave minorant, with c the device's impedance |Z_i| (the passive optimum) and
+        # v = increment / dt. With increments G U + q the minimised cost (J) is
+        #   U'(aG)U + a q'U + b dt/c |U|^2 + b c/dt |G U + q|^2,   b = (1/eta - eta)/4
+        eta = np.tile(np.asarray(efficiency, float), N)
+        a, b = 0.5 * (eta + 1 / eta), 0.25 * (1 / eta - eta)
+        c = np.tile(np.asarray(loss_damping, float), N)
+        loss_u, loss_v = b * cp.dt / c, b * c / cp.dt
+        quad = 0.5 * (a[:, None] * G + (a[:, None] * G).T) + np.diag(loss_u) \
+            + G.T @ (loss_v[:, None] * G) + r * np.eye(N * nu)
+        # scaled (objective / (F_s L_s)), clipped to PSD against round-off
+        w, V = np.linalg.eigh(2 * Fs / Ls * quad)
+        self.H_u = (V * np.clip(w, 2 * r * Fs / Ls * 1e-3, None)) @ V.T
+        W = np.diag(a) + 2 * G.T * loss_v[None, :]          # linear term W q
+        self.Qz = W @ (L @ Phi - E @ cp.Cp) / Ls             # q = Qz z0 + Qd D (scaled)
+        self.Qd = W @ (L @ Om) / Ls
+        self.Phi, self.Om, self.Psi = Phi, Om, Psi
+        self.Fs, self.Ls, self.stroke_penalty = Fs, Ls, stroke_penalty
+        self.has_stroke = bool(np.all(np.isfinite(stroke)))
+        self.stroke = np.tile(stroke, N) / Ls
+        self.force = np.tile(force, N) / Fs
+        self.has_rate = bool(np.all(np.isfinite(rate)))
+        self.rate = np.tile(rate * cp.dt, N) / Fs
+        backend = _QpoasesBackend if solver == "qpoases" else _CvxpyBackend
+        # the exact L1 penalty makes the soft QP's solution the hard one's whenever the hard
+        # QP is feasible: solve the hard QP (half the variables) and the soft one only when
+        # it is infeasible
+        self.forms = [_QpForm(self, soft=False, backend=backend)]
+        if soft_stroke and self.has_stroke:
+            self.forms.append(_QpForm(self, soft=True, backend=backend))
+        self._last, self.soft_solves = 0, 0
+
+    def solve(self, z0, D, u_prev, warm=None):
+        """(U (N, nu) N or N m, status), or (None, status) when no form could be solved."""
+        z0, D, u_prev = np.asarray(z0, float), np.asarray(D, float), np.asarray(u_prev, float)
+        free = (self.Phi @ z0 + self.Om @ D.reshape(-1)) / self.Ls   # positions with U = 0
+        q = self.Qz @ z0 + self.Qd @ D.reshape(-1)
+        status = "not solved"
+        # start with the form that solved last time: the hard QP is infeasible for stretches
+        # (a wave group), and an active-set solver takes long to prove infeasibility
+        order = self.forms if self._last == 0 else self.forms[::-1]
+        for form in order:
+            sol, status, slack = form.solve(q, free, u_prev, warm)
+            if sol is not None:
+                # back to the hard form once the slack is no longer used
+                self._last = int(form.soft and slack > 1e-6)
+                self.soft_solves += int(form.soft)
+                return (sol * self.Fs).reshape(self.N, self.nu), status
+        return None, status
+
+
+class _QpForm:
+    """One layout of the condensed QP: hard stroke limits (variables U) or soft (U, slack).
+    Rows: stroke (Psi U, or Psi U -/+ s), then force rate (differences of U)."""
+
+    def __init__(self, qp, *, soft: bool, backend):
+        N, nu = qp.N, qp.nu
+        self.qp, self.soft, self.n_u = qp, soft, N * nu
+        n_s = N * nu if soft else 0
+        self.n_var = N * nu + n_s
+        rows = []
+        if qp.has_stroke:
+            S = qp.Fs / qp.Ls * qp.Psi
+            rows += [np.hstack([S, -np.eye(n_s)]), np.hstack([S, np.eye(n_s)])] if soft else [S]
+        if qp.has_rate:
+            Dr = np.eye(N * nu) - np.eye(N * nu, k=-nu)
+            rows += [np.hstack([Dr, np.zeros((N * nu, n_s))])]
+        self.A = np.vstack(rows) if rows else np.zeros((0, self.n_var))
+        self.H = np.zeros((self.n_var, self.n_var))
+        self.H[:N * nu, :N * nu] = qp.H_u
+        self.g_slack = np.zeros(self.n_var)
+        if soft:
+            self.H[N * nu:, N * nu:] = 2 * qp.stroke_penalty * np.eye(n_s)
+            self.g_slack[N * nu:] = qp.stroke_penalty
+        self.lbx = np.concatenate([-qp.force, np.zeros(n_s)])
+        self.ubx = np.concatenate([qp.force, np.full(n_s, np.inf)])
+        self.backend = backend(self)
+
+    def bounds(self, q, free, u_prev):
+        """(g, lba, uba) for the linear cost term q, the free positions and the last force."""
+        qp, n = self.qp, self.n_u
+        g = self.g_slack.copy()
+        g[:n] += q
+        lba, uba = [], []
+        if qp.has_stroke:
+            if self.soft:
+                lba += [np.full(n, -np.inf), -qp.stroke - free]
+                uba += [qp.stroke - free, np.full(n, np.inf)]
+            else:
+                lba += [-qp.stroke - free]
+                uba += [qp.stroke - free]
+        if qp.has_rate:
+            first = np.zeros(n)
+            first[:qp.nu] = u_prev / qp.Fs
+            lba += [first - qp.rate]
+            uba += [first + qp.rate]
+        join = (lambda parts: np.concatenate(parts) if parts else np.zeros(0))
+        return g, join(lba), join(uba)
+
+    def solve(self, q, free, u_prev, warm):
+        g, lba, uba = self.bounds(q, free, u_prev)
+        x0 = np.zeros(self.n_var)
+        if warm is not None:
+            x0[:self.n_u] = np.vstack([warm[1:], warm[-1:]]).ravel() / self.qp.Fs
+        sol, status = self.backend.solve(g, self.lbx, self.ubx, lba, uba, x0)
+        if sol is None:
+            return None, status, 0.0
+        return sol[:self.n_u], status, float(np.max(sol[self.n_u:], initial=0.0))
+
+
+class _QpoasesBackend:
+    """Dense qpOASES through CasADi's conic interface; H and A fixed, built once."""
+
+    def __init__(self, form):
+        import casadi as ca
+        self.H, self.A = form.H, form.A
+        self.called = False
+        opts = {"printLevel": "none", "sparse": False, "error_on_fail": False,
+                "hessian_type": "posdef"}
+        self.solver = _quiet(lambda: ca.conic(
+            "mpc_qp", "qpoases", {"h": ca.DM(form.H).sparsity(), "a": ca.DM(form.A).sparsity()},
+            opts))
+
+    def solve(self, g, lbx, ubx, lba, uba, x0):
+        call = (lambda: self.solver(h=self.H, a=self.A, g=g, lbx=lbx, ubx=ubx, lba=lba,
+                                    uba=uba, x0=x0))
+        if not self.called:                 # qpOASES prints its banner on the first solve
+            self.called = True
+            out = _quiet(call)
+        else:
+            out = call()
+        stats = self.solver.stats()
+        if not stats.get("success", False):
+            return None, str(stats.get("return_status", "failed"))
+        return np.asarray(out["x"]).ravel(), "solved"
+
+
+class _CvxpyBackend:
+    """cvxpy with Parameters (built once, DPP), solved by Clarabel."""
+
+    def __init__(self, form):
+        import cvxpy as cp
+        n = form.n_var
+        self.x = cp.Variable(n)
+        self.g = cp.Parameter(n)
+        w, V = np.linalg.eigh(form.H)
+        factor = V * np.sqrt(np.clip(w, 0, None))[None, :]
+        lo, hi = np.isfinite(form.lbx), np.isfinite(form.ubx)
+        cons = [self.x[np.flatnonzero(lo)] >= form.lbx[lo]] if lo.any() else []
+        if hi.any():
+            cons.append(self.x[np.flatnonzero(hi)] <= form.ubx[hi])
+        # which rows have finite bounds is fixed by the layout: probe it once
+        _, lba, uba = form.bounds(np.zeros(form.n_u), np.zeros(form.n_u), np.zeros(form.qp.nu))
+        self.lo_rows, self.hi_rows = np.flatnonzero(np.isfinite(lba)), np.flatnonzero(np.isfinite(uba))
+        self.lba, self.uba = cp.Parameter(self.lo_rows.size), cp.Parameter(self.hi_rows.size)
+        if self.lo_rows.size:
+            cons.append(form.A[self.lo_rows] @ self.x >= self.lba)
+        if self.hi_rows.size:
+            cons.append(form.A[self.hi_rows] @ self.x <= self.uba)
+        objective = 0.5 * cp.sum_squares(factor.T @ self.x) + self.g @ self.x
+        self.problem = cp.Problem(cp.Minimize(objective), cons)
+
+    def solve(self, g, lbx, ubx, lba, uba, x0):
+        import cvxpy as cp
+        self.g.value = g
+        self.lba.value, self.uba.value = lba[self.lo_rows], uba[self.hi_rows]
+        try:
+            self.problem.solve(solver=cp.CLARABEL)
+        except cp.error.SolverError as exc:
+            return None, f"solver error: {exc}"
+        if self.problem.status not in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE):
+            return None, self.problem.status
+        return np.asarray(self.x.value).ravel(), "solved"
+
+
+def _quiet(call):
+    """Run with output silenced: qpOASES prints a banner, through CasADi's stream (which
+    CasADi hands to Python's sys.stdout) or straight to the process's stdout."""
+    import contextlib
+    import io
+    import os
+    import sys
+    sys.stdout.flush()
+    sys.stderr.flush()
+    saved = [os.dup(1), os.dup(2)]
+    try:
+        with open(os.devnull, "w") as null, contextlib.redirect_stdout(io.StringIO()), \
+                contextlib.redirect_stderr(io.StringIO()):
+            os.dup2(null.fileno(), 1)
+            os.dup2(null.fileno(), 2)
+            return call()
+    finally:
+        _flush_c_stdio()                # a pipe's C buffer would print after the restore
+        os.dup2(saved[0], 1)
+        os.dup2(saved[1], 2)
+        for fd in saved:
+            os.close(fd)
+
+
+def _flush_c_stdio() -> None:
+    import ctypes
+    try:
+        ctypes.CDLL(None).fflush(None)
+    except (OSError, AttributeError):
+        pass

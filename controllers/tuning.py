@@ -1,0 +1,121 @@
+"""Tuning within limits: the best damper (or damper and spring) whose predicted force and
+stroke peaks stay within the PTO limits, searched on the frequency-domain statistics."""
+from __future__ import annotations
+
+import numpy as np
+
+from .impedance import (base_params, default_bounds, fd_statistics, intrinsic_impedance,
+                        margin_function)
+
+
+def constrained_tuning(plant, wave, *, pto: str | None = None, params=None,
+                       passive: bool = False, bounds=None, force_max: float | None = None,
+                       stroke_max: float | None = None, efficiency: float | None = None,
+                       exceedance: float = 0.01,
+                       min_margin: float = 1e-3) -> tuple[float, float, float]:
+    """(damping, stiffness, predicted mean power W) maximising the predicted mean power
+    (electrical with `efficiency`, else mechanical) subject to fd_statistics' force and stroke
+    peaks <= force_max (N) and stroke_max (m) (None: no limit) and, for a spring, a stable
+    closed loop with margin >= min_margin (1/s).
+
+    passive: stiffness 0, a 1-D search: a log grid of 400 dampings over `bounds` (default
+    impedance.default_bounds), then Brent's method between the best feasible point's neighbours
+    if both are feasible, else bisection towards the infeasible one (the optimum is on the
+    edge of the feasible set). Spring and damper: a grid of 81 log dampings over `bounds` by
+    161 stiffnesses over +-2 k_s (k_s the matching stiffness at the most energetic component,
+    at least the median |omega Z_i|), the best stable feasible point and the constrained
+    passive optimum as starts of a Nelder-Mead search in (log c, k / k_s) that scores any
+    infeasible or unstable pair as infinitely bad, so the result is never below the passive
+    one in prediction. ValueError if no damping meets the limits.
+    """
+    from scipy.optimize import minimize_scalar
+
+    name = pto or plant.scene.ptos[0].name
+    Z, F = intrinsic_impedance(plant, wave.omega, pto=name, params=params,
+                               direction=wave.direction)
+    f_max = np.inf if force_max is None else float(force_max)
+    s_max = np.inf if stroke_max is None else float(stroke_max)
+    if not (f_max > 0 and s_max > 0):
+        raise ValueError(f"limits must be > 0, got force_max={force_max}, stroke_max={stroke_max}")
+    key = "power_W" if efficiency is None else "electrical_W"
+
+    def evaluate(c, k):
+        st = fd_statistics(Z, F, wave, c, k, efficiency=efficiency, exceedance=exceedance)
+        feasible = (st["force_peak"] <= f_max) & (st["stroke_peak"] <= s_max)
+        return st[key], feasible, st
+
+    if bounds is None:
+        base = base_params(plant, name, params)
+        base[f"{name}__damping"] = 0.0
+        bounds = default_bounds(plant, wave, name, base)
+    x = np.linspace(np.log(bounds[0]), np.log(bounds[1]), 400)
+    objective, feasible, st = evaluate(np.exp(x), 0.0)
+    if not feasible.any():
+        raise ValueError(
+            f"{plant.name}: no damping in {bounds[0]:.4g}..{bounds[1]:.4g} keeps the predicted "
+            f"peaks within force_max {f_max:.4g} and stroke_max {s_max:.4g} (least force peak "
+            f"{st['force_peak'].min():.4g}, least stroke peak {st['stroke_peak'].min():.4g})")
+    j = int(np.argmax(np.where(feasible, objective, -np.inf)))
+    best_x = x[j]
+    inside = 0 < j < x.size - 1
+    if inside and feasible[j - 1] and feasible[j + 1]:
+        res = minimize_scalar(lambda z: -evaluate(np.exp(z), 0.0)[0], method="bounded",
+                              bounds=(x[j - 1], x[j + 1]), options={"xatol": 1e-6})
+        if evaluate(np.exp(res.x), 0.0)[1] and -res.fun >= objective[j]:
+            best_x = float(res.x)
+    else:
+        edge = [n for n in (j - 1, j + 1) if 0 <= n < x.size and not feasible[n]]
+        if edge:
+            lo, hi = x[j], x[edge[0]]
+            for _ in range(50):
+                mid = 0.5 * (lo + hi)
+                lo, hi = (mid, hi) if evaluate(np.exp(mid), 0.0)[1] else (lo, mid)
+            if evaluate(np.exp(lo), 0.0)[0] >= objective[j]:
+                best_x = lo
+    c_passive = float(np.exp(best_x))
+    if passive:
+        return c_passive, 0.0, float(evaluate(c_passive, 0.0)[2]["power_W"])
+
+    margin = margin_function(plant, name, params)
+    w = np.asarray(wave.omega, float)
+    j = int(np.argmax(np.abs(F * wave.amplitude)))
+    k_scale = max(abs(float(w[j] * Z[j].imag)), float(np.median(np.abs(w * Z))))
+    log_c = np.linspace(np.log(bounds[0]), np.log(bounds[1]), 81)
+    k_grid = np.linspace(-2, 2, 161) * k_scale
+    grid = np.empty((log_c.size, k_grid.size))
+    for i, lc in enumerate(log_c):
+        value, ok, _ = evaluate(np.exp(lc), k_grid)
+        grid[i] = np.where(ok, value, -np.inf)
+    starts = [np.array([best_x, 0.0])]
+    for flat in np.argsort(grid, axis=None)[::-1][:400]:     # best first, until a stable one
+        i, m = np.unravel_index(flat, grid.shape)
+        if not np.isfinite(grid[i, m]):
+            break
+        if margin(np.exp(log_c[i]), k_grid[m]) >= min_margin:
+            starts.insert(0, np.array([log_c[i], k_grid[m] / k_scale]))
+            break
+
+    def cost(z):
+        c, k = np.exp(z[0]), z[1] * k_scale
+        value, ok, _ = evaluate(c, k)
+        return -float(value) if ok and margin(c, k) >= min_margin else np.inf
+
+    best = multistart(cost, starts, xatol=1e-5, fatol_rel=1e-9, fatol_abs=1e-12, maxiter=600)
+    c, k = float(np.exp(best.x[0])), float(best.x[1] * k_scale)
+    if not np.isfinite(best.fun):
+        raise ValueError(f"{plant.name}: no stable spring-damper meets the limits")
+    return c, k, float(evaluate(c, k)[2]["power_W"])
+
+
+def multistart(cost, starts, *, xatol, fatol_rel, fatol_abs, maxiter):
+    """The best Nelder-Mead result over the starts in (log damping, scaled stiffness); the
+    function tolerance is relative to the cost at each start."""
+    from scipy.optimize import minimize
+    best = None
+    for start in starts:
+        res = minimize(cost, start, method="Nelder-Mead",
+                       options={"xatol": xatol, "fatol": fatol_rel * abs(cost(start)) + fatol_abs,
+                                "maxiter": maxiter})
+        if best is None or res.fun < best.fun:
+            best = res
+    return best

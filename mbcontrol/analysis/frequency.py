@@ -1,0 +1,158 @@
+"""Frequency-domain analysis: the BEM-direct solution, RAOs and state-space responses.
+
+Convention here: phasors of exp(+i omega t) (python-control's). BEM excitation is stored per
+exp(-i omega t), so its phasor in this convention is the complex conjugate.
+
+The frequency-domain (FD) solution uses the BEM data at each frequency directly, with no
+radiation fit: [-omega^2 (M + A(omega)) + i omega (B(omega) + B_mech) + K] X = F. It is the
+reference the time-domain simulation and the fitted state-space model are checked against.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import casadi as ca
+import numpy as np
+
+from ..plant import dof_selector
+from .linearize import jacobians
+
+
+@dataclass(frozen=True)
+class MechanicalMatrices:
+    """Linear generalised matrices at rest (n_s x n_s), and P0 restricted to hydro DOFs."""
+    mass: np.ndarray           # P0 M_RB P0^T
+    added_mass_inf: np.ndarray  # P0 A_inf P0^T
+    stiffness: np.ndarray      # hydrostatic + PTO + mooring stiffness
+    damping: np.ndarray        # PTO + friction (slope at rest) + mooring damping
+    P_hydro: np.ndarray        # (n_s, n_h): generalised force of a body-DOF wrench
+    output_q: np.ndarray       # (n_y, n_q): output sensitivity to q
+    output_s: np.ndarray       # (n_y, n_s): output sensitivity to s
+
+
+def mechanical_matrices(plant, params=None) -> MechanicalMatrices:
+    """Read the non-radiation linear terms off the plant's exact Jacobians at rest.
+
+    With M_tot = M + A_inf, the linearised s' row is -M_tot^{-1} (K q + B s) + radiation, so
+    K = -M_tot ds'/dq and B = -M_tot ds'/ds (the fitted radiation enters through chi, and its
+    feed-through D_r is removed).
+    """
+    p = plant.params(**params) if isinstance(params, dict) else (
+        plant.p0 if params is None else np.asarray(params, float))
+    tree, n = plant.topology.tree, plant.topology.tree.n_s
+    q = ca.SX.sym("q", tree.n_q)
+    P0 = np.asarray(ca.Function("P", [q], [tree.P(q)])(np.zeros(tree.n_q)))
+    select = dof_selector(plant.topology, list(plant.hydro.dofs)) if plant.hydro else \
+        np.zeros((0, P0.shape[1]))
+    P_h = P0 @ select.T
+    M = np.asarray(ca.Function("M", [q], [tree.mass_matrix(q)])(np.zeros(tree.n_q)))
+    A_inf = P_h @ plant.hydro.added_mass_inf @ P_h.T if plant.hydro else np.zeros_like(M)
+    x0 = plant.x0()
+    A, _, _, C, _, _ = (np.asarray(J) for J in jacobians(plant)(
+        x0, np.zeros(len(plant.inputs)), np.zeros(len(plant.disturbances)), p))
+    rows = slice(tree.n_q, tree.n_q + n)
+    K = -(M + A_inf) @ A[rows, :tree.n_q]
+    B = -(M + A_inf) @ A[rows, tree.n_q:tree.n_q + n]
+    if plant.hydro:
+        B -= P_h @ plant.hydro.radiation_matrices()[3] @ P_h.T
+    return MechanicalMatrices(M, A_inf, K, B, P_h, C[:, :tree.n_q],
+                              C[:, tree.n_q:tree.n_q + n])
+
+
+def frequency_domain_response(plant, omega, *, direction: float = 0.0, params=None,
+                              outputs=None) -> np.ndarray:
+    """Complex response per unit wave amplitude (n_omega, n_outputs), exp(+i omega t).
+
+    Straight from the BEM data (no radiation fit): A(omega), B(omega) and the excitation are
+    interpolated linearly on the BEM grid. outputs: names (default all plant outputs).
+    """
+    omega = np.atleast_1d(np.asarray(omega, float))
+    mech = mechanical_matrices(plant, params)
+    hyd = plant.hydro
+    A_w, B_w = hyd.frequency_domain_matrices(omega)
+    from ..waves import interpolate_complex
+    F = np.conj(interpolate_complex(hyd.omega, hyd.excitation_coefficients(direction), omega))
+    P = mech.P_hydro
+    idx = [plant.outputs.index(o) for o in (outputs or plant.outputs)]
+    out = np.empty((omega.size, len(idx)), dtype=complex)
+    for i, w in enumerate(omega):
+        Z = (-w**2 * (mech.mass + P @ A_w[i] @ P.T) + 1j * w * (mech.damping + P @ B_w[i] @ P.T)
+             + mech.stiffness)
+        X = np.linalg.solve(Z, P @ F[i])
+        y = mech.output_q @ X + mech.output_s @ (1j * w * X)
+        out[i] = y[idx]
+    return out
+
+
+def statespace_response(sys, plant, omega, *, direction: float = 0.0, outputs=None):
+    """Response per unit wave amplitude of a linearised model (n_omega, n_outputs).
+
+    Drives the w inputs of `sys` with the conjugated BEM excitation (exp(+i omega t)).
+    """
+    from ..waves import interpolate_complex
+    omega = np.atleast_1d(np.asarray(omega, float))
+    hyd = plant.hydro
+    F = np.conj(interpolate_complex(hyd.omega, hyd.excitation_coefficients(direction), omega))
+    w_idx = [sys.input_labels.index(f"w__{d}") for d in hyd.dofs]
+    names = outputs or sys.output_labels
+    y_idx = [sys.output_labels.index(o) for o in names]
+    A, B, C, D = (np.asarray(M) for M in (sys.A, sys.B, sys.C, sys.D))
+    eye = np.eye(A.shape[0])
+    out = np.empty((omega.size, len(y_idx)), dtype=complex)
+    for i, w in enumerate(omega):
+        G = C[y_idx] @ np.linalg.solve(1j * w * eye - A, B[:, w_idx]) + D[np.ix_(y_idx, w_idx)]
+        out[i] = G @ F[i]
+    return out
+
+
+def steady_amplitude(ds, name: str, period: float, n_periods: int = 10) -> float:
+    """Half the peak-to-peak of a signal over its last n_periods periods (regular waves)."""
+    t = ds["time"].values
+    window = t >= t[-1] - n_periods * period
+    values = ds[name].values[window]
+    return 0.5 * float(values.max() - values.min())
+
+
+def steady_state_initial(sys, plant, wave) -> np.ndarray:
+    """State at t = 0 on the linear periodic response to a regular wave (no ramp needed).
+
+    x(t) = Re(X exp(i omega t)) with X = (i omega I - A)^-1 B_w conj(F) a; starting there
+    removes the start-up transient of lightly damped modes, leaving only what the nonlinear
+    terms add. Returns the full plant state (sys must be linearize(plant) with all states).
+    """
+    from ..waves import interpolate_complex
+    if wave.omega.size != 1:
+        raise ValueError("steady_state_initial needs a regular wave")
+    w, a = float(wave.omega[0]), float(wave.amplitude[0]) * np.exp(-1j * wave.phase[0])
+    hyd = plant.hydro
+    F = np.conj(interpolate_complex(hyd.omega, hyd.excitation_coefficients(wave.direction),
+                                    np.array([w]))[0] * a)
+    w_idx = [sys.input_labels.index(f"w__{d}") for d in hyd.dofs]
+    A, B = np.asarray(sys.A), np.asarray(sys.B)[:, w_idx]
+    X = np.linalg.solve(1j * w * np.eye(A.shape[0]) - A, B @ F)
+    return plant.x0() + X.real
+
+
+def regular_wave_amplitudes(plant, sys, omegas, outputs, *, height: float, params=None,
+                            periods_settle: int = 4, periods_measure: int = 10,
+                            steps_per_period: int = 200) -> np.ndarray:
+    """Steady amplitudes per unit wave amplitude of the NONLINEAR plant in regular waves.
+
+    For each frequency: start on the linear periodic solution (steady_state_initial, so no
+    long start-up transient), run periods_settle + periods_measure periods with
+    steps_per_period RK4 steps each, and take half the peak-to-peak of each output over the
+    last periods_measure periods, divided by the wave amplitude. Returns (n_omega, n_out).
+    """
+    from ..sim import simulate
+    from ..waves import regular
+    out = np.empty((len(omegas), len(outputs)))
+    for i, w in enumerate(omegas):
+        period = 2 * np.pi / w
+        wave = regular(height, period, ramp_time=0.0)
+        ds = simulate(plant, wave, duration=(periods_settle + periods_measure) * period,
+                      dt=period / steps_per_period, params=params,
+                      x0=steady_state_initial(sys, plant, wave))
+        t = ds["time"].values
+        last = t >= t[-1] - periods_measure * period
+        out[i] = [0.5 * np.ptp(ds[name].values[last]) / (height / 2) for name in outputs]
+    return out

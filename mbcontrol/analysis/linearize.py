@@ -1,0 +1,53 @@
+"""Exact linearisation of a ProcessPlant into a named python-control StateSpace.
+
+The model is in deviation coordinates about an operating point (x0, u0, w0, p), which must be
+an equilibrium: f(x0, u0, w0, p) = 0 to within `tol`. Jacobians are CasADi's exact ones, built
+once per plant. Note that a smoothed Coulomb friction linearises to its slope at v = 0,
+coulomb / velocity_scale; pass params={"<friction>__coulomb": 0} to leave it out.
+"""
+from __future__ import annotations
+
+import control
+import numpy as np
+
+from ..errors import LinearizationError
+from ..plant.jacobians import jacobians
+
+
+def linearize(plant, *, x0=None, u0=None, w0=None, params=None, inputs=None, outputs=None,
+              tol: float = 1e-8) -> control.StateSpace:
+    """Linear model about an equilibrium, with the plant's signal names.
+
+    inputs/outputs: names to keep (default: every u and w; every output). params: dict of
+    overrides or a full vector. Raises LinearizationError when the point is not an equilibrium
+    or a name is unknown.
+    """
+    x0 = plant.x0() if x0 is None else np.asarray(x0, float)
+    u0 = np.zeros(len(plant.inputs)) if u0 is None else np.asarray(u0, float)
+    w0 = np.zeros(len(plant.disturbances)) if w0 is None else np.asarray(w0, float)
+    p = plant.params(**params) if isinstance(params, dict) else (
+        plant.p0 if params is None else np.asarray(params, float))
+    residual = np.asarray(plant.f(x0, u0, w0, p)).ravel()
+    if np.max(np.abs(residual), initial=0.0) > tol:
+        worst = np.argsort(-np.abs(residual))[:3]
+        listing = ", ".join(f"{plant.states[i]}' = {residual[i]:.3g}" for i in worst)
+        raise LinearizationError(f"{plant.name}: the operating point is not an equilibrium "
+                                 f"(largest residuals: {listing}; tolerance {tol:g})")
+    A, Bu, Bw, C, Du, Dw = (np.asarray(M) for M in jacobians(plant)(x0, u0, w0, p))
+    all_inputs = list(plant.inputs) + list(plant.disturbances)
+    B, D = np.hstack([Bu, Bw]), np.hstack([Du, Dw])
+    keep_in = _indices(plant, all_inputs, inputs, "input")
+    keep_out = _indices(plant, list(plant.outputs), outputs, "output")
+    return control.ss(A, B[:, keep_in], C[keep_out], D[np.ix_(keep_out, keep_in)],
+                      states=list(plant.states), inputs=[all_inputs[i] for i in keep_in],
+                      outputs=[plant.outputs[i] for i in keep_out], name=plant.name)
+
+
+def _indices(plant, names, wanted, kind):
+    if wanted is None:
+        return list(range(len(names)))
+    missing = [n for n in wanted if n not in names]
+    if missing:
+        raise LinearizationError(f"{plant.name}: unknown {kind}(s) {missing}; expected some "
+                                 f"of {', '.join(names)}")
+    return [names.index(n) for n in wanted]

@@ -1,0 +1,145 @@
+"""Summaries of simulation results: amplitudes, statistics, PTO power, force and stroke.
+
+Window: for a regular wave, the last 10 wave periods (steady state); for an irregular sea,
+the record after the ramp. Amplitude is half the peak-to-peak within the window. Absorbed
+power is positive.
+
+PTO power is taken from the work the PTO does over each step, not from the sampled power
+-F v: a controller's force is held over each step (zero-order hold), and then the work
+-F_k (x_{k+1} - x_k) is exact while the mean of -F_k v_k misses -F a dt / 2 per step (6 % of
+the power of reactive control on the sphere at dt = 0.01 s). A force the plant computes
+continuously (the scene's own PTO law, no controller) is integrated by the trapezoidal rule.
+"""
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+
+from ..results import jsonable
+
+_BODY_KEYS = {"Surge": "surge_amplitude_m", "Sway": "sway_amplitude_m",
+              "Heave": "heave_amplitude_m", "Roll": "roll_amplitude_rad",
+              "Pitch": "pitch_amplitude_rad", "Yaw": "yaw_amplitude_rad"}
+
+
+def analysis_window(ds) -> np.ndarray:
+    """Boolean mask over time of the window the metrics use."""
+    t = ds["time"].values
+    wave = json.loads(ds.attrs.get("wave", "{}"))
+    if wave.get("type") == "regular":
+        start = t[-1] - 10 * wave["period"]
+    else:
+        start = wave.get("ramp_s", 0.0)
+    mask = t >= start
+    if mask.sum() < 2:
+        raise ValueError(f"the record ({t[-1]:.4g} s) is too short for the metrics window "
+                         f"starting at {start:.4g} s; simulate longer")
+    return mask
+
+
+def signal_stats(values) -> dict:
+    return {"amplitude": 0.5 * float(values.max() - values.min()), "mean": float(values.mean()),
+            "std": float(values.std()), "max_abs": float(np.abs(values).max())}
+
+
+def step_power(ds, pto: str) -> tuple[np.ndarray, np.ndarray]:
+    """(t_k, P_k): the PTO's mean absorbed power over each step [t_k, t_k+1), W, from its work.
+
+    Held force (a controller ran): P_k = -F_k (x_k+1 - x_k) / dt, exact. Otherwise the
+    trapezoidal rule on the sampled force.
+    """
+    t = ds["time"].values
+    force, x = ds[f"{pto}__force"].values, ds[f"{pto}__position"].values
+    held = json.loads(ds.attrs.get("controller", "null")) is not None
+    f = force[:-1] if held else 0.5 * (force[:-1] + force[1:])
+    return t[:-1], -f * np.diff(x) / np.diff(t)
+
+
+def electrical_power(power, efficiency: float) -> np.ndarray:
+    """Electrical power (W) from mechanical absorbed power: eta P when absorbing, P / eta when
+    the PTO drives the body (reactive power is bought back at a loss), as WECCCOMP scores it."""
+    power = np.asarray(power, float)
+    return np.where(power > 0, efficiency * power, power / efficiency)
+
+
+def pto_metrics(ds, pto, start: float | None = None, end: float | None = None) -> dict:
+    """Power, force and stroke metrics of one PTO over [start, end) s (default: the analysis
+    window). `pto` is a scene Pto (its limits and efficiency are used) or a PTO name.
+
+    Keys: mean_power_W (mechanical, absorbed > 0, from work), mean_electrical_power_W (with
+    the PTO's efficiency), mean_abs_power_W, papr (peak |P| over mean P; inf when mean P <= 0),
+    p98_W (98th percentile of |P|), max_force, f98, max_stroke, z98 (98th percentiles of |F|
+    and |x|), force_max / stroke_max (the PTO's limits), force_violation / stroke_violation
+    (worst excess over the limit, 0 if none) and violation_fraction (share of samples outside
+    either limit). Force and stroke are in the PTO's units (N, m or N m, rad).
+    """
+    name = pto if isinstance(pto, str) else pto.name
+    force_max = getattr(pto, "force_max", math.inf)
+    stroke_max = getattr(pto, "stroke_max", math.inf)
+    efficiency = getattr(pto, "efficiency", 1.0)
+    t_step, p_step = step_power(ds, name)
+    t = ds["time"].values
+    if start is None and end is None:
+        mask = analysis_window(ds)
+        start = float(t[mask][0])
+    lo = -np.inf if start is None else start - 1e-9
+    hi = np.inf if end is None else end - 1e-9
+    steps = (t_step >= lo) & (t_step < hi)
+    samples = (t >= lo) & (t < hi)
+    if steps.sum() < 1:
+        raise ValueError(f"empty metrics window [{start}, {end}) s in a {t[-1]:.4g} s record")
+    power = p_step[steps]
+    force = np.abs(ds[f"{name}__force"].values[samples])
+    stroke = np.abs(ds[f"{name}__position"].values[samples])
+    mean = float(power.mean())
+    outside = (force > force_max * (1 + 1e-9)) | (stroke > stroke_max * (1 + 1e-9))
+    return {
+        "mean_power_W": mean,
+        "mean_electrical_power_W": float(electrical_power(power, efficiency).mean()),
+        "mean_abs_power_W": float(np.abs(power).mean()),
+        "papr": float(np.abs(power).max() / mean) if mean > 0 else math.inf,
+        "p98_W": float(np.percentile(np.abs(power), 98)),
+        "max_force": float(force.max()), "f98": float(np.percentile(force, 98)),
+        "max_stroke": float(stroke.max()), "z98": float(np.percentile(stroke, 98)),
+        "force_max": force_max, "stroke_max": stroke_max, "efficiency": efficiency,
+        "force_violation": float(max(force.max() - force_max, 0.0)),
+        "stroke_violation": float(max(stroke.max() - stroke_max, 0.0)),
+        "violation_fraction": float(outside.mean()),
+    }
+
+
+def wecccomp_score(ds, pto, start: float = 25.0, end: float | None = None) -> dict:
+    """The WEC Control Competition's evaluation criterion, scored over t > start (25 s):
+
+        EC = P_e / (2 + F98 / F_max + z98 / z_max - mean|P| / P98)
+
+    P_e: mean electrical power (efficiency applied both ways, W); F98, z98, P98: 98th
+    percentiles of |force|, |stroke| and |mechanical power|; F_max, z_max: the PTO's limits,
+    which must be finite. Returns the pto_metrics over the window plus "EC" (W).
+    """
+    m = pto_metrics(ds, pto, start, end)
+    if not (math.isfinite(m["force_max"]) and math.isfinite(m["stroke_max"])):
+        raise ValueError(f"PTO {getattr(pto, 'name', pto)!r}: the WECCCOMP score needs finite "
+                         f"force_max and stroke_max in the scene")
+    denominator = (2 + m["f98"] / m["force_max"] + m["z98"] / m["stroke_max"]
+                   - m["mean_abs_power_W"] / m["p98_W"])
+    return {**m, "EC": m["mean_electrical_power_W"] / denominator}
+
+
+def summary(ds, plant) -> dict:
+    """The `mbcontrol simulate --json` contract (see README)."""
+    mask = analysis_window(ds)
+    coords = plant.topology.tree.coordinate_names
+    dofs = {name: signal_stats(ds[name].values[mask]) for name in coords}
+    bodies = {}
+    for body in plant.topology.bodies:
+        bodies[body] = {key: 0.5 * float(np.ptp(ds[f"{body}__{dof}"].values[mask]))
+                        for dof, key in _BODY_KEYS.items()}
+    ptos = {pto.name: jsonable(pto_metrics(ds, pto)) for pto in plant.scene.ptos}
+    return {"model": ds.attrs["model"], "wave": json.loads(ds.attrs["wave"]),
+            "duration_s": float(ds.attrs["duration_s"]), "dt_s": float(ds.attrs["dt_s"]),
+            "wall_time_s": float(ds.attrs["wall_time_s"]), "method": ds.attrs["method"],
+            "controller": json.loads(ds.attrs.get("controller", "null")),
+            "dofs": dofs, "bodies": bodies, "ptos": ptos}

@@ -1,0 +1,194 @@
+"""The `mbcontrol` command: catalogue, hydrodynamics, simulation, linearisation, control design.
+
+Examples:
+  mbcontrol models
+  mbcontrol hydro hinged_barge
+  mbcontrol simulate hinged_barge --wave regular --height 0.02 --period 1.0 --duration 30 --json
+  mbcontrol simulate hinged_barge --wave jonswap --hs 0.03 --tp 1.0 --seed 3 --out run.nc
+  mbcontrol simulate hinged_barge --wave regular --height 0.02 --period 1 --controller passive --set damping=1.5
+  mbcontrol linearize hinged_barge --bode bode.png --json
+  mbcontrol design sphere --controller reactive --wave regular --height 2.5 --period 9.6664
+  mbcontrol design sphere --controller passive --wave jonswap --hs 2.5 --tp 8 --json
+  mbcontrol bench rm3 --wave jonswap --hs 2.5 --tp 8 --stability
+  mbcontrol fidelity sphere --wave jonswap --hs 2.5 --tp 9.67 --tol 0.01
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+
+from ..errors import MbcontrolError
+from ..sim.methods import METHODS
+from .commands import (run_bench, run_design, run_fidelity, run_hydro, run_linearize, run_models,
+                       run_simulate)
+
+DESIGN_HELP = """Tune a PTO controller for a sea, then check, bound and simulate it.
+
+The controller is tuned by its module's tuner (passive: optimal damping; reactive: complex-
+conjugate matching, or the best stable pair in a sea; latching / declutching: hold time by
+closed-loop simulation, regular waves only; mpc: its defaults, given the wave), within the
+PTO's force and stroke limits unless --unconstrained. It prints the tuned parameters, the
+power linear theory predicts, the stability margins of a linear law (gain, phase, distance
+of the Nyquist curve from -1, closed-loop poles), the complex-conjugate and force/stroke-
+constrained power bounds, and the metrics of a closed-loop simulation on the nonlinear plant
+with the share of each bound it reaches. It ends with the `mbcontrol simulate` command line
+that re-runs that simulation (the parameters as --set KEY=VALUE).
+
+Example:
+  mbcontrol design sphere --controller passive --wave regular --height 2.5 --period 9.6664
+"""
+
+
+BENCH_HELP = """Speed against accuracy for one model in one sea, measured on this machine.
+
+Runs every integration method over a ladder of steps (rk3, rk4, dopri5, exp-rk4: period/4
+down to period/256) or tolerances (cvodes, adams: rtol 1e-3..1e-7), and the radiation model
+at several fit tolerances (fewer states), and measures for each run:
+  error: max over joint coordinates of RMS(q - q_ref)/RMS(q_ref) after the ramp, q_ref a
+         converged dopri5 run (its own error is printed);
+  cost:  wall time of excitation synthesis + time-stepping (compilation excluded), one core.
+Writes work_precision.png, work_precision.csv and work_precision.nc to --out, prints the
+table, and names the cheapest setting within 1 % RMS. With --stability, adds each method's
+largest stable step (stability.csv).
+
+Example:
+  mbcontrol bench sphere --wave jonswap --hs 2.5 --tp 9.67 --duration 300
+"""
+
+
+def main(argv=None) -> int:
+    parser = _parser()
+    args = parser.parse_args(argv)
+    if not hasattr(args, "run"):
+        parser.print_help()
+        return 2
+    try:
+        return args.run(args) or 0
+    except (MbcontrolError, KeyError, ValueError) as exc:
+        message = exc.args[0] if isinstance(exc, KeyError) and exc.args else exc
+        print(f"mbcontrol: error: {message}", file=sys.stderr)
+        return 1
+
+
+def _parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="mbcontrol", description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
+    sub = parser.add_subparsers(title="commands", metavar="COMMAND")
+
+    p = sub.add_parser("models", help="list the catalogue of models")
+    p.set_defaults(run=run_models)
+
+    p = sub.add_parser("hydro", help="load or compute a model's BEM data and fit its radiation "
+                                     "model; print the fit report")
+    _model_options(p)
+    p.add_argument("--tol", type=float, help="radiation fit tolerance (normalised RMS error)")
+    p.add_argument("--json", action="store_true", help="print the report as JSON")
+    p.set_defaults(run=run_hydro)
+
+    p = sub.add_parser("simulate", help="simulate a model in waves (nonlinear process plant)",
+                       formatter_class=argparse.RawTextHelpFormatter)
+    _model_options(p)
+    _wave_options(p)
+    p.add_argument("--duration", type=float, default=None,
+                   help="simulated time, s (default: 30 periods, or 600 s for irregular seas)")
+    p.add_argument("--dt", type=float, default=0.01, help="time step, s (default 0.01)")
+    p.add_argument("--method", choices=tuple(METHODS), default="rk4",
+                   help="\n".join(f"{m.name}: {m.description}" for m in METHODS.values()))
+    p.add_argument("--rtol", type=float, default=1e-8,
+                   help="relative tolerance of the adaptive methods (cvodes, adams)")
+    p.add_argument("--controller", help="PTO controller by name (e.g. passive)")
+    p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                   help="controller setting, repeatable (e.g. --set damping=2.0)")
+    p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
+                   help="plant parameter override, repeatable (e.g. hinge_pto__damping=3)")
+    p.add_argument("--out", help="write the full result to this netCDF file")
+    p.add_argument("--plot", help="write a time-series figure (PNG) to this file")
+    p.add_argument("--json", action="store_true", help="print the summary as JSON")
+    p.set_defaults(run=run_simulate)
+
+    p = sub.add_parser("design", help="tune a controller for a sea; check its stability margins, "
+                                      "bound it and simulate it",
+                       description=DESIGN_HELP, formatter_class=argparse.RawTextHelpFormatter)
+    _model_options(p)
+    _wave_options(p)
+    p.add_argument("--controller", required=True, metavar="NAME",
+                   help="passive, reactive, latching, declutching or mpc")
+    p.add_argument("--pto", help="the PTO to tune and score (default: the first)")
+    p.add_argument("--duration", type=float, default=None,
+                   help="closed-loop simulation, s (default: 30 periods, longer if the linear\n"
+                        "loop settles slowly; a sea: its repeat period, max(600 s, 20 Tp))")
+    p.add_argument("--dt", type=float, default=None,
+                   help="time step, s (default: period / 1000, or Tp / 1000)")
+    p.add_argument("--unconstrained", action="store_true",
+                   help="tune without the PTO's force and stroke limits (e.g. complex-conjugate\n"
+                        "control) and with no controller saturation; the limits are still\n"
+                        "reported (violations, constrained bound)")
+    p.add_argument("--bounds", choices=("auto", "full", "off"), default="auto",
+                   help="auto: complex-conjugate, and pseudo-spectral unless the sea has more than\n"
+                        "150 components; full: always both (slow for long seas); off: none")
+    p.add_argument("--json", action="store_true", help="print the design as JSON")
+    p.set_defaults(run=run_design)
+
+    p = sub.add_parser("bench", help="speed against accuracy: work-precision chart and table of "
+                                     "every integration method and radiation order; stability "
+                                     "limits", description=BENCH_HELP,
+                       formatter_class=argparse.RawTextHelpFormatter)
+    _model_options(p)
+    _wave_options(p)
+    p.add_argument("--duration", type=float, default=None,
+                   help="record length, s (default: 600 s for a sea, 30 periods for a regular wave)")
+    p.add_argument("--methods", nargs="+", default=list(METHODS), choices=tuple(METHODS),
+                   metavar="METHOD", help=f"methods to chart (default: all of {', '.join(METHODS)})")
+    p.add_argument("--radiation-tols", nargs="*", type=float, default=[0.2, 0.1, 0.05, 0.02],
+                   metavar="TOL", help="radiation fit tolerances to chart (default 0.2 0.1 0.05 0.02;\n"
+                                       "new tolerances are fitted once and cached)")
+    p.add_argument("--stability", action="store_true",
+                   help="also find each method's largest stable step: linearised step map and\n"
+                        "simulated search, for the scene, a 5x tighter radiation fit, an end\n"
+                        "stop on the first PTO's joint and latching control")
+    p.add_argument("--repeats", type=int, default=3, help="timing repeats, best kept (3)")
+    p.add_argument("--out", default=None, help="folder for the PNG, CSV and netCDF "
+                                               "(default out/bench/MODEL)")
+    p.set_defaults(run=run_bench)
+
+    p = sub.add_parser("fidelity", help="the cheapest model that meets an error tolerance in a sea "
+                                        "(fidelity='auto'): what it dropped and what that cost",
+                       formatter_class=argparse.RawTextHelpFormatter)
+    _model_options(p)
+    _wave_options(p)
+    p.add_argument("--tol", type=float, default=0.01,
+                   help="largest relative RMS error against the full model, over body motions\n"
+                        "and PTO velocity and power (default 0.01)")
+    p.add_argument("--duration", type=float, default=None,
+                   help="comparison record, s (default: the ramp plus 40 peak periods)")
+    p.add_argument("--out", help="write the candidate table to this netCDF file")
+    p.set_defaults(run=run_fidelity)
+
+    p = sub.add_parser("linearize", help="linearise about rest; poles, Bode plot")
+    _model_options(p)
+    p.add_argument("--bode", metavar="FILE.png", help="write a Bode plot")
+    p.add_argument("--pair", action="append", default=[], metavar="INPUT:OUTPUT",
+                   help="Bode channel, repeatable (default: each PTO command to its velocity)")
+    p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
+                   help="plant parameter override, repeatable; e.g. hinge_friction__coulomb=0\n"
+                        "(a smoothed Coulomb friction linearises to its slope at rest)")
+    p.add_argument("--json", action="store_true", help="print signals and poles as JSON")
+    p.set_defaults(run=run_linearize)
+    return parser
+
+
+def _model_options(p) -> None:
+    p.add_argument("model", help="catalogue name or path to a scene .toml")
+    p.add_argument("--scene-param", action="append", default=[], metavar="NAME=VALUE",
+                   help="a value for the scene's [parameters], e.g. N=8 for barge_chain (repeatable)")
+
+
+def _wave_options(p) -> None:
+    g = p.add_argument_group("waves")
+    g.add_argument("--wave", choices=("regular", "jonswap", "pm", "none"), default="regular")
+    g.add_argument("--height", type=float, help="regular wave height H, m")
+    g.add_argument("--period", type=float, help="regular wave period T, s")
+    g.add_argument("--hs", type=float, help="significant wave height, m")
+    g.add_argument("--tp", type=float, help="peak period, s")
+    g.add_argument("--gamma", type=float, default=3.3, help="JONSWAP peak enhancement (3.3)")
+    g.add_argument("--seed", type=int, default=0, help="random phase seed (0)")

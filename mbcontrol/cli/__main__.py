@@ -1,0 +1,6 @@
+"""python -m mbcontrol.cli"""
+import sys
+
+from . import main
+
+sys.exit(main())

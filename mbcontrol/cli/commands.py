@@ -1,0 +1,304 @@
+"""The commands behind `mbcontrol COMMAND` (the parser and `main` are in `mbcontrol.cli`)."""
+from __future__ import annotations
+
+import json
+import sys
+
+import numpy as np
+
+from ..results import jsonable
+
+
+def _plant(args, **kwargs):
+    from ..plant import build_plant
+    from ..scene import load_scene
+    values = dict(_key_value(item, "--scene-param") for item in args.scene_param)
+    return build_plant(load_scene(args.model, values or None), **kwargs)
+
+
+def run_models(args) -> int:
+    from ..scene import list_models, load_scene
+    for name in list_models():
+        print(f"{name:16s} {load_scene(name).description}")
+    return 0
+
+
+def run_hydro(args) -> int:
+    plant = _plant(args, radiation_tol=args.tol)
+    if plant.hydro is None:
+        print(f"{plant.name}: no hydrodynamic bodies")
+        return 0
+    rad = plant.hydro.radiation
+    report = {"model": plant.name, "source": plant.hydro.source, "dofs": list(plant.hydro.dofs),
+              "omega_rad_s": [float(plant.hydro.omega[0]), float(plant.hydro.omega[-1])],
+              "n_omega": int(plant.hydro.omega.size), "radiation_states": int(rad.order),
+              "fit_error": float(rad.fit_error),
+              "max_pole_real_part": float(np.max(np.linalg.eigvals(rad.A).real)),
+              "report": jsonable(rad.report)}
+    if args.json:
+        print(json.dumps(report, indent=2))
+    else:
+        print(f"{plant.name}: hydro data {report['source']}")
+        print(f"  DOFs ({len(report['dofs'])}): {', '.join(report['dofs'])}")
+        print(f"  {report['n_omega']} frequencies, {report['omega_rad_s'][0]:.3g}.."
+              f"{report['omega_rad_s'][1]:.3g} rad/s")
+        print(f"  radiation model: {rad.order} states, normalised RMS error "
+              f"{rad.fit_error:.2%}, slowest pole real part {report['max_pole_real_part']:.3g}")
+    return 0
+
+
+def _wave(args, plant, duration):
+    """The wave the CLI options describe, None for --wave none; notes a spectrum cut by the
+    hydro data's band on stderr."""
+    from ..waves import from_args
+    if args.wave == "none":
+        return None
+    omega = plant.hydro.omega if plant.hydro is not None else None
+    band = (float(omega[0]), float(omega[-1])) if omega is not None else None
+    wave = from_args(args.wave, height=args.height, period=args.period, hs=args.hs,
+                     tp=args.tp, gamma=args.gamma, seed=args.seed, duration=duration,
+                     data_band=band)
+    outside = wave.settings.get("spectrum_outside_data", 0.0)
+    if outside > 1e-3:
+        print(f"mbcontrol: note: {100 * outside:.2g} % of the spectrum's variance lies outside the "
+              f"hydro data ({band[0]:.3g}..{band[1]:.3g} rad/s) and is left out; Hs is kept on the "
+              f"rest", file=sys.stderr)
+    return wave
+
+
+def run_simulate(args) -> int:
+    from ..analysis import summary
+    from ..sim import simulate
+    plant = _plant(args)
+    duration = args.duration
+    if args.wave != "none":
+        if duration is None:
+            duration = 30 * args.period if args.wave == "regular" and args.period else 600.0
+    elif duration is None:
+        duration = 60.0
+    wave = _wave(args, plant, duration)
+    controller = _controller(args, wave)
+    params = dict(_key_value(s, "--param") for s in args.param)
+    ds = simulate(plant, wave, duration=duration, dt=args.dt, controller=controller,
+                  method=args.method, rtol=args.rtol, params=params or None,
+                  progress=not args.json)
+    if args.out:
+        from ..results import save_dataset
+        save_dataset(ds, args.out)
+    if args.plot:
+        from ..plotting import time_series
+        names = list(plant.topology.tree.coordinate_names) + [
+            f"{p.name}__power" for p in plant.scene.ptos]
+        time_series(ds, ["eta"] + names, path=args.plot)
+    result = summary(ds, plant)
+    if args.json:
+        print(json.dumps(result, indent=2))
+    else:
+        _print_summary(result)
+    return 0
+
+
+def run_design(args) -> int:
+    from mbcontrol.controllers.design import design
+    plant = _plant(args)
+    if args.wave == "none":
+        raise ValueError("design needs a wave: --wave regular|jonswap|pm")
+    wave = _wave(args, plant, args.duration or 600.0)
+    result = design(plant, wave, args.controller, pto=args.pto, simulate_s=args.duration,
+                    dt=args.dt, bounds={"auto": True, "full": "full", "off": False}[args.bounds],
+                    limits=not args.unconstrained)
+    command = _simulate_command(args, result)
+    if args.json:
+        print(json.dumps({**result.to_dict(), "model": plant.name, "wave": wave.describe(),
+                          "simulate_command": command}, indent=2, allow_nan=False))
+    else:
+        _print_design(plant, wave, result, command)
+    for note in result.warnings:
+        print(f"mbcontrol: warning: {note}", file=sys.stderr)
+    return 0
+
+
+def _simulate_command(args, result) -> str:
+    """The `mbcontrol simulate` command line that re-runs the design's simulation; numbers
+    in repr form, which round-trips a float exactly."""
+    import shlex
+    words = ["mbcontrol", "simulate", args.model]
+    for item in args.scene_param:
+        words += ["--scene-param", item]
+    words += ["--wave", args.wave]
+    if args.wave == "regular":
+        words += ["--height", repr(args.height), "--period", repr(args.period)]
+    else:
+        words += ["--hs", repr(args.hs), "--tp", repr(args.tp), "--seed", str(args.seed)]
+        if args.wave == "jonswap":
+            words += ["--gamma", repr(args.gamma)]
+    sim = result.simulation
+    if sim is not None:
+        words += ["--duration", repr(sim["duration_s"]), "--dt", repr(sim["dt_s"])]
+    words += ["--controller", result.name]
+    for key, value in result.parameters.items():
+        words += ["--set", f"{key}={value!r}"]
+    return shlex.join(words)
+
+
+def _power(value) -> str:
+    if value is None:
+        return "n/a"
+    for scale, unit in ((1e6, "MW"), (1e3, "kW"), (1.0, "W"), (1e-3, "mW")):
+        if abs(value) >= scale or scale == 1e-3:
+            return f"{value / scale:.4g} {unit}"
+
+
+def _print_design(plant, wave, result, command) -> None:
+    F = plant.units(f"{result.pto}__force")
+    X = plant.units(f"{result.pto}__position")
+    units = {"damping": f"{F} s/{X}", "stiffness": f"{F}/{X}", "force_max": F, "stroke_max": X,
+             "rate_max": f"{F}/s"}
+    sea = (f"a regular wave (H {wave.settings['height']:.6g} m, T {wave.settings['period']:.6g} s)"
+           if wave.kind == "regular" else
+           f"a {wave.kind.upper()} sea (Hs "
+           f"{wave.settings['hs']:.6g} m, Tp {wave.settings['tp']:.6g} s, seed "
+           f"{wave.settings['seed']})")
+    print(f"{plant.name}: {result.name} control of PTO {result.pto!r} designed for {sea}")
+    print("  parameters:")
+    for key, value in result.parameters.items():
+        print(f"    {key} = {value!r} {units.get(key, 's')}")
+    print(f"  predicted (linear theory): {_power(result.predicted_power_W)}")
+    if "simulated_power_W" in result.tuner:
+        print(f"  tuner's own simulation: {_power(result.tuner['simulated_power_W'])}")
+    if result.margins is not None:
+        print(f"  stability: {result.margins.message}")
+    b = result.bound
+    limits = f"|F| <= {b['force_max']:.4g} {F}, |x| <= {b['stroke_max']:.4g} {X}"
+    constrained = (_power(b["constrained_W"]) if b["constrained_W"] is not None
+                   else f"n/a ({b['constrained_reason']})")
+    print(f"  bounds: complex-conjugate {_power(b['complex_conjugate_W'])}; constrained "
+          f"({limits}) {constrained}")
+    m = result.metrics
+    if m is None:
+        print("  not simulated (see the warning)")
+    else:
+        sim = result.simulation
+        pct = result.percent_of_bound
+        share = ", ".join(f"{v:.1f} % of the {k.replace('_', '-')} bound"
+                          for k, v in pct.items() if v is not None)
+        print(f"  simulated ({sim['duration_s']:.4g} s, dt {sim['dt_s']:.4g} s, nonlinear plant): "
+              f"mean absorbed power {_power(m['mean_power_W'])} ({share})")
+        print(f"    max force {m['max_force']:.4g} {F}, max stroke {m['max_stroke']:.4g} {X}, "
+              f"peak/mean power {m['papr']:.3g}, samples outside the limits "
+              f"{100 * m['violation_fraction']:.3g} %")
+    print(f"  re-run: {command}")
+
+
+def run_bench(args) -> int:
+    from ..studies.bench_report import bench
+    plant = _plant(args)
+    duration = args.duration or (30 * args.period if args.wave == "regular" and args.period
+                                 else 600.0)
+    wave = _wave(args, plant, duration)
+    if wave is None:
+        raise ValueError("bench needs a wave: --wave regular|jonswap|pm")
+    bench(plant.scene, wave, duration=duration, methods=args.methods,
+          radiation_tols=args.radiation_tols, stability=args.stability,
+          repeats=args.repeats, out=args.out or f"out/bench/{plant.name}")
+    return 0
+
+
+def run_fidelity(args) -> int:
+    from ..studies.fidelity_auto import auto
+    plant = _plant(args)
+    duration = args.duration
+    wave = _wave(args, plant, duration or 600.0)
+    if wave is None:
+        raise ValueError("fidelity needs a wave: --wave regular|jonswap|pm")
+    report = auto(plant.scene, wave, tol=args.tol, duration=duration, progress=True)
+    print(report)
+    if args.out:
+        from ..results import save_dataset
+        save_dataset(report.to_dataset(), args.out)
+    return 0
+
+
+def run_linearize(args) -> int:
+    from ..analysis import linearize
+    plant = _plant(args)
+    params = dict(_key_value(s, "--param") for s in args.param)
+    sys_ = linearize(plant, params=params or None)
+    poles = np.linalg.eigvals(np.asarray(sys_.A))
+    pairs = [tuple(p.split(":", 1)) for p in args.pair] or [
+        (f"u__{p.name}", f"{p.name}__velocity") for p in plant.scene.ptos]
+    if args.bode:
+        from ..plotting import bode
+        omega = np.logspace(np.log10(max(plant.hydro.omega[0], 0.05)) if plant.hydro else -1,
+                            np.log10(plant.hydro.omega[-1]) if plant.hydro else 2, 400)
+        bode(sys_, pairs, omega, path=args.bode)
+    info = {"model": plant.name, "n_states": int(sys_.nstates), "states": sys_.state_labels,
+            "inputs": sys_.input_labels, "outputs": sys_.output_labels,
+            "poles": [[float(p.real), float(p.imag)] for p in poles],
+            "stable": bool(np.all(poles.real < 0)), "bode": args.bode}
+    if args.json:
+        print(json.dumps(info, indent=2))
+    else:
+        print(f"{plant.name}: {sys_.nstates} states, {sys_.ninputs} inputs, {sys_.noutputs} "
+              f"outputs; {'stable' if info['stable'] else 'NOT stable'} (max pole real part "
+              f"{poles.real.max():.3g})")
+        if args.bode:
+            print(f"Bode plot written to {args.bode}")
+    return 0
+
+
+def _controller(args, wave=None):
+    """The --controller with its --set settings. A controller that takes a `wave` (a
+    predictive controller's preview) is handed the simulated one, as `design` does."""
+    if not args.controller:
+        if args.set:
+            raise ValueError("--set needs --controller")
+        return None
+    import inspect
+
+    from mbcontrol.controllers import REGISTRY, make
+    cls = REGISTRY.get(args.controller)
+    signature = inspect.signature(cls).parameters if cls is not None else {}
+    settings = {}
+    for item in args.set:
+        key, value = _key_value(item, "--set", text=True)
+        # text only for a setting that is text (a choice), so a typo in a number is caught
+        if isinstance(value, str) and not _takes_text(signature.get(key)):
+            raise ValueError(f"--set {key}: expected a number, got {value!r}")
+        settings[key] = value
+    if wave is not None and cls is not None and "wave" in inspect.signature(cls).parameters:
+        settings.setdefault("wave", wave)
+    return make(args.controller, **settings)
+
+
+def _takes_text(parameter) -> bool:
+    """Does a controller setting take text: a str default or a str annotation?"""
+    if parameter is None:
+        return False
+    return isinstance(parameter.default, str) or "str" in str(parameter.annotation)
+
+
+def _key_value(item: str, flag: str, text: bool = False):
+    """(key, float value); with text, a value that is not a number stays a string (a
+    controller's choice such as --set forecast=ar)."""
+    if "=" not in item:
+        raise ValueError(f"{flag} expects KEY=VALUE, got {item!r}")
+    key, value = item.split("=", 1)
+    try:
+        return key.strip(), float(value)
+    except ValueError:
+        if text and value.strip():
+            return key.strip(), value.strip()
+        raise ValueError(f"{flag} {key}: expected a number, got {value!r}") from None
+
+
+def _print_summary(result: dict) -> None:
+    print(f"{result['model']}: {result['duration_s']:.4g} s simulated in "
+          f"{result['wall_time_s']:.3g} s ({result['method']}, dt = {result['dt_s']} s)")
+    for body, values in result["bodies"].items():
+        print(f"  {body}: heave amplitude {values['heave_amplitude_m']:.4g} m, pitch amplitude "
+              f"{values['pitch_amplitude_rad']:.4g} rad")
+    for pto, values in result["ptos"].items():
+        print(f"  {pto}: mean absorbed power {values['mean_power_W']:.4g} W, max force "
+              f"{values['max_force']:.4g}, max stroke {values['max_stroke']:.4g}")
+

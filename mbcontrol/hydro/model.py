@@ -1,0 +1,268 @@
+"""The hydrodynamics a plant needs, restricted to the DOFs its joints can move.
+
+`HydroModel` holds body-frame BEM data (NED, at each CoG, exp(-i omega t); see mbcontrol.hydro)
+for the active DOFs and the radiation state-space model fitted to them. Fits are cached on disk
+(keyed by the data, the DOFs, the tolerance, the fit band and the fitting code), written to a
+temporary file and renamed.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+from ..cache import cache_dir
+from ..errors import HydroError
+from ..scene import DOF_NAMES, Scene
+from ..waves import Wave, excitation_series, interpolate_complex
+from . import passivity, radiation, sdp, vector_fit
+from ._io import read_netcdf
+from .bem import compute
+from .geometry import BemBody
+from .isolated import compute_isolated
+from .radiation import RadiationModel, fit_radiation
+from .ssforms import modal_form
+
+
+@dataclass(frozen=True)
+class HydroModel:
+    dofs: tuple[str, ...]
+    data: xr.Dataset                   # body-frame BEM data on `dofs`
+    radiation: RadiationModel
+    source: str
+    fit_omega_max: float = np.inf      # rad/s, the scene's radiation fit band limit
+
+    def _matrix(self, name: str) -> np.ndarray:
+        """(..., influenced, radiating) array: rows are the DOFs the force acts on."""
+        da = self.data[name].sel(influenced_dof=list(self.dofs), radiating_dof=list(self.dofs))
+        dims = [d for d in da.dims if d not in ("influenced_dof", "radiating_dof")]
+        return da.transpose(*dims, "influenced_dof", "radiating_dof").values
+
+    @property
+    def added_mass_inf(self) -> np.ndarray:
+        return self._matrix("added_mass_inf")
+
+    @property
+    def omega(self) -> np.ndarray:
+        return self.data["omega"].values
+
+    def added_mass(self) -> np.ndarray:
+        return self._matrix("added_mass")
+
+    def radiation_damping(self) -> np.ndarray:
+        return self._matrix("radiation_damping")
+
+    def hydrostatic_stiffness(self) -> np.ndarray:
+        return self._matrix("hydrostatic_stiffness")
+
+    def excitation_coefficients(self, direction: float = 0.0) -> np.ndarray:
+        """Complex excitation per unit amplitude (n_omega, n_dof), exp(-i omega t)."""
+        directions = self.data["wave_direction"].values
+        i = int(np.argmin(np.abs(directions - direction)))
+        if abs(directions[i] - direction) > 1e-6:
+            raise HydroError(f"{self.source}: no excitation data for wave direction "
+                             f"{direction:.4g} rad; the data has {np.round(directions, 4)}")
+        da = self.data["excitation_force"].isel(wave_direction=i)
+        return da.sel(influenced_dof=list(self.dofs)).transpose("omega", "influenced_dof").values
+
+    def excitation(self, wave: Wave, t) -> np.ndarray:
+        try:
+            return excitation_series(wave, self.omega, self.excitation_coefficients(
+                wave.direction), t)
+        except ValueError as exc:
+            raise HydroError(f"{self.source}: {exc}") from None
+
+    def stiffness_by_body(self) -> dict[str, np.ndarray]:
+        """6x6 hydrostatic stiffness at each body's CoG (zeros on DOFs not in the data)."""
+        G = self.hydrostatic_stiffness()
+        out: dict[str, np.ndarray] = {}
+        for i, dof_i in enumerate(self.dofs):
+            body, name_i = dof_i.split("__")
+            for j, dof_j in enumerate(self.dofs):
+                body_j, name_j = dof_j.split("__")
+                if body_j == body:
+                    block = out.setdefault(body, np.zeros((6, 6)))
+                    block[DOF_NAMES.index(name_i), DOF_NAMES.index(name_j)] = G[i, j]
+        return out
+
+    def buoyancy(self, water) -> dict:
+        """body -> (rho g V in N, centre of buoyancy at rest in the n-frame, m)."""
+        if "displaced_volume" not in self.data or "center_of_buoyancy" not in self.data:
+            return {}
+        bodies = {d.split("__")[0] for d in self.dofs}
+        out = {}
+        for body in self.data["body"].values.tolist():
+            if body in bodies:
+                volume = float(self.data["displaced_volume"].sel(body=body))
+                centre = self.data["center_of_buoyancy"].sel(body=body).transpose("xyz").values
+                out[body] = (water.rho * water.g * volume, centre)
+        return out
+
+    def radiation_matrices(self):
+        """(A_r, B_r, C_r, D_r) in real modal form: same input-output map, sparse A_r."""
+        r = self.radiation
+        order = [r.dofs.index(d) for d in self.dofs]
+        B, C, D = r.B[:, order], r.C[order, :], r.D[np.ix_(order, order)]
+        try:
+            A, B, C = modal_form(r.A, B, C)
+        except ValueError:
+            A = r.A
+        return A, B, C, D
+
+    def restricted(self, dofs) -> "HydroModel":
+        dofs = tuple(dofs)
+        if dofs == self.dofs:
+            return self
+        missing = [d for d in dofs if d not in self.dofs]
+        if missing:
+            raise HydroError(f"{self.source}: the plant moves {missing} but the hydro model "
+                             f"only has {list(self.dofs)}")
+        return HydroModel(dofs, self.data, _fit_cached(self.data, dofs, None, self.source,
+                                                       self.fit_omega_max),
+                          self.source, self.fit_omega_max)
+
+    def frequency_domain_matrices(self, omega):
+        """A(omega), B(omega) interpolated to omega (n, n_dof, n_dof), for FD solutions."""
+        return (interpolate_complex(self.omega, self.added_mass(), np.asarray(omega)).real,
+                interpolate_complex(self.omega, self.radiation_damping(),
+                                    np.asarray(omega)).real)
+
+
+def load_hydro_model(scene: Scene, dofs, tol: float | None = None) -> HydroModel:
+    """Body-frame data for `dofs` (from scene.hydro.file, or a cached BEM run) and its fit."""
+    tol = scene.hydro.radiation_tol if tol is None else tol
+    source, data = load_hydro_data(scene, dofs)
+    return fit_hydro_model(data, dofs, tol, source, scene.hydro.fit_omega_max)
+
+
+def load_hydro_data(scene: Scene, dofs) -> tuple[str, xr.Dataset]:
+    """(source, body-frame BEM dataset) holding at least `dofs`, without a radiation fit."""
+    # a precomputed file wins; a scene that also gives BEM frequencies falls back to a (cached)
+    # BEM run when the file is absent, e.g. for a parameter value nobody precomputed
+    if scene.hydro.file and (Path(scene.hydro.file).exists() or not scene.hydro.omega):
+        source = scene.hydro.file
+        data = read_netcdf(source)
+    else:
+        source, data = _run_bem(scene, dofs)
+    _check_dofs(data, dofs, source)
+    return source, data
+
+
+def fit_hydro_model(data: xr.Dataset, dofs, tol: float | None, source: str,
+                    fit_omega_max: float = np.inf) -> HydroModel:
+    """A HydroModel of `data` on `dofs`, its radiation fitted to `tol` (cached on disk).
+
+    For callers that change the data first (e.g. mbcontrol.plant.fidelity drops the coupling between
+    bodies): the cache key is the data itself, so a changed dataset never serves an old fit.
+    """
+    _check_dofs(data, dofs, source)
+    fit = _fit_cached(data, tuple(dofs), tol, source, fit_omega_max)
+    return HydroModel(tuple(dofs), data, fit, source, fit_omega_max)
+
+
+def _run_bem(scene: Scene, dofs):
+    if not scene.hydro.omega:
+        raise HydroError(f"{scene.path}: hydro.omega: expected BEM frequencies to compute the "
+                         f"hydrodynamics of the scene's geometry (or a hydro.file)")
+    bodies = []
+    for body in scene.bodies:
+        # solve only what the joints can move (and the scene allows): no more than needed
+        body_dofs = tuple(d.split("__")[1] for d in dofs if d.split("__")[0] == body.name
+                          and d.split("__")[1] in scene.hydro.dofs)
+        if body.hydro and body_dofs:
+            bodies.append(BemBody(name=body.name, geometry=geometry_dict(body.geometry),
+                                      cog=body.cog, mass=body.mass,
+                                      panel_size=scene.hydro.panel_size, dofs=body_dofs))
+    solve = compute if scene.hydro.interaction else compute_isolated
+    data = solve(bodies, rho=scene.water.rho, g=scene.water.g, depth=scene.water.depth,
+                       omegas=np.array(scene.hydro.omega), headings=scene.hydro.headings,
+                       lid=scene.hydro.lid, cache_dir=cache_dir())
+    what = "BEM" if scene.hydro.interaction else "BEM, bodies solved alone,"
+    return f"{what} of {scene.path}", data
+
+
+def geometry_dict(geometry) -> dict:
+    g = {"type": geometry.kind, "center": list(geometry.center)}
+    for key in ("size", "radius", "length", "file"):
+        value = getattr(geometry, key)
+        if value is not None:
+            g[key] = list(value) if isinstance(value, tuple) else value
+    if geometry.kind == "cylinder":
+        g["axis"] = geometry.axis
+    return g
+
+
+def _check_dofs(data: xr.Dataset, dofs, source: str) -> None:
+    for var in ("added_mass", "radiation_damping", "added_mass_inf", "excitation_force",
+                "hydrostatic_stiffness"):
+        if var not in data:
+            raise HydroError(f"{source}: missing variable {var!r}")
+    have = set(data["radiating_dof"].values.tolist())
+    missing = [d for d in dofs if d not in have]
+    if missing:
+        raise HydroError(f"{source}: the scene's joints move {missing}, but the hydro data "
+                         f"has only {sorted(have)}")
+
+
+def fit_band_limit(data: xr.Dataset, scene_limit: float = np.inf) -> float | None:
+    """Highest frequency the radiation fit uses: the scene's fit_omega_max, and for our own
+    BEM runs no higher than where the mesh is still resolved.
+
+    Above `omega_max_mesh` (fewer than 8 panels per wavelength) panel-method damping loses
+    accuracy and even passivity; third-party files carry irregular-frequency spikes the scene
+    can exclude. Fitting either would spend states on numerical artefacts.
+    """
+    limit = min(float(data.attrs.get("omega_max_mesh", np.inf)), float(scene_limit))
+    return limit if np.isfinite(limit) else None
+
+
+def _fit_cached(data: xr.Dataset, dofs, tol, source: str, omega_max: float = np.inf):
+    """fit_radiation with an on-disk cache keyed by the data, the DOFs and the tolerance."""
+    tol = 0.01 if tol is None else tol
+    digest = hashlib.sha256()
+    for var in ("added_mass", "radiation_damping", "added_mass_inf"):
+        digest.update(np.ascontiguousarray(data[var].values).tobytes())
+    # the fitting code is part of the key: a changed algorithm never serves an old fit
+    for module in (radiation, vector_fit, passivity, sdp):
+        digest.update(Path(module.__file__).read_bytes())
+    band = fit_band_limit(data, omega_max)
+    digest.update(json.dumps([list(dofs), tol, band]).encode())
+    path = cache_dir() / f"radiation_{digest.hexdigest()[:20]}.npz"
+    if path.exists():
+        try:
+            with np.load(path, allow_pickle=False) as z:
+                return _model_from_arrays(z)
+        except (OSError, ValueError, KeyError):
+            path.unlink(missing_ok=True)       # a stale or foreign file: refit
+    model = fit_radiation(data, dofs=list(dofs), tol=tol, omega_max=band)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".npz.tmp")
+    os.close(fd)
+    with open(tmp, "wb") as fh:
+        np.savez(fh, A=model.A, B=model.B, C=model.C, D=model.D, dofs=np.array(model.dofs),
+                 order=model.order, fit_error=model.fit_error, entry_errors=model.entry_errors,
+                 report=json.dumps(model.report, default=_jsonable))
+    os.replace(tmp, path)
+    return model
+
+
+def _model_from_arrays(z) -> RadiationModel:
+    return RadiationModel(A=z["A"], B=z["B"], C=z["C"], D=z["D"],
+                          dofs=tuple(str(d) for d in z["dofs"]), order=int(z["order"]),
+                          fit_error=float(z["fit_error"]), entry_errors=z["entry_errors"],
+                          report=json.loads(str(z["report"])))
+
+
+def _jsonable(obj):
+    if isinstance(obj, np.ndarray):
+        return obj.tolist() if obj.dtype.kind != "c" else [obj.real.tolist(), obj.imag.tolist()]
+    if isinstance(obj, np.generic):
+        return obj.item()
+    if isinstance(obj, complex):
+        return [obj.real, obj.imag]
+    return str(obj)

@@ -1,0 +1,18 @@
+"""The process plant: a scene's nonlinear equations of motion as CasADi Functions.
+
+`build_plant(scene)` assembles x' = f(x, u, w; p), y = h(x, u, w; p) with named signals and
+symbolic parameters. Modules: `process` (ProcessPlant and its assembly), `loads` (PTO,
+friction, moorings, drag, end stops, gravity, hydrostatics), `catenary` and `catenary_line`
+(quasi-static mooring lines), `checks` (rest checks), `fidelity` (simplified models),
+`jacobians` (exact Jacobians, shared downstream), `build` (the entry point).
+"""
+from .build import build_plant
+from .catenary import CatenarySolution, solve_catenary
+from .catenary_line import CatenaryLine, catenary_line
+from .fidelity import Fidelity, FidelityError, plant_for
+from .jacobians import jacobians
+from .process import ProcessPlant, active_hydro_dofs, dof_selector
+
+__all__ = ["build_plant", "ProcessPlant", "active_hydro_dofs", "dof_selector", "jacobians",
+           "Fidelity", "FidelityError", "plant_for", "CatenaryLine", "CatenarySolution",
+           "catenary_line", "solve_catenary"]

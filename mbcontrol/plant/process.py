@@ -1,0 +1,291 @@
+"""ProcessPlant: the scene's nonlinear equations of motion as CasADi Functions.
+
+    q' = K(q) s
+    M^g(q) s' = -C^g(q,s) s - mu^g - restoring + P tau_exc + PTO + friction + mooring + drag
+    chi' = A_r chi + B_r nu_h ,  mu_h = C_r chi + D_r nu_h ,  nu_h = (P^T s)[hydro DOFs]
+
+with M^g = P (M_RB + A_inf) P^T (ERRATA section 4). The state is x = [q, s, chi]; inputs are
+u (one force command per PTO) and w (the excitation wrench on each hydro DOF, body axes at the
+CoG); parameters p (PTO, friction, mooring, drag coefficients) stay symbolic.
+"""
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass, field
+
+import casadi as ca
+import numpy as np
+
+from ..hydro import HydroModel, load_hydro_model
+from ..multibody import Topology, build_topology
+from ..scene import DOF_NAMES, Scene, load_scene
+from . import checks, loads
+
+
+@dataclass(frozen=True, eq=False)      # identity semantics: compiled code is cached per plant
+class ProcessPlant:
+    """x' = f(x, u, w, p), y = h(x, u, w, p) with named signals; built once, immutable."""
+    scene: Scene
+    topology: Topology
+    hydro: HydroModel | None
+    states: tuple[str, ...]
+    inputs: tuple[str, ...]          # u: PTO force commands (N or N m)
+    disturbances: tuple[str, ...]    # w: excitation on each hydro DOF (N or N m, body axes)
+    outputs: tuple[str, ...]
+    parameters: tuple[str, ...]
+    p0: np.ndarray
+    f: ca.Function = field(repr=False)
+    h: ca.Function = field(repr=False)
+    notes: dict = field(default_factory=dict)   # build-time findings (plant.checks.rest_checks)
+
+    @property
+    def name(self) -> str:
+        return self.scene.name
+
+    def units(self, signal: str) -> str:
+        """SI unit of a named state, input, disturbance or output."""
+        return _units(self, signal)
+
+    @property
+    def nx(self) -> int:
+        return len(self.states)
+
+    @property
+    def n_q(self) -> int:
+        return self.topology.tree.n_q
+
+    def x0(self) -> np.ndarray:
+        """The rest state (all bodies at their scene pose, still water)."""
+        return np.zeros(self.nx)
+
+    def params(self, **overrides) -> np.ndarray:
+        """Parameter vector with named overrides, e.g. params(hinge_pto__damping=3.0)."""
+        p = self.p0.copy()
+        for key, value in overrides.items():
+            if key not in self.parameters:
+                raise KeyError(f"{self.name}: unknown parameter {key!r}; known: "
+                               f"{', '.join(self.parameters)}")
+            p[self.parameters.index(key)] = value
+        return p
+
+    def excitation(self, wave, t) -> np.ndarray:
+        """Excitation w(t) (len(t), n_w) of a wave on this plant's hydro DOFs."""
+        if self.hydro is None:
+            return np.zeros((np.size(t), 0))
+        return self.hydro.excitation(wave, t)
+
+
+def assemble_plant(scene: Scene | str, hydro: HydroModel | None = None, *,
+                   radiation_tol: float | None = None, radiation: bool = True) -> ProcessPlant:
+    """The full process plant of a scene (a Scene, a scene file or a catalogue name).
+
+    Hydrodynamics come from `hydro` or the scene's hydro.file; the radiation model is fitted
+    to `radiation_tol` (default: the scene's) on the DOFs the joints can move. With
+    radiation=False the plant has no radiation states: w is then the whole wave load on the
+    hydro DOFs (excitation minus radiation memory), as a direct-convolution reference needs.
+    Users call `mbcontrol.plant.build_plant`, which also builds simplified models.
+    """
+    scene = load_scene(scene) if not isinstance(scene, Scene) else scene
+    topo = build_topology(scene)
+    tree = topo.tree
+    q, s = ca.SX.sym("q", tree.n_q), ca.SX.sym("s", tree.n_s)
+    u = ca.SX.sym("u", len(scene.ptos))
+
+    hydro_dofs = active_hydro_dofs(scene, topo)
+    if hydro is None and hydro_dofs:
+        hydro = load_hydro_model(scene, hydro_dofs, tol=radiation_tol)
+    elif hydro is not None:
+        hydro = hydro.restricted(hydro_dofs)
+    n_w = len(hydro_dofs)
+    n_r = hydro.radiation.A.shape[0] if hydro and radiation else 0
+    w, chi = ca.SX.sym("w", n_w), ca.SX.sym("chi", n_r)
+
+    params = loads.Parameters()
+    P = tree.P(q)
+    select = dof_selector(topo, hydro_dofs)                  # 6N -> hydro DOFs
+    added_mass = select.T @ hydro.added_mass_inf @ select if hydro else None
+    nu_h = ca.mtimes(select, ca.mtimes(P.T, s))
+
+    tau = -tree.bias(q, s, added_mass)
+    chi_dot, power = ca.SX(0, 1), {"radiated_power": 0, "excitation_power": 0}
+    if hydro and not radiation:
+        tau += ca.mtimes(P, ca.mtimes(select.T, w))
+        power = {"radiated_power": 0, "excitation_power": ca.dot(nu_h, w)}
+    elif hydro:
+        A_r, B_r, C_r, D_r = hydro.radiation_matrices()
+        mu_h = ca.mtimes(C_r, chi) + ca.mtimes(D_r, nu_h)
+        chi_dot = ca.mtimes(A_r, chi) + ca.mtimes(B_r, nu_h)
+        tau += ca.mtimes(P, ca.mtimes(select.T, w - mu_h))
+        power = {"radiated_power": ca.dot(nu_h, mu_h), "excitation_power": ca.dot(nu_h, w)}
+    if scene.hydro.hydrostatics == "large_angle":
+        restoring, potential = loads.large_angle_hydrostatics(scene, topo, q)
+    else:
+        restoring, potential = loads.restoring_forces(topo, q, hydro.stiffness_by_body() if hydro
+                                                      else {})
+    tau += restoring
+    tau_pto, pto_signals = loads.pto_forces(scene, topo, q, s, u, params)
+    tau += tau_pto + loads.friction_forces(scene, topo, s, params)
+    tau += loads.drag_forces(scene, topo, q, s, params)
+    tau_moor, mooring_energy, tensions = loads.mooring_forces(scene, topo, q, s, params)
+    tau += tau_moor
+    potential += mooring_energy
+    for conservative in (loads.end_stop_forces(scene, topo, q, s, params),
+                         loads.gravity_forces(scene, topo, q)):
+        tau += conservative[0]
+        potential += conservative[1]
+    if scene.hydro.hydrostatics == "linear":
+        tau += loads.static_loads(scene, topo, q, hydro.buoyancy(scene.water) if hydro else {})
+    tau += _preloads(scene, topo, q, s, u, w, chi, tau, pto_signals, params)
+
+    M = tree.mass_matrix(q, added_mass)
+    notes = checks.rest_checks(scene, topo, q, s, u, w, chi, tau, M, params)
+    s_dot = ca.solve(M, tau)
+    x = ca.vertcat(q, s, chi)
+    x_dot = ca.vertcat(ca.mtimes(tree.K(q), s), s_dot, chi_dot)
+    kinetic = 0.5 * ca.mtimes([s.T, M, s])
+    power["energy"] = kinetic + potential
+    y, output_names = _outputs(scene, topo, q, s, pto_signals, power, tensions)
+    p = params.vector
+
+    coords = list(tree.coordinate_names)
+    states = coords + [f"{c}__vel" for c in coords] + [f"radiation_{i}" for i in range(n_r)]
+    inputs = [f"u__{pto.name}" for pto in scene.ptos]
+    disturbances = [f"w__{d}" for d in hydro_dofs]
+    f = ca.Function("f", [x, u, w, p], [x_dot], ["x", "u", "w", "p"], ["xdot"])
+    h = ca.Function("h", [x, u, w, p], [y], ["x", "u", "w", "p"], ["y"])
+    return ProcessPlant(scene, topo, hydro, tuple(states), tuple(inputs), tuple(disturbances),
+                        tuple(output_names), tuple(params.names), np.array(params.values),
+                        f, h, notes)
+
+
+def _preloads(scene, topo, q, s, u, w, chi, tau, pto_signals, params):
+    """Constant PTO forces that make rest an equilibrium (PTOs with preload = "balance").
+
+    The static generalised load at rest does not depend on the parameters (every
+    parametrised load vanishes at rest), so the preloads are solved once, here, and kept as
+    parameters (<pto>__preload, N or N m) that identification may change. Warns, naming the
+    coordinates, when rest is still not an equilibrium.
+    """
+    tree = topo.tree
+    rest = ca.Function("rest", [q, s, u, w, chi, params.vector], [tau])
+    n_p = len(params.names)
+    args = [np.zeros(tree.n_q), np.zeros(tree.n_s), np.zeros(u.shape[0]), np.zeros(w.shape[0]),
+            np.zeros(chi.shape[0]), np.array(params.values) if n_p else np.zeros(0)]
+    residual = np.asarray(rest(*args)).ravel()
+    balancing = [p for p in scene.ptos if p.preload == "balance"]
+    extra = ca.SX.zeros(tree.n_s)
+    if balancing:
+        d_fun = ca.Function("d", [q], [ca.horzcat(*[pto_signals[p.name][3] for p in balancing])])
+        D = np.asarray(d_fun(np.zeros(tree.n_q)))
+        f0, *_ = np.linalg.lstsq(D, -residual, rcond=None)
+        for pto, value, column in zip(balancing, f0, range(len(balancing))):
+            sym = params.add(f"{pto.name}__preload", float(value))
+            extra += pto_signals[pto.name][3] * sym
+        residual = residual + D @ f0
+    scale = max(1.0, float(np.max(np.abs(np.asarray(args[0])))))
+    if np.max(np.abs(residual), initial=0.0) > 1e-9 * scale * max(1.0, _load_scale(scene)):
+        worst = np.argsort(-np.abs(residual))[:3]
+        listing = ", ".join(f"{tree.coordinate_names[i]}: {residual[i]:.4g}" for i in worst)
+        warnings.warn(f"{scene.path}: rest is not an equilibrium; static generalised loads "
+                      f"{listing} (N or N m). Give a PTO preload = \"balance\", or correct "
+                      f"masses, CoGs or the hydro data", RuntimeWarning, stacklevel=3)
+    return extra
+
+
+def _load_scale(scene) -> float:
+    return max(b.mass for b in scene.bodies) * scene.water.g
+
+
+def active_hydro_dofs(scene: Scene, topo: Topology) -> list[str]:
+    """Body DOFs ("<body>__<Dof>") of hydro bodies that the joints let move.
+
+    A DOF is active when its column of P(q) is non-zero at some configuration; probing random
+    configurations finds every column that is not identically zero.
+    """
+    tree = topo.tree
+    q = ca.SX.sym("q", tree.n_q)
+    P_fun = ca.Function("P", [q], [tree.P(q)])
+    rng = np.random.default_rng(12345)
+    norms = sum(np.abs(np.array(P_fun(rng.uniform(-0.5, 0.5, tree.n_q)))) for _ in range(4))
+    moving = norms.sum(axis=0) > 1e-12 if tree.n_q else np.zeros(6 * len(topo.bodies), bool)
+    dofs = []
+    for k, name in enumerate(topo.bodies):
+        if scene.body(name).hydro:
+            dofs += [f"{name}__{d}" for i, d in enumerate(DOF_NAMES) if moving[6 * k + i]]
+    return dofs
+
+
+def dof_selector(topo: Topology, dofs: list[str]) -> np.ndarray:
+    """Rows pick hydro DOFs out of the 6N body-twist vector."""
+    select = np.zeros((len(dofs), 6 * len(topo.bodies)))
+    for row, dof in enumerate(dofs):
+        body, name = dof.split("__")
+        select[row, 6 * topo.body_index(body) + DOF_NAMES.index(name)] = 1.0
+    return select
+
+
+def _outputs(scene, topo: Topology, q, s, pto_signals, power, tensions):
+    tree = topo.tree
+    q_rest = ca.DM.zeros(tree.n_q)
+    values, names = [q, s], list(tree.coordinate_names) + [f"{c}__vel" for c in
+                                                          tree.coordinate_names]
+    for k, body in enumerate(topo.bodies):
+        displacement = tree.cog(q, k) - tree.cog(q_rest, k)
+        values += [displacement, loads.euler_zyx(tree.rotation(q, k))]
+        names += [f"{body}__{dof}" for dof in DOF_NAMES]
+    for pto, (position, velocity, force, _) in pto_signals.items():
+        values += [position, velocity, force, -force * velocity]
+        names += [f"{pto}__position", f"{pto}__velocity", f"{pto}__force", f"{pto}__power"]
+    # energy audit: radiated (W, leaving the bodies), wave input (W), and the mechanical energy
+    # (J): kinetic + hydrostatic, gravity (dry bodies), mooring and end-stop potentials; PTO
+    # forces, springs included, are external: their power is <pto>__power
+    values += [power["radiated_power"], power["excitation_power"], power["energy"]]
+    names += ["radiated_power", "excitation_power", "energy"]
+    for line, signals in tensions.items():
+        values += list(signals)
+        names += [f"{line}__tension", f"{line}__span", f"{line}__height"]
+    return ca.vertcat(*values), names
+
+
+_BODY_UNITS = {"Surge": ("m", "N"), "Sway": ("m", "N"), "Heave": ("m", "N"),
+               "Roll": ("rad", "N m"), "Pitch": ("rad", "N m"), "Yaw": ("rad", "N m")}
+_ENERGY_UNITS = {"radiated_power": "W", "excitation_power": "W", "energy": "J"}
+
+
+def _coordinate_unit(plant, name: str) -> str:
+    """rad for rotations, m for translations, from the joint that owns the coordinate."""
+    for joint in plant.scene.joints:
+        if name == joint.name:
+            if joint.type == "free":
+                return _BODY_UNITS[joint.dofs[0]][0]
+            return "rad" if joint.type == "revolute" else "m"
+        if name.startswith(joint.name + "__"):
+            return _BODY_UNITS[name.split("__")[-1]][0]
+    return ""
+
+
+def _units(plant, signal: str) -> str:
+    if signal in _ENERGY_UNITS:
+        return _ENERGY_UNITS[signal]
+    if signal.startswith("radiation_"):
+        return "internal"
+    if signal.startswith("w__"):
+        return _BODY_UNITS[signal.split("__")[-1]][1]
+    base = signal[3:] if signal.startswith("u__") else signal
+    for pto in plant.scene.ptos:
+        if base == pto.name or base.startswith(pto.name + "__"):
+            coord = "m" if pto.between_points else _coordinate_unit(plant, pto.joint)
+            force = "N m" if coord == "rad" else "N"
+            kind = "force" if base == pto.name else base.split("__")[-1]
+            return {"position": coord, "velocity": f"{coord}/s", "force": force,
+                    "power": "W"}[kind]
+    if signal.endswith("__tension"):
+        return "N"
+    if signal.endswith(("__span", "__height")):
+        return "m"
+    if signal.endswith("__vel"):
+        return f"{_coordinate_unit(plant, signal[:-5])}/s"
+    if "__" in signal and signal.split("__")[-1] in _BODY_UNITS and \
+            signal.split("__")[0] in plant.topology.bodies:
+        return _BODY_UNITS[signal.split("__")[-1]][0]
+    return _coordinate_unit(plant, signal)

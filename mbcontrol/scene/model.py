@@ -1,0 +1,215 @@
+"""Scene files: what a device is made of, read from TOML and validated once.
+
+A scene names its water, rigid bodies (mass, inertia about the CoG, CoG, BEM geometry), the
+joints of a tree (or forest) rooted at "ground", PTOs on joints and extra loads (hinge friction,
+linear moorings, quadratic drag). Every later stage trusts a loaded `Scene`.
+
+Coordinates are in the n-frame (north-east-down: x forward, y starboard, z down, origin on the
+undisturbed free surface) at the reference configuration q = 0, where every body frame is
+aligned with the n-frame. Numbers are SI; strings such as "60 mm" or "5 deg" are converted.
+See models/hinged_barge.toml for an annotated example.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+DOF_NAMES = ("Surge", "Sway", "Heave", "Roll", "Pitch", "Yaw")
+JOINT_TYPES = ("revolute", "prismatic", "fixed", "free")
+
+
+@dataclass(frozen=True)
+class Water:
+    rho: float = 1025.0            # kg/m^3
+    g: float = 9.81                # m/s^2
+    depth: float = math.inf        # m; inf for deep water
+
+
+@dataclass(frozen=True)
+class Geometry:
+    """BEM geometry of a body in the n-frame at rest: a primitive or a mesh file."""
+    kind: str                              # "box" | "cylinder" | "sphere" | "mesh"
+    center: tuple[float, float, float] = (0.0, 0.0, 0.0)   # m, geometric centre (primitives)
+    size: tuple[float, float, float] | None = None         # m, box edge lengths (x, y, z)
+    radius: float | None = None                            # m, cylinder and sphere
+    length: float | None = None                            # m, cylinder
+    axis: str = "z"                                        # cylinder axis
+    file: str | None = None                                # mesh file, absolute path
+
+
+@dataclass(frozen=True)
+class Body:
+    name: str
+    mass: float                                            # kg
+    inertia: tuple[tuple[float, ...], ...]                 # kg m^2, 3x3 about the CoG, n axes
+    cog: tuple[float, float, float]                        # m, n-frame at rest
+    geometry: Geometry | None = None
+    hydro: bool = True                                     # False: no hydrodynamic loads
+
+
+@dataclass(frozen=True)
+class Joint:
+    name: str
+    type: str                                              # one of JOINT_TYPES
+    parent: str                                            # body name or "ground"
+    child: str
+    point: tuple[float, float, float]                      # m, joint point, n-frame at rest
+    axis: tuple[float, float, float] | None = None         # unit axis (revolute, prismatic)
+    dofs: tuple[str, ...] = ()                             # free joints: subset of DOF_NAMES
+
+    @property
+    def n_coordinates(self) -> int:
+        return {"revolute": 1, "prismatic": 1, "fixed": 0}.get(self.type, len(self.dofs))
+
+
+@dataclass(frozen=True)
+class Pto:
+    """A linear PTO: load on its follower = -(damping*v + stiffness*x) + u (+ preload).
+
+    Either on a one-coordinate joint (`joint`; x is the joint coordinate) or between two
+    points (`body`/`point` the follower, `parent`/`parent_point` the other end, "ground" or a
+    body; x is the change of the distance between them, the force acts along their line).
+    preload "balance": a constant force chosen so that rest is an equilibrium (the static
+    load the PTO carries, e.g. a float's weight on a motor).
+    """
+    name: str
+    joint: str | None = None
+    damping: float = 0.0           # N s/m or N m s/rad
+    stiffness: float = 0.0         # N/m or N m/rad
+    force_max: float = math.inf    # N or N m; a limit controllers must respect
+    stroke_max: float = math.inf   # m or rad; a limit controllers must respect
+    efficiency: float = 1.0        # mechanical to electrical conversion, 0..1
+    body: str | None = None
+    point: tuple[float, float, float] | None = None        # m, n-frame at rest
+    parent: str = "ground"
+    parent_point: tuple[float, float, float] | None = None  # m, n-frame at rest
+    preload: str = "none"          # "none" | "balance"
+
+    @property
+    def between_points(self) -> bool:
+        return self.joint is None
+
+
+@dataclass(frozen=True)
+class Friction:
+    """Joint friction -(viscous*v + coulomb*tanh(v/velocity_scale)); tanh smooths the sign."""
+    name: str
+    joint: str
+    viscous: float = 0.0           # N s/m or N m s/rad
+    coulomb: float = 0.0           # N or N m
+    velocity_scale: float = 1e-2   # m/s or rad/s
+
+
+@dataclass(frozen=True)
+class Mooring:
+    """A mooring at a body point (the fairlead).
+
+    kind "linear": a spring-damper from the fairlead's rest position, per n-frame axis.
+    kind "catenary": a quasi-static elastic catenary line to a seabed anchor
+    (mbcontrol.plant.catenary): its tension at the fairlead, from the line's length, axial stiffness
+    EA and submerged weight per metre, with seabed contact.
+    """
+    name: str
+    body: str
+    point: tuple[float, float, float]          # m, fairlead on the body, n-frame at rest
+    stiffness: tuple[float, float, float] = (0.0, 0.0, 0.0)  # N/m along n-frame x, y, z
+    damping: tuple[float, float, float] = (0.0, 0.0, 0.0)  # N s/m
+    kind: str = "linear"                       # "linear" | "catenary"
+    anchor: tuple[float, float, float] | None = None   # m, n-frame (catenary)
+    length: float = 0.0                        # m, unstretched (catenary)
+    EA: float = 0.0                            # N, axial stiffness (catenary)
+    weight: float = 0.0                        # N/m, submerged weight (catenary)
+    excursion: float | None = None             # m, fairlead motion the force table covers
+
+
+@dataclass(frozen=True)
+class EndStop:
+    """Joint travel limits as a stiff, one-sided spring-damper (a contact penalty).
+
+    Beyond `upper` by d > 0 the joint feels -max(stiffness*d + damping*v, 0) (and symmetrically
+    below `lower`): it pushes back while engaged and never pulls, so a stop releases cleanly.
+    A stiff stop raises the highest natural frequency to about sqrt(stiffness / M_jj): an
+    explicit integrator needs steps below ~2.8 / that frequency (the plant reports it).
+    """
+    name: str
+    joint: str
+    lower: float = -math.inf       # m or rad, joint coordinate at the stop (rest is 0)
+    upper: float = math.inf        # m or rad
+    stiffness: float = 0.0         # N/m or N m/rad
+    damping: float = 0.0           # N s/m or N m s/rad, while engaged
+
+
+@dataclass(frozen=True)
+class Drag:
+    """Viscous loads per body DOF on the CoG twist (body axes): -c|v|v - b v."""
+    name: str
+    body: str
+    coefficients: dict[str, float] = field(default_factory=dict)  # quadratic: N s^2/m^2, N m s^2
+    linear: dict[str, float] = field(default_factory=dict)        # linear: N s/m, N m s/rad
+
+
+@dataclass(frozen=True)
+class HydroSettings:
+    file: str | None = None                    # precomputed body-frame data (.nc), absolute path
+    panel_size: float = 0.1                    # m, BEM panel size
+    omega: tuple[float, ...] = ()              # rad/s, BEM frequencies
+    headings: tuple[float, ...] = (0.0,)       # rad, NED wave directions
+    lid: bool = True
+    radiation_tol: float = 0.01                # normalised RMS error of the radiation fit
+    fit_omega_max: float = math.inf            # rad/s: fit the radiation model below this
+    dofs: tuple[str, ...] = DOF_NAMES          # rigid DOFs the BEM solves for, per body
+    source: str | None = None                  # third-party data (WAMIT .out, BEMIO .h5,
+                                               # Capytaine .nc) that `file` is converted from
+    source_bodies: tuple[str, ...] = ()        # scene body per body of the source, in order
+    source_options: dict = field(default_factory=dict)   # reader/cleaning options, see below
+    interaction: bool = True                   # False: each body solved alone (hydro.isolated)
+    hydrostatics: str = "linear"               # "linear" | "large_angle" (box, cylinder, sphere)
+
+
+@dataclass(frozen=True)
+class Scene:
+    name: str
+    path: str
+    description: str
+    water: Water
+    bodies: tuple[Body, ...]
+    joints: tuple[Joint, ...]
+    ptos: tuple[Pto, ...] = ()
+    frictions: tuple[Friction, ...] = ()
+    moorings: tuple[Mooring, ...] = ()
+    drags: tuple[Drag, ...] = ()
+    end_stops: tuple[EndStop, ...] = ()
+    hydro: HydroSettings = HydroSettings()
+    parameters: dict = field(default_factory=dict)  # [parameters] as used (overrides applied)
+
+    def body(self, name: str) -> Body:
+        return next(b for b in self.bodies if b.name == name)
+
+    def joint(self, name: str) -> Joint:
+        return next(j for j in self.joints if j.name == name)
+
+    def digest(self) -> str:
+        """sha256 of the scene's content (not its path): provenance and cache keys.
+
+        Files the scene refers to (hydro data, meshes) enter by name and content, so a copy of
+        a model in another folder has the same digest.
+        """
+        data = asdict(self)
+        data.pop("path")
+        data["hydro"]["file"] = _file_digest(self.hydro.file)
+        data["hydro"]["source"] = Path(self.hydro.source).name if self.hydro.source else None
+        for body in data["bodies"]:
+            if body["geometry"] and body["geometry"]["file"]:
+                body["geometry"]["file"] = _file_digest(body["geometry"]["file"])
+        text = json.dumps(data, sort_keys=True, default=str)
+        return hashlib.sha256(text.encode()).hexdigest()
+
+
+def _file_digest(path: str | None):
+    if path is None:
+        return None
+    content = Path(path).read_bytes() if Path(path).exists() else b"missing"
+    return [Path(path).name, hashlib.sha256(content).hexdigest()]

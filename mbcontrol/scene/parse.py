@@ -1,0 +1,232 @@
+"""Parsing of scene files into the dataclasses of :mod:`mbcontrol.scene`, one section each."""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from .checks import Reader, catenary_geometry, check_topology
+from .model import (DOF_NAMES, JOINT_TYPES, Body, Drag, EndStop, Friction, Geometry, HydroSettings,
+                    Joint, Mooring, Pto, Scene, Water)
+from .template import expand
+
+
+def parse_scene(data: dict, path: Path, parameters: dict | None = None) -> Scene:
+    """Build a Scene from the TOML dictionary; every problem raises SceneError.
+
+    [parameters] and `repeat` entries are expanded first (:mod:`mbcontrol.scene.template`).
+    """
+    data, used = expand(data, str(path), parameters)
+    top = Reader(data, str(path), "")
+    top.allow("name", "description", "water", "body", "joint", "pto", "friction", "mooring",
+              "drag", "end_stop", "hydro")
+    water = _water(top.table("water", required=False))
+    bodies = tuple(_body(r, path) for r in top.tables("body", required=True))
+    joints = tuple(_joint(r) for r in top.tables("joint", required=True))
+    scene = Scene(
+        name=top.string("name", default=path.stem),
+        path=str(path),
+        description=top.string("description", default=""),
+        water=water, bodies=bodies, joints=joints,
+        ptos=tuple(_pto(r) for r in top.tables("pto")),
+        frictions=tuple(_friction(r) for r in top.tables("friction")),
+        moorings=tuple(_mooring(r) for r in top.tables("mooring")),
+        drags=tuple(_drag(r) for r in top.tables("drag")),
+        end_stops=tuple(_end_stop(r) for r in top.tables("end_stop")),
+        hydro=_hydro(top.table("hydro", required=False), path),
+        parameters=used,
+    )
+    return check_topology(scene, top)
+
+
+def _water(r: Reader) -> Water:
+    r.allow("rho", "g", "depth")
+    return Water(rho=r.positive("rho", "density", default=1025.0),
+                 g=r.positive("g", "acceleration", default=9.81),
+                 depth=r.positive("depth", "length", default=math.inf, finite=False))
+
+
+def _body(r: Reader, path: Path) -> Body:
+    r.allow("name", "mass", "inertia", "cog", "geometry", "hydro")
+    return Body(name=r.name(), mass=r.positive("mass", "mass"),
+                inertia=r.inertia("inertia"), cog=r.vector("cog", "length"),
+                geometry=_geometry(r.table("geometry", required=False), path),
+                hydro=r.boolean("hydro", default=True))
+
+
+def _geometry(r: Reader, path: Path) -> Geometry | None:
+    if r.empty:
+        return None
+    r.allow("type", "center", "size", "radius", "length", "axis", "file")
+    kind = r.choice("type", ("box", "cylinder", "sphere", "mesh"))
+    center = r.vector("center", "length", default=(0.0, 0.0, 0.0))
+    if kind == "box":
+        size = r.vector("size", "length")
+        if min(size) <= 0:
+            r.fail("size", f"expected three positive edge lengths (m), got {list(size)}")
+        return Geometry(kind, center, size=size)
+    if kind == "sphere":
+        return Geometry(kind, center, radius=r.positive("radius", "length"))
+    if kind == "cylinder":
+        return Geometry(kind, center, radius=r.positive("radius", "length"),
+                        length=r.positive("length", "length"),
+                        axis=r.choice("axis", ("x", "y", "z"), default="z"))
+    mesh = path.parent / r.string("file")
+    if not mesh.exists():
+        r.fail("file", f"expected an existing mesh file, {mesh} does not exist")
+    return Geometry(kind, center, file=str(mesh))
+
+
+def _joint(r: Reader) -> Joint:
+    r.allow("name", "type", "parent", "child", "point", "axis", "dofs")
+    kind = r.choice("type", JOINT_TYPES)
+    axis, dofs = None, ()
+    if kind in ("revolute", "prismatic"):
+        axis = r.vector("axis", None)
+        norm = float(np.linalg.norm(axis))
+        if norm < 1e-9:
+            r.fail("axis", f"expected a non-zero direction, got {list(axis)}")
+        axis = tuple(float(a) / norm for a in axis)
+    if kind == "free":
+        dofs = r.dof_list("dofs", default=DOF_NAMES)
+    child = r.string("child")
+    return Joint(name=r.name(), type=kind, parent=r.string("parent"), child=child,
+                 point=r.vector("point", "length", default=None), axis=axis, dofs=dofs)
+
+
+def _pto(r: Reader) -> Pto:
+    r.allow("name", "joint", "damping", "stiffness", "force_max", "stroke_max", "efficiency",
+            "body", "point", "parent", "parent_point", "preload")
+    joint = r.string("joint", default=None)
+    points = {k: k in r.data for k in ("body", "point", "parent_point")}
+    if joint is not None and any(points.values()):
+        r.fail("joint", "expected either a joint or body/point/parent_point, not both")
+    if joint is None and not all(points.values()):
+        missing = [k for k, given in points.items() if not given]
+        r.fail(missing[0] if any(points.values()) else "joint",
+               "expected a joint, or body, point and parent_point for a PTO between points")
+    efficiency = r.positive("efficiency", None, default=1.0)
+    if efficiency > 1:
+        r.fail("efficiency", f"expected a number in (0, 1], got {efficiency}")
+    return Pto(name=r.name(), joint=joint,
+               damping=r.nonnegative("damping", default=0.0),
+               stiffness=r.finite("stiffness", default=0.0),
+               force_max=r.positive("force_max", None, default=math.inf, finite=False),
+               stroke_max=r.positive("stroke_max", None, default=math.inf, finite=False),
+               efficiency=efficiency,
+               body=r.string("body", default=None),
+               point=r.vector("point", "length", default=None),
+               parent=r.string("parent", default="ground"),
+               parent_point=r.vector("parent_point", "length", default=None),
+               preload=r.choice("preload", ("none", "balance"), default="none"))
+
+
+def _friction(r: Reader) -> Friction:
+    r.allow("name", "joint", "viscous", "coulomb", "velocity_scale")
+    joint = r.string("joint")
+    return Friction(name=r.string("name", default=f"{joint}_friction"), joint=joint,
+                    viscous=r.nonnegative("viscous", default=0.0),
+                    coulomb=r.nonnegative("coulomb", default=0.0),
+                    velocity_scale=r.positive("velocity_scale", None, default=1e-2))
+
+
+def _mooring(r: Reader) -> Mooring:
+    kind = r.choice("type", ("linear", "catenary"), default="linear")
+    if kind == "catenary":
+        return _catenary(r)
+    r.allow("name", "type", "body", "point", "stiffness", "damping")
+    stiffness = r.vector("stiffness", None)
+    damping = r.vector("damping", None, default=(0.0, 0.0, 0.0))
+    for key, values in (("stiffness", stiffness), ("damping", damping)):
+        if min(values) < 0:
+            r.fail(key, f"expected three non-negative numbers, got {list(values)}")
+    return Mooring(name=r.name(), body=r.string("body"), point=r.vector("point", "length"),
+                   stiffness=stiffness, damping=damping)
+
+
+def _catenary(r: Reader) -> Mooring:
+    r.allow("name", "type", "body", "point", "anchor", "length", "EA", "weight", "excursion")
+    m = Mooring(name=r.name(), body=r.string("body"), point=r.vector("point", "length"),
+                kind="catenary", anchor=r.vector("anchor", "length"),
+                length=r.positive("length", "length"), EA=r.positive("EA"),
+                weight=r.positive("weight"),
+                excursion=r.positive("excursion", "length") if "excursion" in r.data else None)
+    try:    # geometry checks (anchor below the fairlead, within the line's reach)
+        catenary_geometry(f"mooring '{m.name}'", anchor=m.anchor, fairlead=m.point,
+                          length=m.length, EA=m.EA, weight=m.weight, excursion=m.excursion)
+    except ValueError as exc:
+        r.fail("anchor", str(exc))
+    return m
+
+
+def _end_stop(r: Reader) -> EndStop:
+    r.allow("name", "joint", "lower", "upper", "stiffness", "damping")
+    joint = r.string("joint")
+    lower = r.number("lower", "coordinate", default=-math.inf)
+    upper = r.number("upper", "coordinate", default=math.inf)
+    if not lower < upper:
+        r.fail("upper", f"expected upper > lower, got lower = {lower}, upper = {upper}")
+    if not lower < 0 < upper:
+        r.fail("lower" if lower >= 0 else "upper",
+               f"the rest position (joint coordinate 0) must lie strictly between the stops, "
+               f"got [{lower}, {upper}]: a stop engaged at rest moves the equilibrium")
+    if math.isinf(lower) and math.isinf(upper):
+        r.fail("lower", "expected at least one of lower, upper")
+    return EndStop(name=r.string("name", default=f"{joint}_stop"), joint=joint, lower=lower,
+                   upper=upper, stiffness=r.positive("stiffness", None),
+                   damping=r.nonnegative("damping", default=0.0))
+
+
+def _drag(r: Reader) -> Drag:
+    r.allow("name", "body", "coefficients", "linear")
+    body = r.string("body")
+    tables = {}
+    for key in ("coefficients", "linear"):
+        table = r.table(key, required=False)
+        table.allow(*DOF_NAMES)
+        tables[key] = {dof: table.nonnegative(dof) for dof in DOF_NAMES if dof in table.data}
+    if not tables["coefficients"] and not tables["linear"]:
+        r.fail("coefficients", "expected quadratic 'coefficients' or 'linear' damping per DOF")
+    return Drag(name=r.string("name", default=f"{body}_drag"), body=body,
+                coefficients=tables["coefficients"], linear=tables["linear"])
+
+
+def _hydro(r: Reader, path: Path) -> HydroSettings:
+    if r.empty:
+        return HydroSettings()
+    r.allow("file", "panel_size", "omega", "headings", "lid", "radiation_tol", "dofs",
+            "source", "source_bodies", "source_options", "fit_omega_max", "interaction", "hydrostatics")
+    source = r.string("source", default=None)
+    file = r.string("file", default=None)
+    omega = r.frequency_grid("omega")
+    return HydroSettings(
+        file=str(path.parent / file) if file else None,
+        panel_size=r.positive("panel_size", "length", default=0.1),
+        omega=omega,
+        headings=tuple(r.finite_list("headings", "angle", default=(0.0,))),
+        lid=r.boolean("lid", default=True),
+        radiation_tol=r.positive("radiation_tol", None, default=0.01),
+        dofs=r.dof_list("dofs", default=DOF_NAMES),
+        fit_omega_max=r.positive("fit_omega_max", "frequency", default=math.inf, finite=False),
+        source=str((path.parent / source).resolve()) if source else None,
+        source_bodies=tuple(r.string_list("source_bodies", default=())),
+        source_options=_source_options(r.table("source_options", required=False)),
+        interaction=r.boolean("interaction", default=True),
+        hydrostatics=r.choice("hydrostatics", ("linear", "large_angle"), default="linear"))
+
+
+def _source_options(r: Reader) -> dict:
+    """Options for reading and cleaning third-party hydro data (mbcontrol.hydro.readers)."""
+    r.allow("force_symmetric", "negative_damping", "omega_range", "asym_tol")
+    out = {}
+    if "force_symmetric" in r.data:
+        out["force_symmetric"] = r.boolean("force_symmetric")
+    if "negative_damping" in r.data:
+        out["negative_damping"] = r.choice("negative_damping", ("repair", "project", "error"))
+    if "omega_range" in r.data:
+        lo, hi = r.number_list("omega_range", "frequency")
+        out["omega_range"] = (lo, hi)
+    if "asym_tol" in r.data:
+        out["asym_tol"] = r.positive("asym_tol")
+    return out

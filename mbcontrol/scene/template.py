@@ -1,0 +1,112 @@
+"""Scene parameters and repeated entries: one file for a family of devices.
+
+    [parameters]
+    N = 4                                   # barges in the chain
+    L = 0.6
+
+    [[body]]
+    repeat = "i = 1..N"                     # one body per i = 1, 2, ..., N
+    name = "barge{i}"
+    cog = ["{(i - 1) * (L + 0.1) + L / 2}", 0.0, 0.0]
+
+`repeat = "<var> = <first>..<last>"` (inclusive; bounds are expressions) copies an array-of-
+tables entry once per value. In any string, `{expr}` is replaced by the value of an arithmetic
+expression (+ - * / // % **, parentheses, numbers, parameter and loop names); a string that is
+nothing but one `{expr}` becomes the number itself. Overrides (``load_scene(name, {"N": 8})``)
+replace [parameters] values before anything is expanded.
+"""
+from __future__ import annotations
+
+import ast
+import operator
+import re
+
+from ..errors import SceneError
+
+_BRACES = re.compile(r"\{([^{}]+)\}")
+_REPEAT = re.compile(r"^\s*([A-Za-z_]\w*)\s*=\s*(.+?)\s*\.\.\s*(.+?)\s*$")
+_OPS = {ast.Add: operator.add, ast.Sub: operator.sub, ast.Mult: operator.mul,
+        ast.Div: operator.truediv, ast.FloorDiv: operator.floordiv, ast.Mod: operator.mod,
+        ast.Pow: operator.pow, ast.USub: operator.neg, ast.UAdd: operator.pos}
+MAX_REPEAT = 1000
+
+
+def expand(data: dict, file: str, overrides: dict | None = None) -> tuple[dict, dict]:
+    """(data with [parameters] removed, repeats expanded and {expr} substituted; the values used)."""
+    data = dict(data)
+    params = data.pop("parameters", {})
+    if not isinstance(params, dict):
+        raise SceneError(f"{file}: parameters: expected a table of numbers")
+    for key, value in params.items():
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise SceneError(f"{file}: parameters.{key}: expected a number, got {value!r}")
+    unknown = sorted(set(overrides or {}) - set(params))
+    if unknown:
+        raise SceneError(f"{file}: parameters: {unknown} not declared; the scene's parameters are "
+                         f"{sorted(params) or 'none'}")
+    values = {**params, **(overrides or {})}
+    out = {}
+    for key, value in data.items():
+        if isinstance(value, list) and value and all(isinstance(v, dict) for v in value):
+            out[key] = [e for k, entry in enumerate(value)
+                        for e in _repeat(entry, values, file, f"{key}[{k}]")]
+        else:
+            out[key] = _substitute(value, values, file, key)
+    return out, dict(values) if params else {}
+
+
+def _repeat(entry: dict, values: dict, file: str, where: str) -> list[dict]:
+    if "repeat" not in entry:
+        return [_substitute(entry, values, file, where)]
+    spec = entry["repeat"]
+    match = _REPEAT.match(spec) if isinstance(spec, str) else None
+    if not match:
+        raise SceneError(f"{file}: {where}.repeat: expected '<name> = <first>..<last>', got {spec!r}")
+    var, first, last = match.groups()
+    lo, hi = (evaluate(x, values, file, f"{where}.repeat") for x in (first, last))
+    if lo != int(lo) or hi != int(hi) or hi - lo + 1 > MAX_REPEAT:
+        raise SceneError(f"{file}: {where}.repeat: expected whole-number bounds at most {MAX_REPEAT} "
+                         f"apart, got {lo}..{hi}")
+    body = {k: v for k, v in entry.items() if k != "repeat"}
+    return [_substitute(body, {**values, var: i}, file, f"{where}({var}={i})")
+            for i in range(int(lo), int(hi) + 1)]
+
+
+def _substitute(value, values: dict, file: str, where: str):
+    if isinstance(value, dict):
+        return {k: _substitute(v, values, file, f"{where}.{k}") for k, v in value.items()}
+    if isinstance(value, list):
+        return [_substitute(v, values, file, f"{where}[{k}]") for k, v in enumerate(value)]
+    if not isinstance(value, str) or "{" not in value:
+        return value
+    whole = _BRACES.fullmatch(value.strip())
+    if whole:
+        return evaluate(whole.group(1), values, file, where)
+    return _BRACES.sub(lambda m: _format(evaluate(m.group(1), values, file, where)), value)
+
+
+def _format(x: float) -> str:
+    return str(int(x)) if float(x).is_integer() else repr(float(x))
+
+
+def evaluate(text: str, values: dict, file: str, where: str) -> float:
+    """Value of an arithmetic expression over `values` (numbers only; no calls, no attributes)."""
+    try:
+        tree = ast.parse(text.strip(), mode="eval")
+        return _eval(tree.body, values)
+    except (SyntaxError, KeyError, ValueError, ZeroDivisionError, OverflowError) as exc:
+        what = f"unknown name {exc}" if isinstance(exc, KeyError) else str(exc) or type(exc).__name__
+        raise SceneError(f"{file}: {where}: cannot evaluate {{{text}}}: {what}; expected arithmetic "
+                         f"on numbers and the parameters {sorted(values)}") from None
+
+
+def _eval(node, values):
+    if isinstance(node, ast.Constant) and isinstance(node.value, (int, float)) and not isinstance(node.value, bool):
+        return node.value
+    if isinstance(node, ast.Name):
+        return values[node.id]
+    if isinstance(node, ast.BinOp) and type(node.op) in _OPS:
+        return _OPS[type(node.op)](_eval(node.left, values), _eval(node.right, values))
+    if isinstance(node, ast.UnaryOp) and type(node.op) in _OPS:
+        return _OPS[type(node.op)](_eval(node.operand, values))
+    raise ValueError(f"'{ast.unparse(node)}' is not allowed")

@@ -1,0 +1,179 @@
+"""The house's layout, read from the source with `ast`: imports run one way along the flow
+(scene < multibody < hydro < plant < sim < analysis < controllers < studies < cli), no module
+imports itself back through others, no module is past the size rule, no generated file is
+committed. Function-level (lazy) imports count as much as module-level ones."""
+import ast
+import subprocess
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+STAGES = ("scene", "multibody", "hydro", "plant", "sim", "analysis", "controllers", "studies", "cli")
+# modules every stage may use; they import no stage themselves
+COMMON = ("errors", "results", "waves", "plotting", "cache")
+# top-level programs that drive the whole flow: may import any stage, none may import them
+DRIVERS = ("cli", "demo", "models")
+MAX_LINES = 400          # the house rule: a module past ~400 lines is two modules
+SOURCE_DIRS = {"mbcontrol": ROOT / "mbcontrol", "mbcontrol.controllers": ROOT / "controllers",
+               "mbcontrol.models": ROOT / "models"}
+
+
+def _modules() -> dict[str, Path]:
+    """Module name -> file, for the package as installed (controllers/ and models/ inside)."""
+    found = {}
+    for prefix, folder in SOURCE_DIRS.items():
+        for path in folder.rglob("*.py"):
+            parts = list(path.relative_to(folder).with_suffix("").parts)
+            if parts[-1] == "__init__":
+                parts = parts[:-1]
+            found[".".join([prefix, *parts])] = path
+    return found
+
+
+MODULES = _modules()
+
+
+def _resolve(module: str, path: Path, node: ast.ImportFrom) -> str:
+    if node.level == 0:
+        return node.module or ""
+    package = module if path.name == "__init__.py" else module.rsplit(".", 1)[0]
+    base = package.split(".")
+    if node.level > 1:
+        base = base[:-(node.level - 1)]
+    return ".".join(base + ([node.module] if node.module else []))
+
+
+def _target(name: str) -> str | None:
+    """The longest known module a dotted import name refers to."""
+    while name and name not in MODULES:
+        name = name.rpartition(".")[0]
+    return name or None
+
+
+def import_graph() -> dict[str, set[str]]:
+    """module -> the package modules it imports (with `from X import sub`, X.sub)."""
+    graph = {}
+    for module, path in MODULES.items():
+        targets = set()
+        for node in ast.walk(ast.parse(path.read_text(), str(path))):
+            if isinstance(node, ast.ImportFrom):
+                base = _resolve(module, path, node)
+                if not base.startswith("mbcontrol"):
+                    continue
+                for alias in node.names:
+                    targets.add(_target(f"{base}.{alias.name}"))
+            elif isinstance(node, ast.Import):
+                targets |= {_target(a.name) for a in node.names if a.name.startswith("mbcontrol")}
+        graph[module] = {t for t in targets if t and t != module}
+    return graph
+
+
+def stage(module: str) -> tuple[int, str]:
+    """(rank along the flow, name); common modules rank -1, drivers rank past the last stage."""
+    first = module.split(".")[1] if "." in module else ""
+    if module == "mbcontrol":
+        return len(STAGES) + 1, "mbcontrol (entry points)"
+    if first in COMMON:
+        return -1, first
+    if first in DRIVERS:
+        return len(STAGES), first
+    return STAGES.index(first), first
+
+
+def test_every_module_has_a_stage():
+    unknown = [m for m in MODULES if m != "mbcontrol" and m.split(".")[1] not in
+               STAGES + COMMON + DRIVERS]
+    assert not unknown, f"modules outside the flow's packages: {unknown}"
+
+
+def test_imports_run_one_way_along_the_flow():
+    graph = import_graph()
+    upstream = []
+    for module, targets in graph.items():
+        rank, name = stage(module)
+        for target in targets:
+            target_rank, target_name = stage(target)
+            if target == "mbcontrol":
+                upstream.append(f"{module} imports the top package mbcontrol (use a stage package)")
+            elif target_rank > rank:
+                upstream.append(f"{module} ({name}) imports {target} ({target_name}), "
+                                f"which is downstream of it")
+    assert not upstream, "\n".join(sorted(upstream))
+
+
+def test_common_modules_import_no_stage():
+    graph = import_graph()
+    bad = [f"{m} imports {t}" for m, targets in graph.items() if stage(m)[0] == -1
+           for t in targets if stage(t)[0] != -1]
+    assert not bad, bad
+
+
+def test_no_import_circles():
+    """No module reaches itself through its imports (Tarjan's strongly connected components)."""
+    graph = import_graph()
+    index, low, on_stack, stack, circles = {}, {}, set(), [], []
+
+    def visit(v):
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on_stack.add(v)
+        for w in graph.get(v, ()):
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on_stack:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            component = []
+            while True:
+                w = stack.pop()
+                on_stack.discard(w)
+                component.append(w)
+                if w == v:
+                    break
+            if len(component) > 1:
+                circles.append(sorted(component))
+
+    for v in graph:
+        if v not in index:
+            visit(v)
+    assert not circles, f"import circles: {circles}"
+
+
+def test_the_graph_sees_known_edges():
+    """The checks above are only as good as the graph: it must see relative, absolute,
+    lazy (in-function) and submodule imports."""
+    graph = import_graph()
+    assert "mbcontrol.plant.fidelity" in graph["mbcontrol.plant.build"]          # relative
+    assert "mbcontrol.analysis" in graph["mbcontrol.controllers.impedance"]  # lazy, absolute
+    assert "mbcontrol.sim.stability" in graph["mbcontrol.studies.bench_report"]  # from X import sub
+    assert "mbcontrol.plant.process" in graph["mbcontrol.plant"]                  # a package face
+
+
+@pytest.mark.parametrize("folder", ["mbcontrol", "controllers", "models", "benchmarks"])
+def test_no_module_past_the_size_rule(folder):
+    long = {str(p.relative_to(ROOT)): n for p in (ROOT / folder).rglob("*.py")
+            if (n := len(p.read_text().splitlines())) > MAX_LINES}
+    assert not long, f"modules over {MAX_LINES} lines: {long}"
+
+
+def test_no_generated_file_is_committed():
+    try:
+        files = subprocess.run(["git", "ls-files"], cwd=ROOT, capture_output=True, text=True,
+                               check=True).stdout.split()
+    except (OSError, subprocess.CalledProcessError):
+        pytest.skip("not a git work tree")
+    generated = [f for f in files if f.endswith((".c", ".so", ".o", ".pyc"))]
+    assert not generated, generated
+
+
+def test_every_package_is_installed():
+    """pyproject.toml lists packages explicitly: a package left out would import from a source
+    checkout (editable install) and be missing from a wheel."""
+    import tomllib
+    listed = set(tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]
+                 ["packages"])
+    packages = {m for m, path in MODULES.items() if path.name == "__init__.py"}
+    assert packages == listed, (f"missing from pyproject.toml: {sorted(packages - listed)}; "
+                                f"listed but absent: {sorted(listed - packages)}")
