@@ -19,3 +19,7 @@ class SimulationError(MbcontrolError, RuntimeError):
 
 class LinearizationError(MbcontrolError, ValueError):
     """An operating point is not an equilibrium, or a requested signal does not exist."""
+
+
+class FidelityError(MbcontrolError, ValueError):
+    """A fidelity option is invalid or does not fit the scene; names the field and the value."""

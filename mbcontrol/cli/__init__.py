@@ -11,6 +11,7 @@ Examples:
   mbcontrol design sphere --controller passive --wave jonswap --hs 2.5 --tp 8 --json
   mbcontrol bench rm3 --wave jonswap --hs 2.5 --tp 8 --stability
   mbcontrol fidelity sphere --wave jonswap --hs 2.5 --tp 9.67 --tol 0.01
+  mbcontrol identify flume_section --data ../shared/data/tank/scenario_c/5*.csv.xz --out out/id
 """
 from __future__ import annotations
 
@@ -21,6 +22,7 @@ from ..errors import MbcontrolError
 from ..sim.methods import METHODS
 from .commands import (run_bench, run_design, run_fidelity, run_hydro, run_linearize, run_models,
                        run_simulate)
+from .identify import add_parser as add_identify_parser
 
 DESIGN_HELP = """Tune a PTO controller for a sea, then check, bound and simulate it.
 
@@ -174,6 +176,7 @@ def _parser() -> argparse.ArgumentParser:
                         "(a smoothed Coulomb friction linearises to its slope at rest)")
     p.add_argument("--json", action="store_true", help="print signals and poles as JSON")
     p.set_defaults(run=run_linearize)
+    add_identify_parser(sub)
     return parser
 
 

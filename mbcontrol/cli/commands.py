@@ -9,10 +9,17 @@ import numpy as np
 from ..results import jsonable
 
 
+HYDRO_SCALES = ("__added_mass_scale", "__radiation_scale", "__excitation_scale")
+
+
 def _plant(args, **kwargs):
+    """The model's plant; with hydro corrections when a --param names one (as `mbcontrol
+    identify` reports them), so identified values can be simulated."""
     from ..plant import build_plant
     from ..scene import load_scene
     values = dict(_key_value(item, "--scene-param") for item in args.scene_param)
+    if any(item.split("=")[0].endswith(HYDRO_SCALES) for item in getattr(args, "param", [])):
+        kwargs.setdefault("hydro_corrections", True)
     return build_plant(load_scene(args.model, values or None), **kwargs)
 
 

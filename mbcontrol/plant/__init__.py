@@ -4,6 +4,7 @@
 symbolic parameters. Modules: `process` (ProcessPlant and its assembly), `loads` (PTO,
 friction, moorings, drag, end stops, gravity, hydrostatics), `catenary` and `catenary_line`
 (quasi-static mooring lines), `checks` (rest checks), `fidelity` (simplified models),
+`freeze` (DOFs removed: blocked by a rig, or not excited by the waves),
 `jacobians` (exact Jacobians, shared downstream), `build` (the entry point).
 """
 from .build import build_plant

@@ -24,22 +24,14 @@ import casadi as ca
 import numpy as np
 import xarray as xr
 
-from ..errors import MbcontrolError
+from ..errors import FidelityError
 from ..hydro import HydroModel, fit_hydro_model, load_hydro_data
 from ..multibody import build_topology
 from ..scene import DOF_NAMES, Scene, load_scene
-from ..waves import Wave, interpolate_complex
-from .jacobians import jacobians
+from .freeze import FREEZE_THRESHOLD, as_wave_list, freeze_report, frozen_scene
 from .process import ProcessPlant, active_hydro_dofs, assemble_plant
 
-FREEZE_THRESHOLD = 1e-3   # excitation and linear response below this share of the largest of
-                          # their unit class: the DOF contributes < 0.1 % to any compared signal
-ROTATIONS = ("Roll", "Pitch", "Yaw")
 AUDIT_OUTPUTS = ("energy", "excitation_power", "radiated_power")   # plus "<pto>__power"
-
-
-class FidelityError(MbcontrolError, ValueError):
-    """A fidelity option is invalid or does not fit the scene; names the field and the value."""
 
 
 @dataclass(frozen=True)
@@ -48,8 +40,9 @@ class Fidelity:
 
     radiation_tol : normalised RMS error of the radiation fit (None: the scene's).
     couplings : "keep" or "drop" the radiation coupling between different bodies.
-    freeze : body DOFs "<body>__<Dof>" of free/composite joints to remove, or "auto" (those the
-        waves cannot excite; needs waves, see `freeze_report`).
+    freeze : body DOFs "<body>__<Dof>" of free/composite joints to remove, names of revolute or
+        prismatic joints to block (as a test rig does), or "auto" (free-joint DOFs the waves
+        cannot excite; needs waves, see `freeze_report`).
     kinematics : "exact" (the nonlinear plant) or "linear" (its linearisation about rest).
     """
     radiation_tol: float | None = None
@@ -74,10 +67,11 @@ class Fidelity:
                                     f"'<body>__<Dof>', got {self.freeze!r}")
             return
         freeze = tuple(sorted(set(self.freeze)))
-        bad = [d for d in freeze if d.count("__") != 1 or d.split("__")[1] not in DOF_NAMES]
+        bad = [d for d in freeze if d.count("__") > 1 or d.count("__") == 1
+               and d.split("__")[1] not in DOF_NAMES or not d]
         if bad:
             raise FidelityError(f"Fidelity.freeze: {bad} are not body DOFs '<body>__<Dof>' with "
-                                f"<Dof> one of {', '.join(DOF_NAMES)}")
+                                f"<Dof> one of {', '.join(DOF_NAMES)}, nor joint names")
         object.__setattr__(self, "freeze", freeze)
 
     @property
@@ -109,18 +103,19 @@ class Fidelity:
 
 def plant_for(scene: Scene | str, fidelity: Fidelity | None = None, *, waves=None,
               hydro: HydroModel | None = None, reference: ProcessPlant | None = None,
-              freeze_threshold: float = FREEZE_THRESHOLD) -> ProcessPlant:
+              freeze_threshold: float = FREEZE_THRESHOLD,
+              hydro_corrections: bool = False) -> ProcessPlant:
     """The process plant of `scene` at `fidelity` (default: the full model).
 
     waves : a Wave or a list of them; needed for freeze="auto" and used as the band of the
         coupling report (otherwise the radiation fit band). hydro : the full plant's HydroModel,
         to reuse its data (no second read or BEM run). reference : the full plant, if built.
-    The plant's notes["fidelity"] records the resolved options (freeze as an explicit list),
+    hydro_corrections : hydro scale factors as parameters (see `assemble_plant`). The plant's notes["fidelity"] records the resolved options (freeze as an explicit list),
     the frozen-DOF evidence and the size of the dropped coupling.
     """
     scene = load_scene(scene) if not isinstance(scene, Scene) else scene
     fidelity = Fidelity() if fidelity is None else fidelity
-    wave_list = _wave_list(waves)
+    wave_list = as_wave_list(waves)
     notes: dict = {}
     if fidelity.freeze == "auto":
         if not wave_list:
@@ -132,10 +127,11 @@ def plant_for(scene: Scene | str, fidelity: Fidelity | None = None, *, waves=Non
             d for d, row in notes["freeze"].items() if row["frozen"]))
     frozen = frozen_scene(scene, fidelity.freeze)
     if fidelity.couplings == "keep" and not fidelity.freeze and hydro is None:
-        plant = assemble_plant(scene, radiation_tol=fidelity.radiation_tol)
+        plant = assemble_plant(scene, radiation_tol=fidelity.radiation_tol,
+                               hydro_corrections=hydro_corrections)
     else:
         model = _hydro_model(scene, frozen, fidelity, hydro, wave_list, notes)
-        plant = assemble_plant(frozen, model) if model is not None else assemble_plant(frozen)
+        plant = assemble_plant(frozen, model, hydro_corrections=hydro_corrections)
     if fidelity.kinematics == "linear":
         plant = linearised_plant(plant)
     plant.notes["fidelity"] = {"options": fidelity.as_dict(), **notes}
@@ -160,12 +156,6 @@ def _hydro_model(scene, frozen, fidelity, hydro, waves, notes) -> HydroModel | N
         data = drop_couplings(data)
         source = f"{source} (couplings between bodies dropped)"
     return fit_hydro_model(data, dofs, tol, source, limit)
-
-
-def _wave_list(waves) -> list[Wave]:
-    if waves is None:
-        return []
-    return [waves] if isinstance(waves, Wave) else list(waves)
 
 
 # ----------------------------------------------------------------------------- couplings
@@ -246,102 +236,12 @@ def has_couplings(plant: ProcessPlant) -> bool:
 
 # ----------------------------------------------------------------------------- freeze
 
-def frozen_scene(scene: Scene, dofs) -> Scene:
-    """The scene with body DOFs "<body>__<Dof>" removed from their free/composite joints.
-
-    A joint left with no DOF becomes a fixed joint. Raises FidelityError for a DOF that no
-    free joint moves, or whose removal would leave a PTO, friction or end stop without its joint.
-    """
-    if not dofs:
-        return scene
-    joints, removed = {j.child: j for j in scene.joints}, set(dofs)
-    new = []
-    for dof in dofs:
-        body, name = dof.split("__")
-        joint = joints.get(body)
-        if joint is None or joint.type != "free" or name not in joint.dofs:
-            have = [f"{j.child}__{d}" for j in scene.joints if j.type == "free" for d in j.dofs]
-            raise FidelityError(f"{scene.path}: Fidelity.freeze: {dof!r} is not a DOF of a free "
-                                f"or composite joint; expected some of "
-                                f"{have or 'none (the scene has no free joints)'}")
-    for joint in scene.joints:
-        keep = tuple(d for d in joint.dofs if f"{joint.child}__{d}" not in removed)
-        if keep == joint.dofs:
-            new.append(joint)
-            continue
-        if not keep:
-            users = [x.name for x in (*scene.ptos, *scene.frictions, *scene.end_stops)
-                     if getattr(x, "joint", None) == joint.name]
-            if users:
-                raise FidelityError(f"{scene.path}: Fidelity.freeze removes every DOF of joint "
-                                    f"'{joint.name}', which {users} act on")
-            new.append(dataclasses.replace(joint, type="fixed", dofs=()))
-        else:
-            new.append(dataclasses.replace(joint, dofs=keep))
-    return dataclasses.replace(scene, joints=tuple(new))
-
-
-def freeze_report(plant: ProcessPlant, waves, threshold: float = FREEZE_THRESHOLD) -> dict:
-    """Which free-joint DOFs the waves cannot move, with the evidence, per body DOF.
-
-    For each DOF of a free/composite joint: `excitation`, the RMS wave load on it (N or N m)
-    over the waves' components relative to the largest of the same unit class (forces or
-    moments) on any hydro DOF; and `response`, the RMS of its linear response (the plant
-    linearised at rest, driven by the whole excitation, so DOFs moved through coupling count)
-    relative to the largest body motion of its class (m or rad). frozen = both < threshold.
-    The largest over the waves is kept. A DOF excited only parametrically (nonlinearly) is not
-    caught here: `auto` checks the frozen model against the full one in simulation.
-    """
-    waves = _wave_list(waves)
-    dofs = [(f"{j.child}__{d}") for j in plant.scene.joints if j.type == "free" for d in j.dofs]
-    bodies = [f"{b}__{d}" for b in plant.topology.bodies for d in DOF_NAMES]
-    excitation, response = np.zeros(len(dofs)), np.zeros(len(dofs))
-    for wave in waves:
-        rms_w, rms_y = _linear_rms(plant, wave, bodies)
-        hydro = list(plant.hydro.dofs) if plant.hydro else []
-        for k, dof in enumerate(dofs):
-            force = rms_w[hydro.index(dof)] if dof in hydro else 0.0
-            excitation[k] = max(excitation[k], _relative(force, dof, dict(zip(hydro, rms_w))))
-            response[k] = max(response[k], _relative(rms_y[bodies.index(dof)], dof,
-                                                     dict(zip(bodies, rms_y))))
-    return {d: {"excitation": float(e), "response": float(r),
-                "frozen": bool(e < threshold and r < threshold), "threshold": threshold}
-            for d, e, r in zip(dofs, excitation, response)}
-
-
-def _relative(value, dof, table) -> float:
-    """value over the largest entry of the same unit class (rotation or not) in table."""
-    rotation = dof.split("__")[1] in ROTATIONS
-    scale = max((v for d, v in table.items() if (d.split("__")[1] in ROTATIONS) == rotation),
-                default=0.0)
-    return float(value / scale) if scale > 0 else 0.0
-
-
-def _linear_rms(plant, wave, outputs):
-    """RMS excitation per hydro DOF, and RMS linear response of `outputs`, to one wave."""
-    n_w = len(plant.disturbances)
-    if n_w == 0:
-        return np.zeros(0), np.zeros(len(outputs))
-    hydro = plant.hydro
-    F = interpolate_complex(hydro.omega, hydro.excitation_coefficients(wave.direction),
-                            wave.omega) * wave.amplitude[:, None]           # (m, n_w)
-    rms_w = np.sqrt(0.5 * np.sum(np.abs(F) ** 2, axis=0))
-    A, _, Bw, C, _, Dw = (np.asarray(M) for M in jacobians(plant)(
-        plant.x0(), np.zeros(len(plant.inputs)), np.zeros(n_w), plant.p0))
-    rows = [plant.outputs.index(o) for o in outputs]
-    C, Dw, eye = C[rows], Dw[rows], np.eye(A.shape[0])
-    power = np.zeros(len(rows))
-    for w, f in zip(wave.omega, np.conj(F)):      # exp(+i w t) phasors, as python-control's
-        y = C @ np.linalg.solve(1j * w * eye - A, Bw @ f) + Dw @ f
-        power += 0.5 * np.abs(y) ** 2
-    return rms_w, np.sqrt(power)
-
 
 def wave_band(waves) -> tuple[float, float]:
     """(lowest, highest) frequency, rad/s, of the components carrying the waves' energy: those
     whose amplitude^2 is at least 1e-3 of the largest component's."""
     lo, hi = np.inf, 0.0
-    for wave in _wave_list(waves):
+    for wave in as_wave_list(waves):
         a2 = wave.amplitude ** 2
         w = wave.omega[a2 >= 1e-3 * a2.max()]
         lo, hi = min(lo, float(w.min())), max(hi, float(w.max()))

@@ -76,14 +76,19 @@ class ProcessPlant:
 
 
 def assemble_plant(scene: Scene | str, hydro: HydroModel | None = None, *,
-                   radiation_tol: float | None = None, radiation: bool = True) -> ProcessPlant:
+                   radiation_tol: float | None = None, radiation: bool = True,
+                   hydro_corrections: bool = False) -> ProcessPlant:
     """The full process plant of a scene (a Scene, a scene file or a catalogue name).
 
     Hydrodynamics come from `hydro` or the scene's hydro.file; the radiation model is fitted
     to `radiation_tol` (default: the scene's) on the DOFs the joints can move. With
     radiation=False the plant has no radiation states: w is then the whole wave load on the
     hydro DOFs (excitation minus radiation memory), as a direct-convolution reference needs.
-    Users call `mbcontrol.plant.build_plant`, which also builds simplified models.
+    hydro_corrections: per hydro DOF d, parameters d__added_mass_scale, d__radiation_scale and
+    d__excitation_scale (1: the BEM data, dimensionless) scale A(inf) and the radiation kernel
+    (B(omega) and A(omega) - A(inf) together) as S^1/2 X S^1/2, so they stay symmetric and the
+    radiation passive, and the excitation force on d; for identification. Users call
+    `mbcontrol.plant.build_plant`, which also builds simplified models.
     """
     scene = load_scene(scene) if not isinstance(scene, Scene) else scene
     topo = build_topology(scene)
@@ -103,20 +108,29 @@ def assemble_plant(scene: Scene | str, hydro: HydroModel | None = None, *,
     params = loads.Parameters()
     P = tree.P(q)
     select = dof_selector(topo, hydro_dofs)                  # 6N -> hydro DOFs
-    added_mass = select.T @ hydro.added_mass_inf @ select if hydro else None
+    scale = _hydro_scales(params, hydro_dofs) if hydro and hydro_corrections else None
+    added_mass = None
+    if hydro and scale is None:
+        added_mass = select.T @ hydro.added_mass_inf @ select
+    elif hydro:
+        A_inf = ca.mtimes([scale["added_mass"], ca.DM(hydro.added_mass_inf), scale["added_mass"]])
+        added_mass = ca.mtimes([ca.DM(select.T), A_inf, ca.DM(select)])
     nu_h = ca.mtimes(select, ca.mtimes(P.T, s))
+    w_h = w if scale is None else ca.mtimes(scale["excitation"], w)
 
     tau = -tree.bias(q, s, added_mass)
     chi_dot, power = ca.SX(0, 1), {"radiated_power": 0, "excitation_power": 0}
     if hydro and not radiation:
-        tau += ca.mtimes(P, ca.mtimes(select.T, w))
-        power = {"radiated_power": 0, "excitation_power": ca.dot(nu_h, w)}
+        tau += ca.mtimes(P, ca.mtimes(select.T, w_h))
+        power = {"radiated_power": 0, "excitation_power": ca.dot(nu_h, w_h)}
     elif hydro:
         A_r, B_r, C_r, D_r = hydro.radiation_matrices()
-        mu_h = ca.mtimes(C_r, chi) + ca.mtimes(D_r, nu_h)
-        chi_dot = ca.mtimes(A_r, chi) + ca.mtimes(B_r, nu_h)
-        tau += ca.mtimes(P, ca.mtimes(select.T, w - mu_h))
-        power = {"radiated_power": ca.dot(nu_h, mu_h), "excitation_power": ca.dot(nu_h, w)}
+        R = scale["radiation"] if scale is not None else ca.DM.eye(len(hydro_dofs))
+        nu_r = ca.mtimes(R, nu_h)           # the kernel S^1/2 K S^1/2 as a state-space model
+        mu_h = ca.mtimes(R, ca.mtimes(C_r, chi) + ca.mtimes(D_r, nu_r))
+        chi_dot = ca.mtimes(A_r, chi) + ca.mtimes(B_r, nu_r)
+        tau += ca.mtimes(P, ca.mtimes(select.T, w_h - mu_h))
+        power = {"radiated_power": ca.dot(nu_h, mu_h), "excitation_power": ca.dot(nu_h, w_h)}
     if scene.hydro.hydrostatics == "large_angle":
         restoring, potential = loads.large_angle_hydrostatics(scene, topo, q)
     else:
@@ -194,6 +208,16 @@ def _preloads(scene, topo, q, s, u, w, chi, tau, pto_signals, params):
 
 def _load_scale(scene) -> float:
     return max(b.mass for b in scene.bodies) * scene.water.g
+
+
+def _hydro_scales(params, dofs) -> dict:
+    """Diagonal CasADi matrices of the square roots of the per-DOF hydro scale parameters."""
+    out = {}
+    for kind in ("added_mass", "radiation", "excitation"):
+        values = [params.add(f"{d}__{kind}_scale", 1.0) for d in dofs]
+        roots = values if kind == "excitation" else [ca.sqrt(v) for v in values]
+        out[kind] = ca.diag(ca.vertcat(*roots))
+    return out
 
 
 def active_hydro_dofs(scene: Scene, topo: Topology) -> list[str]:

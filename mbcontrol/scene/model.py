@@ -184,6 +184,7 @@ class Scene:
     end_stops: tuple[EndStop, ...] = ()
     hydro: HydroSettings = HydroSettings()
     parameters: dict = field(default_factory=dict)  # [parameters] as used (overrides applied)
+    identify: dict = field(default_factory=dict)    # [identify]: parameter -> (lo, hi) to fit
 
     def body(self, name: str) -> Body:
         return next(b for b in self.bodies if b.name == name)

@@ -20,7 +20,7 @@ def parse_scene(data: dict, path: Path, parameters: dict | None = None) -> Scene
     data, used = expand(data, str(path), parameters)
     top = Reader(data, str(path), "")
     top.allow("name", "description", "water", "body", "joint", "pto", "friction", "mooring",
-              "drag", "end_stop", "hydro")
+              "drag", "end_stop", "hydro", "identify")
     water = _water(top.table("water", required=False))
     bodies = tuple(_body(r, path) for r in top.tables("body", required=True))
     joints = tuple(_joint(r) for r in top.tables("joint", required=True))
@@ -36,6 +36,7 @@ def parse_scene(data: dict, path: Path, parameters: dict | None = None) -> Scene
         end_stops=tuple(_end_stop(r) for r in top.tables("end_stop")),
         hydro=_hydro(top.table("hydro", required=False), path),
         parameters=used,
+        identify=_identify(top.table("identify", required=False)),
     )
     return check_topology(scene, top)
 
@@ -229,4 +230,19 @@ def _source_options(r: Reader) -> dict:
         out["omega_range"] = (lo, hi)
     if "asym_tol" in r.data:
         out["asym_tol"] = r.positive("asym_tol")
+    return out
+
+
+def _identify(r: Reader) -> dict:
+    """[identify]: plant parameter name -> [lo, hi], the default set `mbcontrol identify`
+    fits (names are checked against the plant when it is built)."""
+    out = {}
+    for key, value in r.data.items():
+        expected = "expected [lo, hi] with lo < hi (the fitted parameter's bounds)"
+        if not isinstance(value, list) or len(value) != 2:
+            r.fail(key, f"{expected}, got {value!r}")
+        lo, hi = r.number_list(key, None)
+        if not lo < hi:
+            r.fail(key, f"{expected}, got {value!r}")
+        out[key] = (float(lo), float(hi))
     return out

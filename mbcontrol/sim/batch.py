@@ -29,39 +29,16 @@ def simulate_batch(plant, waves=None, params=None, *, duration: float, dt: float
     Returns a Dataset over (case, time) with every plant output, and the states over
     (case, time, state_name); attrs: wall_time_s (excitation + stepping of all cases).
     """
-    import time
-
     from .simulate import energy_audit
-    spec = integrators.method(method)
-    if not spec.fixed_step:
-        raise ValueError(f"simulate_batch needs a fixed-step method, got {method!r}")
-    waves_list = list(waves) if isinstance(waves, (list, tuple)) else [waves]
-    params_list = list(params) if isinstance(params, (list, tuple)) else [params]
-    n_cases = max(len(waves_list), len(params_list))
-    for name, items in (("waves", waves_list), ("params", params_list)):
-        if len(items) not in (1, n_cases):
-            raise ValueError(f"simulate_batch: {name} has {len(items)} entries; expected 1 or "
-                             f"{n_cases} (one per case)")
-    waves_list = waves_list * n_cases if len(waves_list) == 1 else waves_list
-    params_list = params_list * n_cases if len(params_list) == 1 else params_list
-    P = np.array([_vector(plant, p) for p in params_list])                 # (cases, np)
-    n = int(round(duration / dt))
-    x0 = plant.x0() if x0 is None else np.asarray(x0, float)
-    length = integrators.chunk_length(n)
-    fun = _batch_function(plant, method, length, n_cases, compiled)
-
-    start = time.perf_counter()
-    W_nodes = np.stack([integrators.excitation_at_nodes(plant, w, n, dt, spec.nodes)
-                        for w in waves_list])                              # (cases, n, k, nw)
-    X = _run(fun, plant, method, x0, W_nodes, P, dt, n, length)
-    wall = time.perf_counter() - start
-
-    t = np.arange(n + 1) * dt
-    Y = np.empty((n_cases, n + 1, len(plant.outputs)))
-    U = np.zeros((n + 1, len(plant.inputs)))
+    waves_list, params_list = _cases(waves, params)
+    t, X, P, wall = batch_states(plant, waves_list, params_list, duration=duration, dt=dt,
+                                 method=method, x0=x0, compiled=compiled)
+    n_cases = X.shape[0]
+    Y = np.empty((n_cases, t.size, len(plant.outputs)))
+    U = np.zeros((t.size, len(plant.inputs)))
     for c in range(n_cases):
         W = plant.excitation(waves_list[c], t) if waves_list[c] is not None \
-            else np.zeros((n + 1, len(plant.disturbances)))
+            else np.zeros((t.size, len(plant.disturbances)))
         Y[c] = integrators.outputs(plant, X[c], U, W, P[c], compiled=compiled)
         if audit:
             try:
@@ -79,6 +56,43 @@ def simulate_batch(plant, waves=None, params=None, *, duration: float, dt: float
                      "parameter_names": list(plant.parameters)})
     ds["parameters"] = (("case", "parameter"), P)
     return ds
+
+
+def batch_states(plant, waves=None, params=None, *, duration: float, dt: float,
+                 method: str = "rk4", x0=None, compiled: bool = True):
+    """The stepping of `simulate_batch` alone: (t (n+1,), X (cases, n+1, nx), P (cases, np),
+    wall time s), for callers that evaluate outputs themselves (e.g. only over a window)."""
+    import time
+    spec = integrators.method(method)
+    if not spec.fixed_step:
+        raise ValueError(f"simulate_batch needs a fixed-step method, got {method!r}")
+    waves_list, params_list = _cases(waves, params)
+    n_cases = len(waves_list)
+    P = np.array([_vector(plant, p) for p in params_list])                 # (cases, np)
+    n = int(round(duration / dt))
+    x0 = plant.x0() if x0 is None else np.asarray(x0, float)
+    length = integrators.chunk_length(n)
+    fun = _batch_function(plant, method, length, n_cases, compiled)
+
+    start = time.perf_counter()
+    W_nodes = np.stack([integrators.excitation_at_nodes(plant, w, n, dt, spec.nodes)
+                        for w in waves_list])                              # (cases, n, k, nw)
+    X = _run(fun, plant, method, x0, W_nodes, P, dt, n, length)
+    return np.arange(n + 1) * dt, X, P, time.perf_counter() - start
+
+
+def _cases(waves, params) -> tuple[list, list]:
+    """waves and params as two lists of one entry per case (a single entry is shared)."""
+    waves_list = list(waves) if isinstance(waves, (list, tuple)) else [waves]
+    params_list = list(params) if isinstance(params, (list, tuple)) else [params]
+    n_cases = max(len(waves_list), len(params_list))
+    for name, items in (("waves", waves_list), ("params", params_list)):
+        if len(items) not in (1, n_cases):
+            raise ValueError(f"simulate_batch: {name} has {len(items)} entries; expected 1 or "
+                             f"{n_cases} (one per case)")
+    waves_list = waves_list * n_cases if len(waves_list) == 1 else waves_list
+    params_list = params_list * n_cases if len(params_list) == 1 else params_list
+    return waves_list, params_list
 
 
 def _vector(plant, params) -> np.ndarray:

@@ -21,7 +21,8 @@ import numpy as np
 import xarray as xr
 
 from ..plant import ProcessPlant
-from ..plant.fidelity import Fidelity, FidelityError, _wave_list, has_couplings, plant_for
+from ..plant.fidelity import Fidelity, FidelityError, has_couplings, plant_for
+from ..plant.freeze import as_wave_list
 from ..scene import Scene, load_scene
 from ..sim import simulate
 
@@ -162,7 +163,7 @@ def auto(scene: Scene | str, waves, tol: float = 0.01, *, duration: float | None
     then the lower error.
     """
     scene = load_scene(scene) if not isinstance(scene, Scene) else scene
-    wave_list = _wave_list(waves)
+    wave_list = as_wave_list(waves)
     if not wave_list:
         raise FidelityError("auto: waves: expected a Wave or a non-empty list of Waves")
     if not tol > 0:

@@ -17,7 +17,7 @@ from scipy.integrate import simpson
 
 from mbcontrol import waves
 from mbcontrol.plant import Fidelity, FidelityError, build_plant, jacobians, plant_for
-from mbcontrol.plant.fidelity import frozen_scene
+from mbcontrol.plant.freeze import frozen_scene
 from mbcontrol.scene import load_scene, parse_scene
 from mbcontrol.sim import simulate
 from mbcontrol.studies.fidelity_auto import auto

@@ -1,0 +1,15 @@
+"""Identification against measurements (the seed's section 4): fit a plant's unknown parameters
+so that it reproduces measured regular-wave responses, with standard errors and validation on
+runs the fit did not see.
+
+Modules: `records` (measured records: CSV and netCDF readers, channel checks), `flume` (the
+tank dataset of ../shared/data/tank as runs), `costs` (first harmonic, the seed's Eq. 67 peaks
+and lows), `problem` (runs + plant + parameters -> residuals and their exact Jacobian), `fit`
+(Nelder-Mead and Gauss-Newton, uncertainty), `report` (tables, JSON, figures).
+"""
+from .fit import FitResult, IdentifiabilityWarning, fit
+from .problem import FitParameter, Identification, Run
+from .records import Record, RecordError, read_csv, read_netcdf
+
+__all__ = ["Identification", "FitParameter", "Run", "fit", "FitResult", "IdentifiabilityWarning",
+           "Record", "RecordError", "read_csv", "read_netcdf"]

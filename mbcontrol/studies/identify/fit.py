@@ -1,0 +1,161 @@
+"""Fitting an `Identification`: Nelder-Mead (the seed's simplex search) or Gauss-Newton with
+exact sensitivities (a bounded trust-region Levenberg-Marquardt, scipy's least_squares
+"trf"), multi-start, and the uncertainty of the result.
+
+Uncertainty (at the optimum, from the Gauss-Newton Hessian J^T J of the residuals in the
+physical parameters, scaled by the residual variance s^2 = |r|^2 / (m - n)): covariance
+s^2 (J^T J)^-1, standard errors, correlations. Parameters the data cannot separate are named
+in a warning: a pair with |correlation| > CORRELATION_LIMIT, or the direction of the smallest
+singular value of the column-scaled Jacobian when its condition number passes CONDITION_LIMIT.
+"""
+from __future__ import annotations
+
+import time
+import warnings
+from dataclasses import dataclass, field
+
+import numpy as np
+
+METHODS = ("gauss-newton", "nelder-mead")
+CORRELATION_LIMIT = 0.95
+CONDITION_LIMIT = 1e6
+
+
+class IdentifiabilityWarning(UserWarning):
+    """The data cannot separate some of the fitted parameters."""
+
+
+@dataclass
+class FitResult:
+    """What a fit found: values (parameter -> value), std (standard errors, same units),
+    correlation (n x n), cost before and after (1/2 |r|^2), the residuals, simulations run,
+    wall time (s), the method and a list of warnings."""
+    method: str
+    names: list
+    initial: dict
+    values: dict
+    std: dict
+    correlation: np.ndarray
+    cost_initial: float
+    cost: float
+    residuals: np.ndarray = field(repr=False)
+    simulations: int = 0
+    evaluations: int = 0
+    wall_time_s: float = 0.0
+    starts: int = 1
+    warnings: list = field(default_factory=list)
+    condition_number: float = float("nan")
+
+
+def fit(problem, method: str = "gauss-newton", *, starts: int = 1, seed: int = 0,
+        max_evaluations: int | None = None, tol: float = 1e-8, progress: bool = False,
+        theta0=None) -> FitResult:
+    """Fit `problem` (an Identification) by `method`; starts > 1 adds random starts inside
+    the bounds (uniform in theta) and keeps the best. Returns a FitResult with uncertainty."""
+    from scipy.optimize import least_squares, minimize
+    if method not in METHODS:
+        raise ValueError(f"method {method!r}: expected one of {', '.join(METHODS)}")
+    lo, hi = problem.bounds()
+    rng = np.random.default_rng(seed)
+    first = problem.theta0() if theta0 is None else np.asarray(theta0, float)
+    points = [first] + [lo + (hi - lo) * rng.uniform(size=lo.size) for _ in range(starts - 1)]
+    sims0, t0 = problem.simulations, time.perf_counter()
+    bar = _bar(progress, method)
+    cost_initial = problem.cost_value(first)
+    best, evaluations = None, 0
+    for start in points:
+        if method == "gauss-newton":
+            cache = {}
+
+            def both(theta):
+                key = tuple(theta)
+                if key not in cache:
+                    cache.clear()
+                    cache[key] = problem.residuals(theta, jacobian=True)
+                    _tick(bar, 0.5 * float(cache[key][0] @ cache[key][0]))
+                return cache[key]
+
+            res = least_squares(lambda th: both(th)[0], start, jac=lambda th: both(th)[1],
+                                bounds=(lo, hi), method="trf", x_scale="jac", ftol=tol,
+                                xtol=tol, gtol=tol, max_nfev=max_evaluations or 100)
+            theta, value, evaluations = res.x, float(res.cost), evaluations + res.nfev
+        else:
+            span = np.where(hi > lo, hi - lo, 1.0)
+
+            def cost(z):                      # the simplex lives on [0, 1] per parameter
+                value = problem.cost_value(lo + span * np.clip(z, 0.0, 1.0))
+                _tick(bar, value)
+                return value
+
+            z0 = (start - lo) / span
+            res = minimize(cost, z0, method="Nelder-Mead", bounds=[(0.0, 1.0)] * lo.size,
+                           options={"xatol": 1e-4, "fatol": tol * max(cost_initial, 1e-300),
+                                    "maxfev": max_evaluations or 200 * lo.size,
+                                    "adaptive": lo.size > 3})
+            theta, value, evaluations = lo + span * res.x, float(res.fun), evaluations + res.nfev
+        if best is None or value < best[1]:
+            best = (theta, value)
+    if bar is not None:
+        bar.close()
+    theta, value = best
+    r, J = problem.residuals(theta, jacobian=True)
+    result = FitResult(method=method, names=[p.name for p in problem.fit],
+                       initial={p.name: p.initial for p in problem.fit},
+                       values=problem.values(theta), std={}, correlation=np.eye(len(theta)),
+                       cost_initial=cost_initial, cost=0.5 * float(r @ r), residuals=r,
+                       evaluations=evaluations, starts=len(points))
+    uncertainty(problem, theta, r, J, result)
+    result.simulations = problem.simulations - sims0
+    result.wall_time_s = time.perf_counter() - t0
+    return result
+
+
+def uncertainty(problem, theta, r, J, result: FitResult) -> None:
+    """Standard errors and correlations from s^2 (J_p^T J_p)^-1, J_p = dr/dp (physical)."""
+    names = result.names
+    dp = np.array([p.from_theta(t) if p.log else 1.0 for p, t in zip(problem.fit, theta)])
+    Jp = J / dp[None, :]
+    m, n = Jp.shape
+    dof = max(m - n, 1)
+    s2 = float(r @ r) / dof
+    scale = np.where(np.linalg.norm(Jp, axis=0) > 0, np.linalg.norm(Jp, axis=0), 1.0)
+    Js = Jp / scale
+    sv = np.linalg.svd(Js, compute_uv=False)
+    result.condition_number = float(sv[0] / sv[-1]) if sv[-1] > 0 else float("inf")
+    cov = s2 * np.linalg.pinv(Js.T @ Js) / np.outer(scale, scale)
+    std = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    result.std = dict(zip(names, map(float, std)))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        corr = cov / np.outer(std, std)
+    result.correlation = np.nan_to_num(corr)
+    messages = []
+    for i in range(n):
+        for j in range(i + 1, n):
+            if abs(result.correlation[i, j]) > CORRELATION_LIMIT:
+                messages.append(f"{names[i]} and {names[j]} are correlated "
+                                f"{result.correlation[i, j]:+.3f}: the data cannot separate them")
+    if result.condition_number > CONDITION_LIMIT:
+        _, _, Vt = np.linalg.svd(Js)
+        weak = Vt[-1]
+        lead = [names[k] for k in np.argsort(-np.abs(weak)) if abs(weak[k]) > 0.3]
+        messages.append(f"ill-conditioned (condition number {result.condition_number:.3g}): "
+                        f"the combination of {', '.join(lead)} is barely seen by the data")
+    if m <= n:
+        messages.append(f"{m} residuals for {n} parameters: no degrees of freedom left for "
+                        f"the residual variance")
+    for text in messages:
+        warnings.warn(text, IdentifiabilityWarning, stacklevel=3)
+    result.warnings = messages
+
+
+def _bar(progress: bool, method: str):
+    if not progress:
+        return None
+    from tqdm.auto import tqdm
+    return tqdm(desc=f"identify ({method})", unit="eval", leave=False)
+
+
+def _tick(bar, cost: float) -> None:
+    if bar is not None:
+        bar.update(1)
+        bar.set_postfix(cost=f"{cost:.4g}")

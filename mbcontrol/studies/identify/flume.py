@@ -1,0 +1,201 @@
+"""The flume dataset of ../shared/data/tank (Sundsdal et al. 2025) as identification runs.
+
+File names follow `SPPH[_R]`: S the series (1 calibration: waves alone; 3 sway, heave and roll
+free; 4 sway and heave; 5 sway and roll; 6 heave and roll), PP the frequency index (01-14), H
+the height code (1: 24 mm, 2: 40 mm nominal), R a repetition. `load_runs(files)` turns model
+runs into `Run`s for `mbcontrol.studies.identify`:
+
+- the steady window from the flume's geometry and the run's own wavemaker start (found in
+  WM_Position): it opens when the ramp's end (RAMP_PERIODS after the paddle starts, at the
+  group velocity c_g of finite depth) has passed the model plus SETTLE_PERIODS for the model's
+  transient, and closes when waves reflected by the model have come back from the paddle,
+  3 x / c_g after the paddle started (x = 7 m); whole periods only; a run with none is refused;
+- the incident wave at the model from the calibration runs of the same PP and H: the first
+  harmonic at each probe (in its own steady window), carried to x = 7 m as a progressive wave
+  e^{i(k x - omega t)} and averaged over probes and repetitions (their spread is reported),
+  related to the paddle's first harmonic, and applied to the model run's own paddle motion so
+  the two runs need no common clock;
+- the free DOFs of the series as channels (Sway m, Heave m, Roll rad), each checked (missing,
+  NaN or flat: a tracking failure), and the plant the series needs: the blocked joint frozen
+  (`Fidelity(freeze=...)`) and, with heave blocked, 0.3 kg more moving in sway.
+"""
+from __future__ import annotations
+
+import math
+import re
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from .costs import harmonic, whole_periods
+from .problem import Run
+from .records import RecordError, channel_problem, read_csv
+
+DEPTH, G = 1.0, 9.81                    # m, m/s^2
+MODEL_X = 7.0                           # m from the wavemaker
+BEACH_X = 11.5                          # m, the middle of the parabolic beach (13.63 m - 2.1 m)
+PROBES = {"WP_1": 3.00, "WP_2": 4.95, "WP_3": 5.20, "WP_4": 5.50, "WP_6": 8.50}   # m
+RAMP_PERIODS = 5                        # the wavemaker's ramp (README)
+SETTLE_PERIODS = 2                      # for the model's own transient after the ramp
+OMEGA = {1: 4.143, 2: 4.952, 3: 5.075, 4: 5.194, 5: 5.311, 6: 5.425, 7: 5.646, 8: 5.860,
+         9: 6.065, 10: 7.004, 11: 7.830, 12: 8.578, 13: 9.265, 14: 9.905}           # rad/s
+HEIGHT = {1: 0.024, 2: 0.040}           # m, nominal
+SERIES = {3: ("Sway", "Heave", "Roll"), 4: ("Sway", "Heave"), 5: ("Sway", "Roll"),
+          6: ("Heave", "Roll")}
+FREEZE = {3: (), 4: ("roll",), 5: ("heave",), 6: ("sway",)}     # joints of flume_section.toml
+SCENE_PARAMETERS = {5: {"sway_extra_mass": 0.3}}                 # kg: the heave block rides in sway
+_NAME = re.compile(r"^(?P<series>\d)(?P<pp>\d\d)(?P<h>\d)(?:_(?P<rep>\d+))?$")
+
+
+def parse_name(path) -> dict:
+    """{series, pp, omega (rad/s), height_code, height (m), repetition} from `SPPH[_R]`."""
+    path = Path(path)
+    stem = path.name.split(".")[0]
+    m = _NAME.match(stem)
+    if not m or int(m["pp"]) not in OMEGA or int(m["h"]) not in HEIGHT:
+        raise RecordError(f"{path}: name {stem!r} does not follow the flume convention SPPH[_R] "
+                          f"(S series 1-6, PP 01-14, H 1 or 2, R a repetition), e.g. 4021_1")
+    pp, h = int(m["pp"]), int(m["h"])
+    return {"series": int(m["series"]), "pp": pp, "omega": OMEGA[pp], "height_code": h,
+            "height": HEIGHT[h], "repetition": int(m["rep"]) if m["rep"] else 0}
+
+
+def wavenumber(omega: float, depth: float = DEPTH) -> float:
+    """k (rad/m) of omega^2 = g k tanh(k h), by Newton from the deep-water guess."""
+    k = omega ** 2 / G
+    for _ in range(50):
+        f = G * k * math.tanh(k * depth) - omega ** 2
+        df = G * math.tanh(k * depth) + G * k * depth / math.cosh(k * depth) ** 2
+        k, step = k - f / df, f / df
+        if abs(step) < 1e-14 * k:
+            break
+    return k
+
+
+def group_velocity(omega: float, depth: float = DEPTH) -> float:
+    """c_g (m/s) in finite depth: (omega / k) (1 + 2 k h / sinh 2 k h) / 2."""
+    k = wavenumber(omega, depth)
+    return omega / k * 0.5 * (1 + 2 * k * depth / math.sinh(2 * k * depth))
+
+
+def wavemaker_start(record, share: float = 0.05) -> float:
+    """Time (s) the paddle starts: WM_Position first leaves its still level by `share` of its
+    largest excursion."""
+    t, wm = record.time, record.channel("WM_Position")
+    still = np.median(wm[: max(10, int(0.5 / np.median(np.diff(t))))])
+    excursion = np.abs(wm - still)
+    if excursion.max() <= 0:
+        raise RecordError(f"{record.path}: WM_Position never moves; expected a wavemaker start")
+    return float(t[np.argmax(excursion > share * excursion.max())])
+
+
+def steady_window(start: float, omega: float, x: float = MODEL_X) -> tuple[float, float]:
+    """(open, close) s: ramp passed plus the settling periods, until the model's reflection is
+    back from the paddle (see the module notes); not yet cut to whole periods."""
+    period, cg = 2 * math.pi / omega, group_velocity(omega)
+    return start + x / cg + (RAMP_PERIODS + SETTLE_PERIODS) * period, start + 3 * x / cg
+
+
+def _paddle(record, start, omega):
+    """The paddle's first harmonic (complex) over whole periods after its ramp."""
+    period = 2 * math.pi / omega
+    t0 = start + (RAMP_PERIODS + 1) * period
+    return harmonic(record.time, record.channel("WM_Position"), omega, t0,
+                    min(t0 + 10 * period, record.time[-1]))
+
+
+def incident_transfer(paths, omega: float) -> tuple[complex, float]:
+    """(H, spread): the incident wave's first harmonic at the model per unit paddle harmonic,
+    from calibration runs, and the relative spread of the estimates (over probes and runs)."""
+    k, period = wavenumber(omega), 2 * math.pi / omega
+    estimates = []
+    for path in paths:
+        record = read_csv(path)
+        start = wavemaker_start(record)
+        paddle = _paddle(record, start, omega)
+        for probe, x in PROBES.items():
+            if probe not in record.channels or channel_problem(record, probe):
+                continue
+            t0 = start + x / group_velocity(omega) + (RAMP_PERIODS + 1) * period
+            t1 = start + (2 * BEACH_X - x) / group_velocity(omega)   # before the beach's echo
+            try:
+                a = harmonic(record.time, record.channels[probe], omega, t0, t1)
+            except ValueError:
+                continue
+            # progressive wave, Re(A e^{i omega t}) with A(x) = A(x_p) e^{-i k (x - x_p)}
+            estimates.append(a * np.exp(-1j * k * (MODEL_X - x)) / paddle)
+    if not estimates:
+        raise RecordError(f"calibration {', '.join(map(str, paths))}: no probe gave a steady "
+                          f"harmonic at omega = {omega} rad/s")
+    estimates = np.array(estimates)
+    mean = complex(np.mean(estimates))
+    return mean, float(np.std(np.abs(estimates)) / abs(mean))
+
+
+def calibration_files(folder, pp: int, height_code: int) -> list[Path]:
+    """The calibration runs 1PPH and 1PPH_R in `folder`."""
+    folder = Path(folder)
+    found = sorted(p for p in folder.glob(f"1{pp:02d}{height_code}*.csv*")
+                   if _NAME.match(p.name.split(".")[0]))
+    if not found:
+        raise RecordError(f"{folder}: no calibration run 1{pp:02d}{height_code}[_R].csv[.xz] "
+                          f"for frequency index {pp:02d} and height code {height_code}")
+    return found
+
+
+def load_run(path, calibration, *, channels: dict | None = None) -> Run:
+    """One model run as a `Run` (see the module notes); RecordError names file and channel."""
+    path = Path(path)
+    info = parse_name(path)
+    if info["series"] not in SERIES:
+        raise RecordError(f"{path}: series {info['series']} is not a model run; expected one of "
+                          f"{sorted(SERIES)} (1 is a calibration run)")
+    record = read_csv(path)
+    omega, free = info["omega"], SERIES[info["series"]]
+    start = wavemaker_start(record)
+    open_, close = steady_window(start, omega)
+    close = min(close, float(record.time[-1]))
+    try:
+        open_, close, n = whole_periods(record.time, omega, open_, close)
+    except ValueError:
+        raise RecordError(f"{path}: no whole wave period ({2 * math.pi / omega:.3f} s) between "
+                          f"the ramp's passage ({open_:.2f} s) and the reflections' return "
+                          f"({close:.2f} s); the run is too short for a steady window") from None
+    names = channels or {c: c for c in free}
+    for channel in free:
+        problem = channel_problem(record, channel, (open_, close))
+        if problem:
+            raise RecordError(f"{path}: {problem}")
+    transfer, spread = incident_transfer(calibration_files(calibration, info["pp"],
+                                                           info["height_code"]), omega)
+    incident = transfer * _paddle(record, start, omega)
+    return Run(name=path.name.split(".")[0], omega=omega, amplitude=abs(incident),
+               phase=float(np.angle(incident)), window=(open_, close), time=record.time,
+               channels={names[c]: record.channels[c] for c in free},
+               group=f"series {info['series']}", freeze=FREEZE[info["series"]],
+               scene_parameters=dict(SCENE_PARAMETERS.get(info["series"], {})), source=str(path),
+               notes={"periods": n, "calibration_spread": spread, **info})
+
+
+def load_runs(paths, calibration=None, *, drop_bad: bool = False) -> list[Run]:
+    """Runs from files; calibration: the folder of 1PPH files (default: `calibration` beside
+    the data files' folder). drop_bad: skip unusable runs with one warning listing each and
+    why, instead of raising at the first."""
+    paths = [Path(p) for p in paths]
+    if not paths:
+        raise RecordError("no data files given")
+    calibration = Path(calibration) if calibration else paths[0].parent.parent / "calibration"
+    runs, dropped = [], []
+    for path in paths:
+        try:
+            runs.append(load_run(path, calibration))
+        except RecordError as exc:
+            if not drop_bad:
+                raise
+            dropped.append(str(exc))
+    if dropped:
+        warnings.warn(f"dropped {len(dropped)} run(s):\n  " + "\n  ".join(dropped), stacklevel=2)
+    if not runs:
+        raise RecordError("no usable run among the files given")
+    return runs

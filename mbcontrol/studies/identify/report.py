@@ -1,0 +1,156 @@
+"""What an identification shows: per run and channel the measured and modelled first-harmonic
+amplitudes, their errors per channel, the parameter table, the JSON contract of `mbcontrol
+identify --json` and the figures (response amplitude over frequency per DOF, before and after;
+time series of one run).
+
+Errors per channel, over the runs where the channel's DOF is free: `rms_error`, the RMS of
+model minus measured amplitude (the channel's unit); `rms_relative_error`, the RMS of
+(model - measured) / measured (dimensionless).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ...results import jsonable
+from .costs import harmonic, whole_periods
+
+
+def amplitude_rows(problem, values: dict) -> list[dict]:
+    """Per run and free channel: {run, group, omega (rad/s), incident (m), channel, unit,
+    measured, model (first-harmonic amplitudes, channel unit), relative_error}."""
+    sims = problem.simulate(values)
+    rows = []
+    for run, sim in zip(problem.runs, sims):
+        start, end, _ = whole_periods(run.time, run.omega, *run.window)
+        for channel, (t, y, _) in sim.items():
+            measured = abs(harmonic(run.time, run.channels[channel], run.omega, start, end))
+            model = abs(harmonic(t, y, run.omega, start, end))
+            rows.append({"run": run.name, "group": run.group, "omega": run.omega,
+                         "incident": run.amplitude, "channel": channel,
+                         "unit": "rad" if channel.lower().startswith(("roll", "pitch", "yaw"))
+                         else "m", "measured": measured, "model": model,
+                         "relative_error": (model - measured) / measured})
+    return rows
+
+
+def channel_errors(rows: list[dict]) -> dict:
+    """{channel: {rms_error, rms_relative_error, runs}} over the rows."""
+    out = {}
+    for channel in sorted({r["channel"] for r in rows}):
+        mine = [r for r in rows if r["channel"] == channel]
+        diff = np.array([r["model"] - r["measured"] for r in mine])
+        rel = np.array([r["relative_error"] for r in mine])
+        out[channel] = {"rms_error": float(np.sqrt(np.mean(diff ** 2))),
+                        "rms_relative_error": float(np.sqrt(np.mean(rel ** 2))),
+                        "runs": len(mine)}
+    return out
+
+
+def errors_block(rows: list[dict], residuals=None) -> dict:
+    """{runs, rms_error, channels}: the "fit" / "validation" block of the JSON contract;
+    rms_error is the RMS of the relative amplitude errors over every run and channel."""
+    rel = np.array([r["relative_error"] for r in rows])
+    return {"runs": sorted({r["run"] for r in rows}),
+            "rms_error": float(np.sqrt(np.mean(rel ** 2))) if rel.size else None,
+            "channels": channel_errors(rows)}
+
+
+def summary(model: str, problem, result, fit_rows, validation_rows=None) -> dict:
+    """The JSON contract of `mbcontrol identify --json`."""
+    params = {}
+    for p in problem.fit:
+        params[p.name] = {"initial": p.initial, "value": result.values[p.name],
+                          "std": result.std.get(p.name), "lo": p.lo, "hi": p.hi}
+    return jsonable({
+        "model": model, "method": result.method, "cost": problem.cost,
+        "parameters": params, "correlation": np.asarray(result.correlation).tolist(),
+        "fit": errors_block(fit_rows),
+        "validation": errors_block(validation_rows) if validation_rows else None,
+        "simulations": result.simulations, "wall_time_s": result.wall_time_s,
+        "cost_initial": result.cost_initial, "cost_final": result.cost,
+        "warnings": list(result.warnings),
+    })
+
+
+def parameter_table(problem, result) -> str:
+    """Plain-text table: parameter, initial, identified +- sigma, bounds."""
+    lines = [f"{'parameter':36s} {'initial':>11s} {'identified':>11s} {'+- sigma':>10s}  bounds"]
+    for p in problem.fit:
+        v, s = result.values[p.name], result.std.get(p.name, math.nan)
+        lines.append(f"{p.name:36s} {p.initial:11.4g} {v:11.4g} {s:10.3g}  "
+                     f"[{p.lo:.3g}, {p.hi:.3g}]{' log' if p.log else ''}")
+    lines.append(f"cost (1/2 |r|^2, {problem.cost}): {result.cost_initial:.4g} -> {result.cost:.4g}"
+                 f"; {result.simulations} simulations, {result.wall_time_s:.1f} s")
+    return "\n".join(lines)
+
+
+def error_table(rows: list[dict], label: str) -> str:
+    """Per channel: RMS error (unit) and RMS relative error over the runs."""
+    lines = [f"{label}: {'channel':8s} {'runs':>4s} {'rms error':>12s} {'rms relative':>13s}"]
+    for channel, e in channel_errors(rows).items():
+        unit = next(r["unit"] for r in rows if r["channel"] == channel)
+        lines.append(f"{'':{len(label) + 2}s}{channel:8s} {e['runs']:4d} "
+                     f"{e['rms_error']:10.3g} {unit:1s} {100 * e['rms_relative_error']:12.1f}%")
+    return "\n".join(lines)
+
+
+def plot_amplitudes(rows_by_label: dict, path) -> None:
+    """Response amplitude per unit incident amplitude against frequency, one panel per channel,
+    measured (dots) and each labelled model (lines), runs grouped by `group` (markers)."""
+    import matplotlib.pyplot as plt
+
+    from ...plotting import save
+    first = next(iter(rows_by_label.values()))
+    channels = sorted({r["channel"] for r in first})
+    fig, axes = plt.subplots(1, len(channels), figsize=(4.2 * len(channels), 3.6), squeeze=False)
+    markers = dict(zip(sorted({r["group"] for r in first}), "osD^v<>"))
+    for ax, channel in zip(axes[0], channels):
+        mine = [r for r in first if r["channel"] == channel]
+        unit = mine[0]["unit"]
+        for group, marker in markers.items():
+            pts = sorted((r["omega"], r["measured"] / r["incident"]) for r in mine
+                         if r["group"] == group)
+            if pts:
+                ax.plot(*zip(*pts), marker, color="k", mfc="none", label=f"measured, {group}")
+        for k, (label, rows) in enumerate(rows_by_label.items()):
+            for group, marker in markers.items():
+                pts = sorted((r["omega"], r["model"] / r["incident"]) for r in rows
+                             if r["channel"] == channel and r["group"] == group)
+                if pts:
+                    ax.plot(*zip(*pts), "-" + marker, color=f"C{k}", ms=3, lw=1,
+                            label=f"{label}, {group}")
+        ax.set_xlabel("wave frequency, rad/s")
+        ax.set_ylabel(f"{channel} amplitude / wave amplitude, {unit}/m")
+        ax.set_title(channel)
+        ax.grid(alpha=0.3)
+    axes[0][-1].legend(fontsize=6, loc="best")
+    fig.tight_layout()
+    save(fig, path)
+
+
+def plot_time_series(problem, run_name: str, values_by_label: dict, path) -> None:
+    """One run's free channels over its steady window: measured and each labelled model."""
+    import matplotlib.pyplot as plt
+
+    from ...plotting import save
+    k = next(i for i, r in enumerate(problem.runs) if r.name == run_name)
+    run = problem.runs[k]
+    sims = {label: problem.simulate(values)[k] for label, values in values_by_label.items()}
+    fig, axes = plt.subplots(len(run.channels), 1, figsize=(8, 2.6 * len(run.channels)),
+                             squeeze=False, sharex=True)
+    for ax, channel in zip(axes[:, 0], run.channels):
+        keep = (run.time >= run.window[0]) & (run.time <= run.window[1])
+        ax.plot(run.time[keep], run.channels[channel][keep], "k", lw=1.2, label="measured")
+        for i, (label, sim) in enumerate(sims.items()):
+            t, y, _ = sim[channel]
+            ax.plot(t, y, color=f"C{i}", lw=1, label=label)
+        ax.set_ylabel(channel)
+        ax.grid(alpha=0.3)
+    axes[0, 0].set_title(f"{run.name}: {run.group}, omega {run.omega:.3f} rad/s, wave amplitude "
+                         f"{1000 * run.amplitude:.1f} mm")
+    axes[-1, 0].set_xlabel("time on the run's clock, s")
+    axes[0, 0].legend(fontsize=7)
+    fig.tight_layout()
+    save(fig, path)
