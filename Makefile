@@ -41,6 +41,7 @@ bench: $(VENV)/.installed-test
 	$(PY) benchmarks/scaling.py --n 2 4 8 16 --out $(OUT)/bench/scaling
 	$(PY) benchmarks/mpc.py --out $(OUT)/bench/mpc
 	$(PY) benchmarks/nmpc.py --out $(OUT)/bench/nmpc
+	$(PY) benchmarks/identify.py --out $(OUT)/bench/identify
 
 clean:
 	rm -rf $(OUT) .pytest_cache

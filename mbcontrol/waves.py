@@ -43,6 +43,25 @@ class Wave:
                 "ramp_s": self.ramp_time, "n_components": int(self.omega.size)}
 
 
+def wavenumber(omega: float, depth: float, g: float = 9.81) -> float:
+    """k (rad/m) of the linear dispersion relation omega^2 = g k tanh(k h), omega in rad/s and
+    the water depth h in m (Newton's method from the deep-water guess)."""
+    k = omega ** 2 / g
+    for _ in range(50):
+        f = g * k * math.tanh(k * depth) - omega ** 2
+        df = g * math.tanh(k * depth) + g * k * depth / math.cosh(k * depth) ** 2
+        k, step = k - f / df, f / df
+        if abs(step) < 1e-14 * k:
+            break
+    return k
+
+
+def group_velocity(omega: float, depth: float, g: float = 9.81) -> float:
+    """c_g (m/s) in water of depth h (m): (omega / k) (1 + 2 k h / sinh 2 k h) / 2."""
+    k = wavenumber(omega, depth, g)
+    return omega / k * 0.5 * (1 + 2 * k * depth / math.sinh(2 * k * depth))
+
+
 def ramp(t, ramp_time: float) -> np.ndarray:
     """Half-cosine ramp 0 -> 1 over ramp_time seconds (1 everywhere if ramp_time == 0)."""
     t = np.asarray(t, dtype=float)

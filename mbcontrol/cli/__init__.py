@@ -195,3 +195,6 @@ def _wave_options(p) -> None:
     g.add_argument("--tp", type=float, help="peak period, s")
     g.add_argument("--gamma", type=float, default=3.3, help="JONSWAP peak enhancement (3.3)")
     g.add_argument("--seed", type=int, default=0, help="random phase seed (0)")
+    g.add_argument("--direction", type=float, metavar="DEG",
+                   help="heading the waves travel towards, degrees in the n-frame (default: the "
+                        "hydro data's heading when it has one only, else 0)")

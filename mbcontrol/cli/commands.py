@@ -1,7 +1,9 @@
 """The commands behind `mbcontrol COMMAND` (the parser and `main` are in `mbcontrol.cli`)."""
 from __future__ import annotations
 
+import dataclasses
 import json
+import math
 import sys
 
 import numpy as np
@@ -65,6 +67,10 @@ def _wave(args, plant, duration):
     wave = from_args(args.wave, height=args.height, period=args.period, hs=args.hs,
                      tp=args.tp, gamma=args.gamma, seed=args.seed, duration=duration,
                      data_band=band)
+    headings = plant.hydro.data["wave_direction"].values if plant.hydro is not None else [0.0]
+    direction = math.radians(args.direction) if getattr(args, "direction", None) is not None \
+        else float(headings[0]) if len(headings) == 1 else 0.0
+    wave = dataclasses.replace(wave, direction=direction)
     outside = wave.settings.get("spectrum_outside_data", 0.0)
     if outside > 1e-3:
         print(f"mbcontrol: note: {100 * outside:.2g} % of the spectrum's variance lies outside the "

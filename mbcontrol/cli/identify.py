@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 import json
-import math
 import sys
 import warnings
 from pathlib import Path
@@ -51,8 +50,9 @@ def add_parser(sub) -> None:
     p.add_argument("--validate", nargs="+", default=[], metavar="FILE",
                    help="runs to predict with the fitted values (not fitted)")
     p.add_argument("--dt", type=float, default=0.01, help="simulation step, s (0.01)")
-    p.add_argument("--settle", type=float, default=30.0,
-                   help="simulated time before each steady window, s (30)")
+    p.add_argument("--settle", type=float, default=60.0,
+                   help="simulated time before each steady window, s (60: the flume "
+                        "model's lightly damped 8 s sway mode needs it to settle)")
     p.add_argument("--drop-bad", action="store_true",
                    help="skip unusable runs with a warning instead of stopping")
     p.add_argument("--out", metavar="DIR", help="write summary.json, tables and figures here")
@@ -60,77 +60,38 @@ def add_parser(sub) -> None:
     p.set_defaults(run=run_identify)
 
 
-def fit_parameters(scene, plant_parameters: dict, specs: list[str]):
-    """FitParameters from --fit specs (or the scene's [identify] table when none)."""
-    from ..studies.identify import FitParameter
-    chosen = {}
-    if not specs:
-        if not scene.identify:
-            raise ValueError(f"{scene.path}: no --fit given and no [identify] table in the scene")
-        chosen = dict(scene.identify)
-    for spec in specs:
-        name, _, bounds = spec.partition("=")
-        if bounds:
-            try:
-                lo, hi = (float(v) for v in bounds.split(":"))
-            except ValueError:
-                raise ValueError(f"--fit {spec}: expected NAME=LO:HI with two numbers") from None
-        elif name in scene.identify:
-            lo, hi = scene.identify[name]
-        else:
-            raise ValueError(f"--fit {name}: no bounds given and none in {scene.path}'s "
-                             f"[identify] table; write --fit {name}=LO:HI")
-        chosen[name] = (lo, hi)
-    out = []
-    for name, (lo, hi) in chosen.items():
-        if name not in plant_parameters:
-            raise ValueError(f"--fit {name}: not a parameter of {scene.name}; it has "
-                             f"{', '.join(sorted(plant_parameters))}")
-        log = lo > 0
-        nominal = plant_parameters[name]
-        initial = nominal if lo <= nominal <= hi and (nominal > 0 or not log) else (
-            math.sqrt(lo * hi) if log else 0.5 * (lo + hi))
-        out.append(FitParameter(name, float(initial), float(lo), float(hi), log=log))
-    return out
-
-
 def run_identify(args) -> int:
-    from ..plant import build_plant
-    from ..scene import load_scene
-    from ..studies.identify import Identification, fit
+    from ..studies.identify import fit
     from ..studies.identify import report as rep
     from ..studies.identify.flume import load_runs
+    from ..studies.identify.setup import flume_identification, prediction
     from .commands import _key_value
 
-    scene = load_scene(args.model)
+    params = dict(_key_value(s, "--param") for s in args.param)
+    common = dict(cost=args.cost, phase=args.phase, params=params, dt=args.dt,
+                  settle=args.settle)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         runs = load_runs(args.data, args.calibration, drop_bad=args.drop_bad)
         validation = load_runs(args.validate, args.calibration, drop_bad=args.drop_bad) \
             if args.validate else []
+        problem = flume_identification(args.model, None, runs=runs, fit=args.fit, **common)
     for w in caught:
         print(f"mbcontrol: warning: {w.message}", file=sys.stderr)
-    full = build_plant(scene, hydro_corrections=True)
-    parameters = fit_parameters(scene, dict(zip(full.parameters, full.p0)), args.fit)
-    params = dict(_key_value(s, "--param") for s in args.param)
-    outputs = _outputs(full, runs + validation)
-    common = dict(outputs=outputs, cost=args.cost, phase=args.phase, params=params, dt=args.dt,
-                  settle=args.settle)
-    problem = Identification(scene.path, runs, parameters, **common)
-    initial = {p.name: p.initial for p in parameters}
-    before = rep.amplitude_rows(problem, initial)
+    before = rep.amplitude_rows(problem, {})      # the scene's own values: the model as built
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         result = fit(problem, args.method, starts=args.starts, progress=not args.json)
     after = rep.amplitude_rows(problem, result.values)
     v_before = v_after = None
     if validation:
-        vproblem = Identification(scene.path, validation, parameters, **common)
-        v_before = rep.amplitude_rows(vproblem, initial)
+        # fixed at the fitted values (those its plants have: a DOF may be blocked there)
+        vproblem = prediction(problem, validation)
+        v_before = rep.amplitude_rows(vproblem, {})
         v_after = rep.amplitude_rows(vproblem, result.values)
-    summary = rep.summary(scene.name, problem, result, after, v_after)
-    summary["fit_initial"] = rep.errors_block(before)
-    summary["validation_initial"] = rep.errors_block(v_before) if v_before else None
+    summary = rep.summary(problem.scene_name, problem, result, after, v_after)
+    summary["fit_before"] = rep.errors_block(before)
+    summary["validation_before"] = rep.errors_block(v_before) if v_before else None
     if args.out:
         _write(Path(args.out), problem, result, summary, before, after, v_before, v_after)
     if args.json:
@@ -139,26 +100,14 @@ def run_identify(args) -> int:
     for w in caught:
         print(f"mbcontrol: warning: {w.message}", file=sys.stderr)
     print(rep.parameter_table(problem, result))
-    print(rep.error_table(before, "fit runs, initial"))
+    print(rep.error_table(before, "fit runs, scene values"))
     print(rep.error_table(after, "fit runs, identified"))
     if validation:
-        print(rep.error_table(v_before, "validation, initial"))
+        print(rep.error_table(v_before, "validation, scene values"))
         print(rep.error_table(v_after, "validation, identified"))
     if args.out:
         print(f"wrote {args.out}/summary.json, parameters.txt, amplitudes.png, time_series.png")
     return 0
-
-
-def _outputs(plant, runs) -> dict:
-    """Measured channel -> plant output of the same name, case aside (Roll -> roll)."""
-    lower = {o.lower(): o for o in plant.outputs}
-    out = {}
-    for channel in sorted({c for r in runs for c in r.channels}):
-        if channel.lower() not in lower:
-            raise ValueError(f"channel {channel!r} has no plant output of that name in "
-                             f"{plant.name}; expected a joint named like it")
-        out[channel] = lower[channel.lower()]
-    return out
 
 
 def _write(out: Path, problem, result, summary, before, after, v_before, v_after) -> None:
@@ -173,10 +122,12 @@ def _write(out: Path, problem, result, summary, before, after, v_before, v_after
         with os.fdopen(fd, "w") as fh:
             fh.write(text)
         os.replace(tmp, out / name)
-    rep.plot_amplitudes({"initial": before, "identified": after}, out / "amplitudes.png")
+    rep.plot_amplitudes({"scene values": before, "identified": after}, out / "amplitudes.png")
     if v_after:
-        rep.plot_amplitudes({"initial": v_before, "identified": v_after},
+        rep.plot_amplitudes({"scene values": v_before, "identified": v_after},
                             out / "amplitudes_validation.png")
     worst = max(after, key=lambda r: abs(r["relative_error"]))["run"]
-    rep.plot_time_series(problem, worst, {"initial": {p.name: p.initial for p in problem.fit},
-                                          "identified": result.values}, out / "time_series.png")
+    rep.plot_time_series(problem, worst, {"scene values": {}, "identified": result.values},
+                         out / "time_series.png")
+    import matplotlib.pyplot as plt
+    plt.close("all")

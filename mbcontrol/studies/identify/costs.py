@@ -3,8 +3,9 @@
 All take samples y(t) over a steady window holding whole periods of the wave (the window is
 cut to an integer number of periods first), so model and measurement are measured alike.
 
-- `harmonic`: the complex first-harmonic amplitude Y, y(t) ~ c + Re(Y e^{i omega t}) (least
-  squares on cos, sin and a constant), in the signal's unit;
+- `harmonic`: the complex first-harmonic amplitude Y, y(t) ~ c + d t + Re(Y e^{i omega t})
+  (least squares on cos, sin, a constant and a trend: a slow drift, e.g. a soft sway mode still
+  settling, leaks into the harmonic otherwise), in the signal's unit;
 - `peaks_and_lows`: the seed's Eq. 67 vector: per wave period in the window, the largest and
   the smallest value, [peak_1, low_1, peak_2, low_2, ...], in the signal's unit;
 - `eq67_error`: the seed's error, sum |f_hat_i - f_i|^2 over peaks and lows (unit squared).
@@ -32,13 +33,18 @@ def _in(t, start, end):
 
 def harmonic(t, y, omega: float, start: float, end: float) -> complex:
     """First-harmonic complex amplitude Y (signal unit) of y over whole periods of
-    [start, end]: y ~ c + Re(Y exp(i omega t)), least squares. |Y| is the amplitude."""
+    [start, end]: y ~ c + d t + Re(Y exp(i omega t)), least squares. |Y| is the amplitude."""
     start, end, _ = whole_periods(t, omega, start, end)
     keep = _in(t, start, end)
     tt, yy = np.asarray(t, float)[keep], np.asarray(y, float)[keep]
-    basis = np.column_stack([np.cos(omega * tt), -np.sin(omega * tt), np.ones_like(tt)])
-    (a, b, _), *_ = np.linalg.lstsq(basis, yy, rcond=None)
+    (a, b, _, _), *_ = np.linalg.lstsq(_basis(tt, omega, start, end), yy, rcond=None)
     return complex(a, b)
+
+
+def _basis(tt, omega, start, end):
+    """cos, -sin, 1 and the trend (t - mid) / half-length over the window."""
+    trend = (tt - 0.5 * (start + end)) / (0.5 * (end - start))
+    return np.column_stack([np.cos(omega * tt), -np.sin(omega * tt), np.ones_like(tt), trend])
 
 
 def harmonic_weights(t, omega: float, start: float, end: float) -> np.ndarray:
@@ -47,10 +53,8 @@ def harmonic_weights(t, omega: float, start: float, end: float) -> np.ndarray:
     start, end, _ = whole_periods(t, omega, start, end)
     t = np.asarray(t, float)
     keep = _in(t, start, end)
-    tt = t[keep]
-    basis = np.column_stack([np.cos(omega * tt), -np.sin(omega * tt), np.ones_like(tt)])
     weights = np.zeros((2, t.size))
-    weights[:, keep] = np.linalg.pinv(basis)[:2]
+    weights[:, keep] = np.linalg.pinv(_basis(t[keep], omega, start, end))[:2]
     return weights
 
 

@@ -124,17 +124,21 @@ def uncertainty(problem, theta, r, J, result: FitResult) -> None:
     result.condition_number = float(sv[0] / sv[-1]) if sv[-1] > 0 else float("inf")
     cov = s2 * np.linalg.pinv(Js.T @ Js) / np.outer(scale, scale)
     std = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    unseen = np.linalg.norm(Jp, axis=0) == 0
+    std[unseen] = np.nan
     result.std = dict(zip(names, map(float, std)))
     with np.errstate(invalid="ignore", divide="ignore"):
         corr = cov / np.outer(std, std)
     result.correlation = np.nan_to_num(corr)
-    messages = []
+    messages = [f"{names[k]} has no effect on the data (e.g. its joint is blocked in every "
+                f"run): its value is the initial one and its sigma undefined"
+                for k in np.flatnonzero(unseen)]
     for i in range(n):
         for j in range(i + 1, n):
             if abs(result.correlation[i, j]) > CORRELATION_LIMIT:
                 messages.append(f"{names[i]} and {names[j]} are correlated "
                                 f"{result.correlation[i, j]:+.3f}: the data cannot separate them")
-    if result.condition_number > CONDITION_LIMIT:
+    if result.condition_number > CONDITION_LIMIT and not unseen.any():
         _, _, Vt = np.linalg.svd(Js)
         weak = Vt[-1]
         lead = [names[k] for k in np.argsort(-np.abs(weak)) if abs(weak[k]) > 0.3]

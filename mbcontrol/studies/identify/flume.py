@@ -28,6 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ... import waves
 from .costs import harmonic, whole_periods
 from .problem import Run
 from .records import RecordError, channel_problem, read_csv
@@ -61,24 +62,6 @@ def parse_name(path) -> dict:
             "height": HEIGHT[h], "repetition": int(m["rep"]) if m["rep"] else 0}
 
 
-def wavenumber(omega: float, depth: float = DEPTH) -> float:
-    """k (rad/m) of omega^2 = g k tanh(k h), by Newton from the deep-water guess."""
-    k = omega ** 2 / G
-    for _ in range(50):
-        f = G * k * math.tanh(k * depth) - omega ** 2
-        df = G * math.tanh(k * depth) + G * k * depth / math.cosh(k * depth) ** 2
-        k, step = k - f / df, f / df
-        if abs(step) < 1e-14 * k:
-            break
-    return k
-
-
-def group_velocity(omega: float, depth: float = DEPTH) -> float:
-    """c_g (m/s) in finite depth: (omega / k) (1 + 2 k h / sinh 2 k h) / 2."""
-    k = wavenumber(omega, depth)
-    return omega / k * 0.5 * (1 + 2 * k * depth / math.sinh(2 * k * depth))
-
-
 def wavemaker_start(record, share: float = 0.05) -> float:
     """Time (s) the paddle starts: WM_Position first leaves its still level by `share` of its
     largest excursion."""
@@ -93,7 +76,7 @@ def wavemaker_start(record, share: float = 0.05) -> float:
 def steady_window(start: float, omega: float, x: float = MODEL_X) -> tuple[float, float]:
     """(open, close) s: ramp passed plus the settling periods, until the model's reflection is
     back from the paddle (see the module notes); not yet cut to whole periods."""
-    period, cg = 2 * math.pi / omega, group_velocity(omega)
+    period, cg = 2 * math.pi / omega, waves.group_velocity(omega, DEPTH, G)
     return start + x / cg + (RAMP_PERIODS + SETTLE_PERIODS) * period, start + 3 * x / cg
 
 
@@ -108,7 +91,7 @@ def _paddle(record, start, omega):
 def incident_transfer(paths, omega: float) -> tuple[complex, float]:
     """(H, spread): the incident wave's first harmonic at the model per unit paddle harmonic,
     from calibration runs, and the relative spread of the estimates (over probes and runs)."""
-    k, period = wavenumber(omega), 2 * math.pi / omega
+    k, period = waves.wavenumber(omega, DEPTH, G), 2 * math.pi / omega
     estimates = []
     for path in paths:
         record = read_csv(path)
@@ -117,8 +100,8 @@ def incident_transfer(paths, omega: float) -> tuple[complex, float]:
         for probe, x in PROBES.items():
             if probe not in record.channels or channel_problem(record, probe):
                 continue
-            t0 = start + x / group_velocity(omega) + (RAMP_PERIODS + 1) * period
-            t1 = start + (2 * BEACH_X - x) / group_velocity(omega)   # before the beach's echo
+            t0 = start + x / waves.group_velocity(omega, DEPTH, G) + (RAMP_PERIODS + 1) * period
+            t1 = start + (2 * BEACH_X - x) / waves.group_velocity(omega, DEPTH, G)   # before the beach's echo
             try:
                 a = harmonic(record.time, record.channels[probe], omega, t0, t1)
             except ValueError:

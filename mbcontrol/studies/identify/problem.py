@@ -1,12 +1,13 @@
 """An identification problem: measured regular-wave runs, the plant that should reproduce them,
-the parameters to fit and the cost, evaluated in batches with exact sensitivities.
+the parameters to fit and the cost, evaluated with exact sensitivities.
 
 Each run is simulated on its own clock: the model starts at rest `settle` seconds before the
 run's steady window and is driven by the incident wave measured for that run (amplitude and
 phase at the model, from the calibration), so at the window's samples model and measurement
 are directly comparable. Runs that free the same DOFs share one plant (frozen as the run
-says) and are stepped together in one compiled call (`simulate_batch`'s machinery); with
-`jacobian=True` the plant carries its forward sensitivities (`mbcontrol.sim.sensitivity`).
+says), compiled once; they are stepped one compiled call per run, or with batch=True all
+together in one call (`simulate_batch`'s machinery). With `jacobian=True` the plant carries
+its forward sensitivities (`mbcontrol.sim.sensitivity`).
 
 Costs (residual vector r, cost 1/2 |r|^2), per run and free channel:
 - "harmonic": (|Y_model| - |Y_meas|) / |Y_meas| w_c, the relative error of the first-harmonic
@@ -22,6 +23,7 @@ Costs (residual vector r, cost 1/2 |r|^2), per run and free channel:
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -103,15 +105,23 @@ class Identification:
     scene: a catalogue name or scene path; runs: `Run`s; fit: `FitParameter`s (plant parameter
     names); outputs: measured channel -> plant output (e.g. {"Roll": "roll"}); params: fixed
     overrides of other plant parameters; weights: channel -> w_c (default 1); settle: s of
-    simulation before each window (the model starts at rest); ramp_periods: the simulated
-    wave's half-cosine ramp; dt: step (s); direction: wave heading in the n-frame (rad).
+    simulation before each window (the model starts at rest: long enough for its slowest mode
+    to die out, so that the window holds its steady response); ramp_periods: the simulated
+    wave's half-cosine ramp; dt: step (s); direction: wave heading in the n-frame (rad);
+    batch: step a plant's runs together in one compiled call, each for the longest run's
+    duration (True), or one call per run for its own duration (False, the default: measured
+    10-20 % faster on the flume data, `benchmarks/identify.py`, as a compiled call of 512
+    steps leaves little overhead to share and the batch pays the longest window for every
+    run); drop_absent: a fit parameter that no run's plant has (its joint is blocked in every run)
+    is dropped with a warning instead of raising.
     """
 
     def __init__(self, scene, runs, fit, *, outputs: dict, cost: str = "harmonic",
                  phase: bool = False, weights: dict | None = None, params: dict | None = None,
-                 dt: float = 0.01, settle: float = 30.0, ramp_periods: float = 5.0,
+                 dt: float = 0.01, settle: float = 60.0, ramp_periods: float = 5.0,
                  direction: float = math.pi / 2, method: str = "rk4",
-                 samples_per_period: int = 40, compiled: bool = True):
+                 samples_per_period: int = 40, compiled: bool = True, batch: bool = False,
+                 drop_absent: bool = False):
         if cost not in COSTS:
             raise ValueError(f"cost {cost!r}: expected one of {', '.join(COSTS)}")
         if not runs:
@@ -119,12 +129,17 @@ class Identification:
         names = [p.name for p in fit]
         if len(set(names)) != len(names):
             raise ValueError(f"identification: a parameter is listed twice in {names}")
+        self.options = dict(cost=cost, phase=phase, weights=weights, params=params, dt=dt,
+                            settle=settle, ramp_periods=ramp_periods, direction=direction,
+                            method=method, samples_per_period=samples_per_period,
+                            compiled=compiled, batch=batch)
         self.scene, self.runs, self.fit = scene, list(runs), list(fit)
         self.outputs, self.cost, self.phase = dict(outputs), cost, bool(phase)
         self.weights = {c: 1.0 for c in self.outputs} | dict(weights or {})
         self.params = dict(params or {})
         self.dt, self.settle, self.ramp_periods = float(dt), float(settle), float(ramp_periods)
         self.direction, self.method, self.compiled = float(direction), method, compiled
+        self.batch = bool(batch)
         self.samples_per_period = int(samples_per_period)
         for run in self.runs:
             unknown = [c for c in run.channels if c not in self.outputs]
@@ -140,7 +155,11 @@ class Identification:
         self._plants, self._sensitivity = {}, {}
         self._measured = [self._measure(run) for run in self.runs]
         self.scales = self._channel_scales()
-        self.check()
+        self.check(drop_absent)
+
+    @property
+    def scene_name(self) -> str:
+        return load_scene(self.scene).name
 
     # ------------------------------------------------------------------ theta <-> values
     def theta0(self) -> np.ndarray:
@@ -163,11 +182,23 @@ class Identification:
             self._plants[key] = build_plant(scene, fidelity=fidelity, hydro_corrections=True)
         return self._plants[key]
 
-    def check(self) -> None:
-        """Build every group's plant; KeyError for a parameter none of them has."""
+    def check(self, drop_absent: bool = False) -> None:
+        """Build every group's plant; KeyError for a parameter none of them has (or, with
+        drop_absent, a warning and the fit parameter dropped)."""
         known = set()
         for key in self.groups:
             known |= set(self.plant(key).parameters)
+        absent = [p.name for p in self.fit if p.name not in known]
+        if drop_absent and self.fit:
+            self.fit = [p for p in self.fit if p.name in known]
+            if self.fit:             # present but without effect (drag on a blocked DOF)
+                _, J = self.residuals(self.theta0(), jacobian=True)
+                absent += [p.name for p, col in zip(self.fit, J.T) if not np.any(col)]
+                self.fit = [p for p in self.fit if p.name not in absent]
+                self._sensitivity.clear()
+            if absent:
+                warnings.warn(f"not fitted: {', '.join(absent)}: no effect on these runs "
+                              f"(their DOF is blocked in every run given)", stacklevel=3)
         unknown = [n for n in [p.name for p in self.fit] + list(self.params) if n not in known]
         if unknown:
             raise KeyError(f"{self.scene}: unknown parameter(s) {unknown}; the plant has "
@@ -203,9 +234,13 @@ class Identification:
         return {c: float(np.mean(a)) for c, a in amplitudes.items()}
 
     # ------------------------------------------------------------------ simulation
+    def _duration(self, run) -> float:
+        """Simulated time (s): the batch's common one, or the run's own settle + window."""
+        return self.duration if self.batch else self.settle + run.window[1] - run.window[0]
+
     def _shift(self, run) -> float:
-        """t_shift: the run's clock minus the simulation's (the window ends at duration)."""
-        return run.window[1] - self.duration
+        """t_shift: the run's clock minus the simulation's (the window ends at the end)."""
+        return run.window[1] - self._duration(run)
 
     def _wave(self, run):
         return waves.regular(2 * run.amplitude, run.period,
@@ -224,17 +259,21 @@ class Identification:
                          if n in plant.parameters}
             p = plant.params(**overrides)
             runs = [self.runs[i] for i in members]
-            t, X, _, _ = batch_states(plant, [self._wave(r) for r in runs], [p],
-                                duration=self.duration, dt=self.dt, method=self.method,
-                                compiled=self.compiled)
+            batches = [runs] if self.batch else [[r] for r in runs]
+            stepped = []                                   # per run: (t, X of the run)
+            for group in batches:
+                t, X, _, _ = batch_states(plant, [self._wave(r) for r in group], [p],
+                                          duration=self._duration(group[0]), dt=self.dt,
+                                          method=self.method, compiled=self.compiled)
+                stepped += [(t, X[c]) for c in range(len(group))]
             self.simulations += len(runs)
-            for c, (i, run) in enumerate(zip(members, runs)):
+            for (t, Xc), i, run in zip(stepped, members, runs):
                 shift = self._shift(run)
                 keep = t >= run.window[0] - shift - 1e-9
                 tw = t[keep]
                 W = plant.excitation(self._wave(run), tw)
                 U = np.zeros((tw.size, len(plant.inputs)))
-                Y = evaluate_outputs(plant, X[c][keep], U, W, p, compiled=self.compiled)
+                Y = evaluate_outputs(plant, Xc[keep], U, W, p, compiled=self.compiled)
                 out = {}
                 for channel in run.channels:
                     name = self.outputs[channel]

@@ -96,9 +96,10 @@ def error_table(rows: list[dict], label: str) -> str:
     return "\n".join(lines)
 
 
-def plot_amplitudes(rows_by_label: dict, path) -> None:
+def plot_amplitudes(rows_by_label: dict, path=None, title: str | None = None):
     """Response amplitude per unit incident amplitude against frequency, one panel per channel,
-    measured (dots) and each labelled model (lines), runs grouped by `group` (markers)."""
+    measured (dots) and each labelled model (lines), runs grouped by `group` (markers).
+    Returns the figure (written to path when given)."""
     import matplotlib.pyplot as plt
 
     from ...plotting import save
@@ -125,13 +126,23 @@ def plot_amplitudes(rows_by_label: dict, path) -> None:
         ax.set_ylabel(f"{channel} amplitude / wave amplitude, {unit}/m")
         ax.set_title(channel)
         ax.grid(alpha=0.3)
-    axes[0][-1].legend(fontsize=6, loc="best")
-    fig.tight_layout()
-    save(fig, path)
+    legend = {}
+    for ax in axes[0]:
+        for handle, label in zip(*ax.get_legend_handles_labels()):
+            legend.setdefault(label, handle)
+    fig.legend(legend.values(), legend.keys(), fontsize=7, loc="lower center",
+               ncol=min(len(legend), 4), frameon=False)
+    if title:
+        fig.suptitle(title)
+    fig.tight_layout(rect=(0, 0.06 * math.ceil(len(legend) / 4), 1, 1))
+    if path is not None:
+        save(fig, path)
+    return fig
 
 
-def plot_time_series(problem, run_name: str, values_by_label: dict, path) -> None:
-    """One run's free channels over its steady window: measured and each labelled model."""
+def plot_time_series(problem, run_name: str, values_by_label: dict, path=None):
+    """One run's free channels over its steady window: measured and each labelled model.
+    Returns the figure (written to path when given)."""
     import matplotlib.pyplot as plt
 
     from ...plotting import save
@@ -153,4 +164,6 @@ def plot_time_series(problem, run_name: str, values_by_label: dict, path) -> Non
     axes[-1, 0].set_xlabel("time on the run's clock, s")
     axes[0, 0].legend(fontsize=7)
     fig.tight_layout()
-    save(fig, path)
+    if path is not None:
+        save(fig, path)
+    return fig

@@ -1,0 +1,92 @@
+"""`mbcontrol identify`: the --json contract on real tank runs, identified values taken back by
+`simulate --param`, and clear errors for bad specs and files."""
+import json
+import math
+from pathlib import Path
+
+import pytest
+
+from mbcontrol.cli import main
+
+TANK = Path(__file__).resolve().parents[3] / "shared" / "data" / "tank"
+RUNS = TANK / "scenario_c"
+if not RUNS.exists():
+    pytest.skip(f"tank data not found at {TANK}", allow_module_level=True)
+FEW = [str(RUNS / f"{name}.csv.xz") for name in ("6081_1", "6101_2", "6111_1")]
+
+
+def run(capsys, *argv):
+    code = main(list(argv))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_identify_json_contract(capsys, tmp_path):
+    code, out, err = run(capsys, "identify", "flume_section", "--data", *FEW[:2],
+                         "--validate", FEW[2], "--fit", "viscous__Roll_linear",
+                         "--fit", "heave_rig__viscous=1:60", "--dt", "0.02", "--settle", "10",
+                         "--out", str(tmp_path), "--json")
+    assert code == 0, err
+    s = json.loads(out)
+    assert set(s) >= {"model", "method", "cost", "parameters", "correlation", "fit",
+                      "validation", "simulations", "wall_time_s"}
+    assert (s["model"], s["method"], s["cost"]) == ("flume_section", "gauss-newton", "harmonic")
+    assert list(s["parameters"]) == ["viscous__Roll_linear", "heave_rig__viscous"]
+    for name, p in s["parameters"].items():
+        assert set(p) == {"initial", "value", "std", "lo", "hi"}
+        assert p["lo"] <= p["value"] <= p["hi"] and p["std"] > 0
+    assert s["parameters"]["heave_rig__viscous"]["lo"] == 1.0          # bounds from --fit
+    assert s["parameters"]["viscous__Roll_linear"]["hi"] == 5.0         # from [identify]
+    corr = s["correlation"]
+    assert len(corr) == 2 and all(len(row) == 2 for row in corr)
+    assert corr[0][0] == pytest.approx(1.0) and corr[0][1] == pytest.approx(corr[1][0])
+    assert s["fit"]["runs"] == ["6081_1", "6101_2"] and s["validation"]["runs"] == ["6111_1"]
+    for block in (s["fit"], s["validation"]):
+        assert set(block["channels"]) == {"Heave", "Roll"}                 # free in series 6
+        for ch in block["channels"].values():
+            assert ch["rms_error"] >= 0 and 0 <= ch["rms_relative_error"] < 1
+        # the overall figure is the RMS of the per-channel relative errors (equal run counts)
+        rel = [ch["rms_relative_error"] for ch in block["channels"].values()]
+        assert block["rms_error"] == pytest.approx(math.sqrt(sum(r * r for r in rel) / 2))
+    assert s["simulations"] > 0 and s["wall_time_s"] > 0
+    assert s["cost_final"] <= s["cost_initial"]
+    assert json.loads((tmp_path / "summary.json").read_text()) == s
+    assert (tmp_path / "amplitudes.png").stat().st_size > 10_000
+    assert (tmp_path / "time_series.png").stat().st_size > 10_000
+
+
+def test_default_set_drops_what_the_runs_cannot_see(capsys):
+    # series 6 clamps sway: the scene's sway rig damping has no effect and is not fitted
+    code, out, err = run(capsys, "identify", "flume_section", "--data", FEW[0], FEW[1],
+                         "--dt", "0.02", "--settle", "10", "--json")
+    assert code == 0, err
+    assert "not fitted: sway_rig__viscous" in err
+    assert "sway_rig__viscous" not in json.loads(out)["parameters"]
+
+
+def test_identified_values_go_back_into_simulate(capsys):
+    code, out, err = run(capsys, "simulate", "flume_section", "--height", "0.024", "--period",
+                         "1.2", "--duration", "5", "--dt", "0.01",
+                         "--param", "section__Roll__added_mass_scale=0.86",
+                         "--param", "viscous__Roll_linear=0.19", "--json")
+    assert code == 0, err
+    assert json.loads(out)["dofs"]["roll"]["max_abs"] > 0
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["--fit", "no_such_parameter=1:2"], "not a parameter of flume_section"),
+    (["--fit", "viscous__Heave"], "write --fit viscous__Heave=LO:HI"),
+    (["--fit", "viscous__Roll=2"], "expected NAME=LO:HI with two numbers"),
+    (["--fit", "viscous__Roll=2:1"], "viscous__Roll: expected lo < hi"),
+])
+def test_bad_fit_specs_are_named(capsys, argv, message):
+    code, _, err = run(capsys, "identify", "flume_section", "--data", FEW[0], *argv)
+    assert code == 1 and message in err
+
+
+def test_bad_files_are_named(capsys, tmp_path):
+    bad = tmp_path / "scenario_c" / "4xx1.csv"
+    bad.parent.mkdir()
+    bad.write_text("Time [s],Sway [m]\n0,0\n")
+    code, _, err = run(capsys, "identify", "flume_section", "--data", str(bad))
+    assert code == 1 and "4xx1.csv" in err and "SPPH[_R]" in err
