@@ -42,6 +42,7 @@ bench: $(VENV)/.installed-test
 	$(PY) benchmarks/mpc.py --out $(OUT)/bench/mpc
 	$(PY) benchmarks/nmpc.py --out $(OUT)/bench/nmpc
 	$(PY) benchmarks/identify.py --out $(OUT)/bench/identify
+	$(PY) benchmarks/sweep.py --out $(OUT)/bench/sweep
 
 clean:
 	rm -rf $(OUT) .pytest_cache

@@ -49,7 +49,8 @@ def wavenumber(omega: float, depth: float, g: float = 9.81) -> float:
     k = omega ** 2 / g
     for _ in range(50):
         f = g * k * math.tanh(k * depth) - omega ** 2
-        df = g * math.tanh(k * depth) + g * k * depth / math.cosh(k * depth) ** 2
+        kh = k * depth
+        df = g * math.tanh(kh) + (g * kh / math.cosh(kh) ** 2 if kh < 350 else 0.0)
         k, step = k - f / df, f / df
         if abs(step) < 1e-14 * k:
             break
@@ -59,7 +60,8 @@ def wavenumber(omega: float, depth: float, g: float = 9.81) -> float:
 def group_velocity(omega: float, depth: float, g: float = 9.81) -> float:
     """c_g (m/s) in water of depth h (m): (omega / k) (1 + 2 k h / sinh 2 k h) / 2."""
     k = wavenumber(omega, depth, g)
-    return omega / k * 0.5 * (1 + 2 * k * depth / math.sinh(2 * k * depth))
+    kh2 = 2 * k * depth
+    return omega / k * 0.5 * (1 + (kh2 / math.sinh(kh2) if kh2 < 700 else 0.0))  # deep: 1/2
 
 
 def ramp(t, ramp_time: float) -> np.ndarray:

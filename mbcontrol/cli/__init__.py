@@ -23,6 +23,7 @@ from ..sim.methods import METHODS
 from .commands import (run_bench, run_design, run_fidelity, run_hydro, run_linearize, run_models,
                        run_simulate)
 from .identify import add_parser as add_identify_parser
+from .sweep import add_parser as add_sweep_parser
 
 DESIGN_HELP = """Tune a PTO controller for a sea, then check, bound and simulate it.
 
@@ -177,6 +178,7 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="print signals and poles as JSON")
     p.set_defaults(run=run_linearize)
     add_identify_parser(sub)
+    add_sweep_parser(sub)
     return parser
 
 

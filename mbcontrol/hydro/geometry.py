@@ -34,8 +34,10 @@ class BemBody:
         ``{"type": "sphere", "radius": r, "center": [...]}``,
         ``{"type": "mesh", "file": path, "axes": "z_up"|"ned"}``.
         Coordinates in the n-frame (NED) at rest, m; "center" is the geometric centre.
-        Mesh files are read with ``capytaine.load_mesh``; their vertices are taken as z-up
-        (x forward, y port, the convention of GDF/Nemoh/HAMS files) unless ``"axes": "ned"``.
+        Mesh files are read with ``capytaine.load_mesh`` (STL through meshio); their vertices
+        are taken as z-up (x forward, y port, the convention of GDF/Nemoh/HAMS/STL files)
+        unless ``"axes": "ned"``; an optional ``"center"`` (NED, m) places the mesh's own
+        origin in the n-frame (a mesh drawn about its body's CoG, say), default the origin.
     cog : centre of gravity in the n-frame (NED), m.
     mass : kg; enters the hydrostatic stiffness (gravity term about the CoG).
     panel_size : target panel edge length, m.
@@ -196,6 +198,9 @@ def hull_mesh(body: BemBody):
                              f"({type(exc).__name__}: {exc})") from exc
         if g.get("axes", "z_up") == "ned":
             mesh = mesh.rotated_with_matrix(NED_TO_ZUP)  # a rotation (det +1): normals stay outward
+        origin = NED_TO_ZUP @ np.asarray(g.get("center", (0.0, 0.0, 0.0)), dtype=float)
+        if np.any(origin != 0.0):                        # a mesh drawn in its body's own frame
+            mesh = mesh.translated(tuple(origin))
     mesh = mesh.immersed_part()
     if mesh.nb_faces == 0 or not mesh.volume > 0:
         raise HydroError(f"body '{body.name}': geometry ({kind}) has no immersed volume; "

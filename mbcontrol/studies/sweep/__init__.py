@@ -1,0 +1,14 @@
+"""Power performance at scale: sweeps over sea states, seeds, controller settings, plant and
+scene parameters, closed loop, serially or on Dask, resumable from a store on disk; power
+matrices, capture widths, annual energy at a site.
+
+Modules: `cases` (seas, grids, the seas CSV, cases and their keys), `store` (records on disk,
+the assembled Dataset), `runner` (serial and Dask execution), `power` (energy flux, annual
+energy, power matrix, NDBC spectra and occurrence tables), `study` (`sweep`), `plots`.
+"""
+from .cases import SeaState, grid, read_seas
+from .power import annual_energy_MWh, energy_flux, occurrence, power_matrix
+from .study import sweep
+
+__all__ = ["sweep", "SeaState", "grid", "read_seas", "energy_flux", "annual_energy_MWh",
+           "power_matrix", "occurrence"]

@@ -1,0 +1,102 @@
+"""A whole sweep: cases from seas, seeds and varied quantities, run (serially or on Dask)
+into a store, assembled into one Dataset, with the power figures per sea state: wave energy
+flux J, capture width P / J and its ratio to a characteristic width, and for weighted seas the
+weighted mean power and the mean annual energy."""
+from __future__ import annotations
+
+import datetime
+import math
+import time
+from pathlib import Path
+
+import numpy as np
+
+from .cases import build_cases, roles_for
+from .power import annual_energy_MWh, energy_flux
+from .runner import _PLANTS, execute
+from .store import CaseStore, assemble
+
+
+def sweep(model: str, seas, *, seeds: int = 1, vary: dict | None = None, params=None,
+          scene_params=None, controller: str | None = None, settings=None,
+          duration: float = 600.0, dt: float = 0.05, method: str = "rk4",
+          store=None, workers: int | None = 0, scheduler: str | None = None,
+          width: float | None = None, progress: bool = True):
+    """Run a sweep and return (Dataset, summary).
+
+    seas: SeaStates (`cases.grid`, `cases.read_seas`); vary: name -> values (scene
+    parameter, plant parameter or controller setting); workers: 0 serial, None one Dask
+    worker per core, N workers; scheduler: a Dask scheduler address; store: a folder (resume:
+    finished cases are not run again; `<store>/sweep.nc` holds the Dataset); width: the
+    characteristic width (m) for the capture width ratio."""
+    from mbcontrol.controllers import REGISTRY
+
+    from ...plant import build_plant
+    from ...scene import load_scene
+    start = time.perf_counter()
+    vary = {k: list(v) for k, v in (vary or {}).items()}
+    scene = load_scene(model, scene_params or None)
+    if controller is not None and controller not in REGISTRY:
+        raise ValueError(f"--controller {controller}: expected one of {', '.join(REGISTRY)}")
+    plant = build_plant(scene)
+    _PLANTS[(model, tuple(sorted((scene_params or {}).items())))] = plant   # serial path: reuse
+    roles = roles_for(vary, scene, plant.parameters, REGISTRY.get(controller))
+    unknown = [p for p in (params or {}) if p not in plant.parameters]
+    if unknown:
+        raise ValueError(f"--param {unknown[0]}: not a parameter of {scene.name}; it has "
+                         f"{', '.join(plant.parameters)}")
+    cases = build_cases(model, seas, seeds=seeds, vary=vary, roles=roles, params=params,
+                        scene_params=scene_params, controller=controller, settings=settings,
+                        duration=duration, dt=dt, method=method)
+    case_store = CaseStore(store)
+    run = execute(cases, case_store, workers=workers, scheduler=scheduler, progress=progress)
+    depth, rho, g = scene.water.depth, scene.water.rho, scene.water.g
+    attrs = {"model": scene.name, "controller": controller, "settings": dict(settings or {}),
+             "params": dict(params or {}), "scene_params": dict(scene_params or {}),
+             "duration_s": duration, "dt_s": dt, "method": method,
+             "created": datetime.datetime.now().isoformat(timespec="seconds"),
+             "metrics": "mbcontrol.analysis.metrics.pto_metrics over the record after the ramp"}
+    ds = assemble(cases, case_store, seas, vary, seeds, attrs)
+    J = np.array([energy_flux(s.hs, s.tp, s.gamma, depth, rho, g) for s in seas])
+    ds["energy_flux_W_per_m"] = ("sea", J)
+    ds["capture_width_m"] = ds["mean_power_W"] / ds["energy_flux_W_per_m"]
+    if width:
+        ds["capture_width_ratio"] = ds["capture_width_m"] / width
+        ds.attrs["characteristic_width_m"] = width
+    if store is not None:
+        from ...hydro import write_netcdf_atomic
+        write_netcdf_atomic(ds, Path(store) / "sweep.nc")
+    summary = _summary(ds, seas, run, time.perf_counter() - start, len(cases))
+    return ds, summary
+
+
+def _summary(ds, seas, run, wall, n_cases) -> dict:
+    """The JSON contract of `mbcontrol sweep --json` (per sea: means over seeds; when other
+    quantities are varied, per sea the values over them as lists in the sweep's order)."""
+    power = ds["mean_power_W"].mean("seed")
+    cw = ds["capture_width_m"].mean("seed")
+    rows = []
+    for k, s in enumerate(seas):
+        p, c = power.isel(sea=k).values, cw.isel(sea=k).values
+        row = {"hs": s.hs, "tp": s.tp, "weight": None if math.isnan(s.weight) else s.weight,
+               "mean_power_W": _plain(p), "capture_width_m": _plain(c),
+               "energy_flux_W_per_m": float(ds["energy_flux_W_per_m"].values[k])}
+        if not math.isnan(s.te):
+            row["te"] = s.te
+        if "capture_width_ratio" in ds:
+            row["capture_width_ratio"] = _plain(ds["capture_width_ratio"].mean("seed")
+                                                .isel(sea=k).values)
+        rows.append(row)
+    weights = np.array([s.weight for s in seas])
+    weighted = aep = None
+    if not np.any(np.isnan(weights)) and power.ndim == 1:
+        weighted = float(np.sum(weights * power.values))
+        aep = annual_energy_MWh(power.values, weights)
+    return {"model": ds.attrs["model"], "cases": n_cases, "computed": run["computed"],
+            "reused": run["reused"], "wall_time_s": wall, "seas": rows,
+            "weighted_mean_power_W": weighted, "annual_energy_MWh": aep}
+
+
+def _plain(values):
+    values = np.asarray(values, float)
+    return float(values) if values.ndim == 0 else values.tolist()

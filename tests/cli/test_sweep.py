@@ -1,0 +1,57 @@
+"""`mbcontrol sweep`: the --json contract, the figure, and clear errors."""
+import json
+
+import pytest
+
+from mbcontrol.cli import main
+
+
+def run(capsys, *argv):
+    code = main(list(argv))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_sweep_json_contract_and_annual_energy(capsys, tmp_path):
+    seas = tmp_path / "seas.csv"
+    seas.write_text("Hm0,Tp,weights\n1.0,8,0.5\n2.0,10,0.3\n3.0,12,0.2\n")
+    png = tmp_path / "sweep.png"
+    code, out, err = run(capsys, "sweep", "sphere", "--seas", str(seas), "--duration", "100",
+                         "--dt", "0.1", "--workers", "0", "--width", "10", "--plot", str(png),
+                         "--json")
+    assert code == 0, err
+    s = json.loads(out)
+    assert set(s) >= {"model", "cases", "computed", "reused", "wall_time_s", "seas",
+                      "weighted_mean_power_W", "annual_energy_MWh"}
+    assert (s["model"], s["cases"], s["computed"], s["reused"]) == ("sphere", 3, 3, 0)
+    rows = s["seas"]
+    assert [(r["hs"], r["tp"], r["weight"]) for r in rows] == [(1.0, 8.0, 0.5), (2.0, 10.0, 0.3),
+                                                                (3.0, 12.0, 0.2)]
+    for r in rows:
+        assert r["mean_power_W"] > 0
+        assert r["capture_width_m"] == pytest.approx(r["mean_power_W"] / r["energy_flux_W_per_m"])
+        assert r["capture_width_ratio"] == pytest.approx(r["capture_width_m"] / 10)
+    weighted = sum(r["weight"] * r["mean_power_W"] for r in rows)
+    assert s["weighted_mean_power_W"] == pytest.approx(weighted)
+    assert s["annual_energy_MWh"] == pytest.approx(weighted * 8766 / 1e6)
+    assert png.stat().st_size > 20_000
+
+
+def test_sweep_vary_gives_lists(capsys):
+    code, out, err = run(capsys, "sweep", "sphere", "--hs", "1", "--tp", "9", "--duration", "80",
+                         "--dt", "0.1", "--workers", "0", "--vary", "pto__damping=2e5,5e5",
+                         "--json")
+    assert code == 0, err
+    row = json.loads(out)["seas"][0]
+    assert len(row["mean_power_W"]) == 2 and row["weight"] is None
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["--hs", "1"], "--hs needs --tp"),
+    (["--hs", "1", "--tp", "8", "--vary", "no_such=1,2"], "--vary no_such: not a scene parameter"),
+    (["--hs", "1", "--tp", "8", "--vary", "pto__damping=a,b"], "expected NAME=v1,v2"),
+    (["--hs", "1", "--tp", "8", "--controller", "nope"], "--controller nope: expected one of"),
+])
+def test_sweep_errors_are_clear(capsys, argv, message):
+    code, _, err = run(capsys, "sweep", "sphere", "--workers", "0", *argv)
+    assert code == 1 and message in err
