@@ -56,6 +56,9 @@ CONTRACT = {"passive": ("damping",), "reactive": ("damping", "stiffness"),
             "latching": ("damping", "latch_time"), "declutching": ("damping", "declutch_time"),
             "mpc": ("horizon_s", "dt_s", "force_max", "stroke_max", "rate_max"),
             "nmpc": ("horizon_s", "dt_s", "force_max", "stroke_max", "rate_max")}
+# MPC's default force-rate limit (with a force limit): a full reversal, -F_max to +F_max, takes
+# a fifth of the wave period at the least; a real drive cannot switch within a few samples
+RATE_REVERSALS_PER_PERIOD = 5
 MAX_HARMONICS = 25            # the constrained bound's QP stays < 0.1 s (0.07 s at 15)
 SETTLE_TIME_CONSTANTS = 12      # e^-12 = 6e-6: the start-up transient left in the window
 
@@ -259,6 +262,9 @@ def _tune(plant, wave, name, pto_obj, limits, model_params, notes):
         # on the sphere (tests/test_mpc.py) and a QP of real-time size
         own.setdefault("horizon_s", float(wave.period))
         own.setdefault("dt_s", float(wave.period) / 40)
+        if "force_max" in finite:      # a drive's slew: a full reversal in a fifth of a period
+            own.setdefault("rate_max", RATE_REVERSALS_PER_PERIOD * 2 * finite["force_max"]
+                           / float(wave.period))
     controller = make(name, **own, **extra)
     parameters = {}
     for key in CONTRACT.get(name, ()):

@@ -11,3 +11,11 @@ def cache_dir() -> Path:
     path = Path(os.environ.get("MBCONTROL_CACHE", Path.home() / ".cache" / "mbcontrol"))
     path.mkdir(parents=True, exist_ok=True)
     return path
+
+
+def status(message: str) -> None:
+    """One line on stderr for a long job the cache will spare next time (a radiation fit, a
+    compilation): what it is doing and how long it usually takes. MBCONTROL_QUIET=1 hides it."""
+    import sys
+    if not os.environ.get("MBCONTROL_QUIET"):
+        print(f"mbcontrol: {message}", file=sys.stderr, flush=True)

@@ -84,23 +84,33 @@ def main(argv=None) -> int:
           f"{bound * 1e3:.3g} mW")
 
     step(f"5/6 closed loop on the nonlinear plant ({args.duration:.0f} s)")
-    runs = {}
+    # a drive's slew limit: a full torque reversal in a fifth of the peak period at the least
+    rate = 5 * 2 * limit / sea.period
+    runs, records = {}, {}
     for label, controller in ((f"scene PTO law ({c_scene:g} N m s/rad)", None),
                               ("passive, designed", Passive(damping)),
                               ("reactive, designed", Reactive(c_r, k_r)),
-                              (f"MPC, torque limit {limit:g} N m",
+                              (f"MPC, {limit:g} N m, {rate:.0f} N m/s",
+                               Mpc(horizon_s=1.2, dt_s=0.03, wave=sea, forecast="ar",
+                                   rate_max=rate)),
+                              (f"MPC, {limit:g} N m, no rate limit",
                                Mpc(horizon_s=1.2, dt_s=0.03, wave=sea, forecast="ar"))):
         ds = simulate(plant, sea, duration=args.duration, dt=0.005, controller=controller)
-        runs[label] = summary(ds, plant)
-        print(f"  {label:28s} mean power {runs[label]['ptos']['hinge_pto']['mean_power_W'] * 1e3:7.3f}"
+        runs[label], records[label] = summary(ds, plant), ds
+        print(f"  {label:34s} mean power {runs[label]['ptos']['hinge_pto']['mean_power_W'] * 1e3:7.3f}"
               f" mW, max torque {runs[label]['ptos']['hinge_pto']['max_force']:.3f} N m, "
               f"simulated at {args.duration / runs[label]['wall_time_s']:,.0f}x real time")
-    plotting.time_series(ds.sel(time=slice(20, 60)), ["eta", "pivot", "hinge",
-                                                      "hinge_pto__force", "hinge_pto__power"],
-                         title="hinged barge, passive control, JONSWAP Hs 3 cm Tp 1.1 s",
-                         units={"eta": "m (up)", "pivot": "rad", "hinge": "rad",
-                                "hinge_pto__force": "N m", "hinge_pto__power": "W"},
-                         path=out / "closed_loop.png")
+    limited, free = (runs[k]["ptos"]["hinge_pto"]["mean_power_W"] for k in list(runs)[-2:])
+    report["design"].update(mpc_rate_limit=rate, mpc_power_change_by_rate_limit=limited / free - 1)
+    print(f"  the {rate:.0f} N m/s torque-rate limit changes the MPC's power by "
+          f"{100 * (limited / free - 1):+.1f} %")
+    plotting.compare_runs({k: v.sel(time=slice(20, 40)) for k, v in records.items()},
+                          ["hinge", "hinge_pto__force", "hinge_pto__power"],
+                          title="hinged barge in a JONSWAP sea (Hs 3 cm, Tp 1.1 s): each "
+                                "column one controller",
+                          units={"hinge": "rad", "hinge_pto__force": "N m",
+                                 "hinge_pto__power": "W"},
+                          path=out / "closed_loop.png")
     report["closed_loop"] = runs
 
     step("6/6 summary")

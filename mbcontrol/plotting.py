@@ -74,6 +74,27 @@ def time_series(ds, names, *, title=None, path=None, units=None):
     return fig
 
 
+def compare_runs(runs: dict, names, *, title=None, units=None, path=None):
+    """Runs side by side: a column per run (titled by its label), a row per variable, each
+    row on one y scale, so what the title of a column says is what it shows."""
+    fig, axes = plt.subplots(len(names), len(runs), sharex=True, sharey="row", squeeze=False,
+                             figsize=(3.2 * len(runs), 1.8 * len(names) + 0.9))
+    for j, (label, ds) in enumerate(runs.items()):
+        axes[0, j].set_title(label, fontsize=8)
+        for i, name in enumerate(names):
+            axes[i, j].plot(ds["time"].values, ds[name].values, lw=0.8)
+            axes[i, j].grid(alpha=0.3)
+            if j == 0:
+                axes[i, j].set_ylabel(f"{name}\n{(units or {}).get(name, '')}", fontsize=8)
+        axes[-1, j].set_xlabel("time (s)")
+    if title:
+        fig.suptitle(title)
+    fig.tight_layout()
+    if path:
+        save(fig, path)
+    return fig
+
+
 def response_comparison(omega, curves: dict, *, ylabel, title, path=None):
     """Amplitude per unit wave amplitude against frequency, one line or marker set each.
 

@@ -14,6 +14,13 @@ Examples
     python models/generate_hydro.py --timing-only hinged_barge   # 3 frequencies, an estimate
     nice -n 10 python models/generate_hydro.py hinged_barge      # full run (~7 min, one core)
     python models/generate_hydro.py --fit-report hinged_barge    # radiation fit of the saved file
+    python models/generate_hydro.py --ship-fits                  # radiation fits shipped in models/
+
+--ship-fits builds each catalogue model's plant (and the flume section's three blocked-DOF
+variants the tank runs use) and copies the radiation fits they used into models/radiation_fits,
+where a fresh machine finds them before fitting. Their names are the cache's keys (the data,
+DOFs, tolerance, band and the fitting code), so after any change to those, rerun this: the
+catalogue tests fail until the shipped fits match again.
 """
 from __future__ import annotations
 
@@ -98,6 +105,41 @@ def fit_report(path: Path, tol: float, omega_max: str | None) -> None:
         print(f"  group {grp['dofs']}: {grp['history'][-1]['poles']} poles -> {grp['order']} states")
 
 
+SHIP_VARIANTS = {"flume_section": [("roll",), ("heave",), ("sway",)]}   # Fidelity(freeze=...)
+
+
+def ship_fits(names=None) -> int:
+    """Build the plants, copy the fits they used into models/radiation_fits (atomically)."""
+    import os
+    import shutil
+    import tempfile
+
+    from mbcontrol.cache import cache_dir
+    from mbcontrol.hydro import model as hydro_model
+    from mbcontrol.plant import Fidelity, build_plant
+    from mbcontrol.scene import list_models
+    out = hydro_model.shipped_fits_dir()
+    out.mkdir(parents=True, exist_ok=True)
+    wanted = set()
+    for name in names or list_models():
+        for freeze in [()] + SHIP_VARIANTS.get(name, []):
+            hydro_model.FITS_SERVED.clear()
+            build_plant(name, fidelity=Fidelity(freeze=freeze) if freeze else None)
+            wanted.update(hydro_model.FITS_SERVED)
+    for fit in sorted(wanted):
+        if (out / fit).exists():
+            continue
+        fd, tmp = tempfile.mkstemp(dir=out, suffix=".tmp")
+        os.close(fd)
+        shutil.copyfile(cache_dir() / fit, tmp)
+        os.replace(tmp, out / fit)
+    stale = [p for p in out.glob("radiation_*.npz") if p.name not in wanted and not names]
+    for path in stale:
+        path.unlink()
+    print(f"models/radiation_fits: {len(wanted)} fits ({len(stale)} stale removed)")
+    return 0
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("models", nargs="*", help="catalogue scene names (default: all with a hydro file)")
@@ -111,7 +153,11 @@ def main(argv=None) -> int:
                     help="fit only up to this ω (rad/s), or 'mesh' for the dataset's omega_max_mesh")
     ap.add_argument("--n-jobs", type=int, default=1, help="Capytaine processes")
     ap.add_argument("--no-progress", action="store_true", help="hide the progress bar")
+    ap.add_argument("--ship-fits", action="store_true",
+                    help="copy the catalogue's radiation fits into models/radiation_fits")
     args = ap.parse_args(argv)
+    if args.ship_fits:
+        return ship_fits(args.models)
 
     import numpy as np
     from mbcontrol.hydro import compute, write_netcdf_atomic

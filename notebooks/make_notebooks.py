@@ -73,11 +73,11 @@ CONTROLLERS = [
              "print(f'complex-conjugate {cc/1e3:.0f} kW; constrained: sinusoidal force "
              "{ps1/1e3:.0f} kW, with harmonics {ps/1e3:.0f} kW')"),
     ("md", "## Controllers\nPassive and reactive are tuned by linear theory (unconstrained, so "
-           "they show what the limits cost); latching's latch time is searched on the plant around "
-           "the classical (T - T_n) / 2; "
+           "they show what the limits cost); latching's latch time and damping are searched on the plant "
+           "(latch time around the classical (T - T_n) / 2, bracketing its sharp peak); "
            "MPC respects the limits (Kalman filter on the joint encoders, AR forecast)."),
     ("code", "c_opt, _ = optimal_damping(plant, wave)\nc_r, k_r, _ = reactive_tuning(plant, wave)\n"
-             "latch, c_l, _ = optimal_latch_time(plant, wave, force_max=np.inf)\n"
+             "latch, c_l, _ = optimal_latch_time(plant, wave, force_max=np.inf, tune_damping=True)\n"
              "controllers = {\n"
              "    'passive': make('passive', damping=c_opt, force_max=np.inf),\n"
              "    'latching': make('latching', damping=c_l, latch_time=latch,"

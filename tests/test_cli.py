@@ -135,3 +135,15 @@ def test_fidelity_command_reports_the_choice(capsys, tmp_path):
                        "--out", str(tmp_path / "fidelity.nc"))
     assert code == 0 and "fidelity for sphere" in out and "chosen" in out
     assert (tmp_path / "fidelity.nc").stat().st_size > 0
+
+
+def test_first_use_messages_name_the_file_and_the_settings(capsys, tmp_path):
+    garbage = tmp_path / "garbage.toml"
+    garbage.write_bytes(b"\x89PNG\r\n\x1a\n\x00\x00\xff\xfe binary")
+    code, _, err = run(capsys, "simulate", str(garbage), "--height", "1", "--period", "5")
+    assert code == 1 and str(garbage) in err and "not a text scene file" in err
+    assert "codec" not in err
+    code, _, err = run(capsys, "simulate", "hinged_barge", "--height", "0.02", "--period", "1",
+                       "--controller", "passive", "--set", "dampin=3")
+    assert code == 1 and "has no setting 'dampin'" in err
+    assert "damping, period, force_max" in err and "__init__" not in err

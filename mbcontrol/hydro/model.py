@@ -11,13 +11,14 @@ import hashlib
 import json
 import os
 import tempfile
+import time
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import xarray as xr
 
-from ..cache import cache_dir
+from ..cache import cache_dir, status
 from ..errors import HydroError
 from ..scene import DOF_NAMES, Scene
 from ..waves import Wave, excitation_series, interpolate_complex
@@ -222,6 +223,9 @@ def fit_band_limit(data: xr.Dataset, scene_limit: float = np.inf) -> float | Non
     return limit if np.isfinite(limit) else None
 
 
+FITS_SERVED: list = []      # the fit files asked for, in order (models/generate_hydro.py --ship-fits)
+
+
 def _fit_cached(data: xr.Dataset, dofs, tol, source: str, omega_max: float = np.inf):
     """fit_radiation with an on-disk cache keyed by the data, the DOFs and the tolerance."""
     tol = 0.01 if tol is None else tol
@@ -233,14 +237,25 @@ def _fit_cached(data: xr.Dataset, dofs, tol, source: str, omega_max: float = np.
         digest.update(Path(module.__file__).read_bytes())
     band = fit_band_limit(data, omega_max)
     digest.update(json.dumps([list(dofs), tol, band]).encode())
-    path = cache_dir() / f"radiation_{digest.hexdigest()[:20]}.npz"
+    name = f"radiation_{digest.hexdigest()[:20]}.npz"
+    FITS_SERVED.append(name)
+    shipped = shipped_fits_dir() / name
+    if shipped.exists():                       # the catalogue's, made by generate_hydro.py
+        with np.load(shipped, allow_pickle=False) as z:
+            return _model_from_arrays(z)
+    path = cache_dir() / name
     if path.exists():
         try:
             with np.load(path, allow_pickle=False) as z:
                 return _model_from_arrays(z)
         except (OSError, ValueError, KeyError):
             path.unlink(missing_ok=True)       # a stale or foreign file: refit
+    started = time.perf_counter()
+    status(f"fitting the radiation model of {Path(source).name} ({len(dofs)} DOFs, tolerance "
+           f"{tol:g}): typically 5-90 s, once; cached afterwards")
     model = fit_radiation(data, dofs=list(dofs), tol=tol, omega_max=band)
+    status(f"radiation model fitted in {time.perf_counter() - started:.1f} s: "
+           f"{model.order} states, error {model.fit_error:.2%}")
     fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".npz.tmp")
     os.close(fd)
     with open(tmp, "wb") as fh:
@@ -249,6 +264,17 @@ def _fit_cached(data: xr.Dataset, dofs, tol, source: str, omega_max: float = np.
                  report=json.dumps(model.report, default=_jsonable))
     os.replace(tmp, path)
     return model
+
+
+def shipped_fits_dir() -> Path:
+    """The radiation fits shipped with the catalogue (models/radiation_fits), keyed as the
+    cache is: by the data, the DOFs, the tolerance, the band and the fitting code itself, so a
+    shipped fit serves exactly the fit it replaces and a stale one is never found."""
+    from importlib.resources import files
+    try:
+        return Path(str(files("mbcontrol.models"))) / "radiation_fits"
+    except ModuleNotFoundError:
+        return Path(__file__).resolve().parents[2] / "models" / "radiation_fits"
 
 
 def _model_from_arrays(z) -> RadiationModel:

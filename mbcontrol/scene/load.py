@@ -40,7 +40,11 @@ def load_scene(path_or_name: str | Path, parameters: dict | None = None) -> Scen
     """
     path = resolve(path_or_name)
     try:
-        data = tomllib.loads(path.read_text())
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except UnicodeDecodeError as exc:
+        raise SceneError(f"{path}: not a text scene file: byte {exc.object[exc.start]:#04x} at "
+                         f"offset {exc.start} is not UTF-8; expected a TOML scene "
+                         f"(see models/*.toml)") from None
     except tomllib.TOMLDecodeError as exc:
         raise SceneError(f"{path}: not valid TOML: {exc}") from None
     return parse_scene(data, path, parameters)

@@ -12,12 +12,13 @@ import os
 import shutil
 import subprocess
 import tempfile
+import time
 import warnings
 from pathlib import Path
 
 import casadi as ca
 
-from ..cache import cache_dir
+from ..cache import cache_dir, status
 
 # -O3 for this CPU, and reassociation so that the radiation model's dense products vectorise;
 # NaN and Inf keep their IEEE meaning (no -ffinite-math-only), so divergence is still caught.
@@ -65,12 +66,16 @@ def compile_function(fun: ca.Function, enabled: bool = True) -> ca.Function:
     library = folder / f"{fun.name()}_{key.hexdigest()[:20]}.so"
     if library.exists():
         return ca.external(fun.name(), str(library))
+    started = time.perf_counter()
+    status(f"compiling {fun.name()} ({len(source) // 1000} kB of C): typically 2-60 s, once; "
+           f"cached afterwards")
     with tempfile.TemporaryDirectory(dir=folder) as tmp:
         c_file = Path(tmp) / f"{fun.name()}.c"
         c_file.write_text(source)
         built = Path(tmp) / "out.so"
         result = subprocess.run([cc, *FLAGS, str(c_file), "-o", str(built), "-lm"],
                                 capture_output=True, text=True)
+        status(f"compiled {fun.name()} in {time.perf_counter() - started:.1f} s")
         if result.returncode != 0:
             warnings.warn(f"C compilation failed ({result.stderr[:300]}); using "
                           f"interpreted CasADi code", RuntimeWarning, stacklevel=2)
