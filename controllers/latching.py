@@ -232,7 +232,8 @@ def _bracket_search(objective, lo, hi, step, xatol):
     """Maximise a sharply peaked 1-D objective: scan [lo, hi] every `step` (finer than the
     peak, so it is bracketed, not stepped over), then refine between the best point's
     neighbours by Brent. A coarse grid or Brent alone can settle on a flank: on the sphere
-    the simulated power against latch time rises 208 -> 434 -> 894 -> 446 kW in 0.1 s steps.
+    (H 2.5 m, T 9.67 s, damping 4.9e4) the simulated power against latch time goes
+    278 -> 690 -> 878 -> 537 kW at 2.4, 2.5, 2.6, 2.7 s.
     Returns (x, objective(x)) of the best point seen."""
     xs = np.linspace(lo, hi, max(3, int(np.ceil((hi - lo) / step)) + 1))
     values = [objective(x) for x in xs]
