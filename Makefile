@@ -43,6 +43,7 @@ bench: $(VENV)/.installed-test
 	$(PY) benchmarks/nmpc.py --out $(OUT)/bench/nmpc
 	$(PY) benchmarks/identify.py --out $(OUT)/bench/identify
 	$(PY) benchmarks/sweep.py --out $(OUT)/bench/sweep
+	$(PY) benchmarks/sweep_light.py --out $(OUT)/bench/sweep_light
 
 clean:
 	rm -rf $(OUT) .pytest_cache

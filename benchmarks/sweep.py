@@ -25,7 +25,6 @@ from mbcontrol.controllers import REGISTRY, make
 from mbcontrol.plant import build_plant
 from mbcontrol.sim import simulate
 from mbcontrol.studies.sweep import grid, read_seas, sweep
-from mbcontrol.studies.sweep.runner import _band
 
 SITES = Path(__file__).resolve().parents[2] / "shared" / "data" / "sites"
 
@@ -38,7 +37,8 @@ def measure(model, seas, seeds, duration, dt, controller=None) -> dict:
     for s in seas:
         for seed in range(seeds):
             wave = waves.irregular(s.hs, s.tp, seed=seed, duration=duration,
-                                   band=_band(plant, s.tp))
+                                   data_band=(float(plant.hydro.omega[0]),
+                                              float(plant.hydro.omega[-1])))
             law = None
             if controller:      # a predictive law gets the simulated sea, as the sweep does
                 takes_wave = "wave" in inspect.signature(REGISTRY[controller]).parameters

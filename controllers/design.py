@@ -6,7 +6,9 @@
    it, so `mbcontrol simulate MODEL --controller NAME --set k=v ...` re-runs it), tuned by the
    tuner of its module: passive `optimal_damping`, reactive `reactive_tuning`, latching
    `optimal_latch_time`, declutching `optimal_declutch`, mpc none (a horizon of one wave
-   period in 40 steps, the wave as its forecast, the PTO's limits);
+   period in 40 steps, its causal AR forecast - the wave only sets its Kalman wave model and
+   warm-up damper -, the PTO's limits, or its default soft stroke limit where the scene sets
+   none);
 2. what linear theory predicts it absorbs (W; passive and reactive only: the frequency-domain
    solution straight from the BEM data), and for the linear laws their stability margins on
    the linearised plant (controllers.margins);
@@ -92,13 +94,23 @@ class DesignResult:
     dataset: object = field(default=None, repr=False)     # the closed-loop run (xarray)
 
     @property
+    def valid(self) -> bool | None:
+        """Did the closed-loop result pass its physics checks (None: not simulated)?"""
+        return None if self.simulation is None else self.simulation["summary"]["valid"]
+
+    @property
+    def invalid_reasons(self) -> list:
+        return [] if self.simulation is None else self.simulation["summary"]["invalid_reasons"]
+
+    @property
     def stable(self) -> bool | None:
         """The linear closed loop's verdict (None where there is no linear loop)."""
         return None if self.margins is None else self.margins.stable
 
     def to_dict(self) -> dict:
         """JSON-ready (json.dumps(..., allow_nan=False) works): inf and nan become None."""
-        out = {"controller": self.name, "pto": self.pto, "parameters": self.parameters,
+        out = {"controller": self.name, "pto": self.pto, "valid": self.valid,
+               "invalid_reasons": self.invalid_reasons, "parameters": self.parameters,
                "predicted_power_W": self.predicted_power_W, "bound": self.bound,
                "metrics": self.metrics, "percent_of_bound": self.percent_of_bound,
                "margins": None if self.margins is None else self.margins.to_dict(),
@@ -178,6 +190,9 @@ def design(plant, wave, name: str, *, pto: str | None = None, simulate_s: float 
             metrics = pto_metrics(ds, pto_obj)
             simulation = {"duration_s": float(duration), "dt_s": float(dt),
                           "summary": summary(ds, plant)}
+            if not simulation["summary"]["valid"]:
+                notes.append("the closed-loop result is INVALID: "
+                             + "; ".join(simulation["summary"]["invalid_reasons"]))
             power = metrics["mean_power_W"]
             for key, ref in (("complex_conjugate", bound.get("complex_conjugate_W")),
                              ("constrained", bound.get("constrained_W"))):
@@ -224,6 +239,8 @@ def _tune(plant, wave, name, pto_obj, limits, model_params, notes):
     # the controller's own limits, explicit (its default, None, would mean the scene's): the
     # scene's with limits, none without, so make(name, **parameters) is the very controller
     own = {k: (v if limits else math.inf) for k, v in scene.items() if _accepts(cls, k)}
+    if name == "mpc" and limits:     # no scene limit: the MPC's own default (a soft stroke
+        own = {k: v for k, v in own.items() if math.isfinite(v)}   # limit in its linear range)
     # the wave is a setting beyond the parameters: a predictive controller's preview
     extra = {"wave": wave} if _accepts(cls, "wave") else {}
     if name in ("passive", "reactive"):

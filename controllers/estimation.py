@@ -9,7 +9,11 @@ also a disturbance observer, which is what the MPC needs.
 
 `ArPredictor`: forecasts each d_i by an auto-regressive model fitted by least squares to the
 filter's recent estimates (refitted every few seconds), the usual causal predictor for wave
-excitation; a regular wave is predicted exactly by AR(2).
+excitation; a regular wave is predicted exactly by AR(2). A least-squares fit may be
+unstable (a root of the characteristic polynomial outside the unit circle: a fit to a growing
+record, e.g. the wave's ramp), and its forecast then grows geometrically over the horizon; such
+roots are reflected into the unit circle (r -> 1 / conj(r): the same spectral magnitude up to a
+constant, a decaying forecast) and the event counted.
 
 Units: d in the control plant's generalised units (N-like), t and dt in s, omega in rad/s.
 """
@@ -121,26 +125,30 @@ class ArPredictor:
     """Auto-regressive forecast of each excitation component from its past estimates.
 
     order: AR order p; window_s: the least-squares fit uses the last window_s seconds;
-    refit_s: refit period. Until a fit exists, `forecast` returns None (use a fallback).
+    refit_s: refit period; min_samples: samples before the first fit (at least 4 p). Until a
+    fit exists, `forecast` returns None (use a fallback). Counters: fits, unstable_fits (fits
+    whose model was stabilised, see the module docstring).
     """
 
     def __init__(self, nd: int, dt: float, *, order: int = 8, window_s: float = 120.0,
-                 refit_s: float = 10.0, ridge: float = 1e-8):
+                 refit_s: float = 10.0, ridge: float = 1e-8, min_samples: int = 0):
         self.nd, self.dt, self.order = nd, dt, order
-        self.window = max(int(round(window_s / dt)), 4 * order)
+        self.min_samples = max(int(min_samples), 4 * order)
+        self.window = max(int(round(window_s / dt)), self.min_samples)
         self.refit = max(int(round(refit_s / dt)), 1)
         self.ridge = ridge
         self.history: list[np.ndarray] = []
         self.coefficients = None          # (nd, order), newest sample first
         self._maps = None
         self._since_fit = 0
+        self.fits = self.unstable_fits = 0
 
     def append(self, d: np.ndarray) -> None:
         self.history.append(np.array(d, float))
         if len(self.history) > self.window:
             del self.history[0]
         self._since_fit += 1
-        if len(self.history) >= 4 * self.order and (
+        if len(self.history) >= self.min_samples and (
                 self.coefficients is None or self._since_fit >= self.refit):
             self._fit()
 
@@ -153,7 +161,9 @@ class ArPredictor:
             X, y = rows[:, :p][:, ::-1], rows[:, p]                        # newest first
             scale = float(np.mean(y ** 2)) or 1.0
             lhs = X.T @ X + self.ridge * scale * len(y) * np.eye(p)
-            coefs[i] = np.linalg.solve(lhs, X.T @ y)
+            coefs[i], reflected = stabilised(np.linalg.solve(lhs, X.T @ y))
+            self.unstable_fits += reflected
+        self.fits += 1
         self.coefficients = coefs
         self._maps = None
         self._since_fit = 0
@@ -183,3 +193,15 @@ class ArPredictor:
                 maps[i, k] = row
                 row = row @ companion
         return maps
+
+
+def stabilised(coefficients: np.ndarray) -> tuple[np.ndarray, bool]:
+    """(coefficients, changed): an AR model x_k = sum_j a_j x_k-j with every root of
+    z^p - a_1 z^(p-1) - ... - a_p outside the unit circle reflected into it (r -> 1/conj(r))."""
+    a = np.asarray(coefficients, float)
+    roots = np.roots(np.concatenate([[1.0], -a]))
+    radius = np.abs(roots)
+    if roots.size == 0 or radius.max() <= 1.0:
+        return a, False
+    roots = np.where(radius > 1.0, roots / radius ** 2, roots)
+    return -np.real(np.poly(roots))[1:], True

@@ -43,12 +43,16 @@ from .base import signal_indices
 
 STATE_NOTE = ("full-state feedback: an oracle that reads the plant's whole state x, "
               "radiation states included (no real device measures them)")
+# the NMPC forecasts with the true future excitation and reads the true state: its power is
+# a non-causal upper bound, and its results say so (as an MPC asked for forecast "known")
+ORACLE_LABEL = "non-causal upper bound (true future wave, full state)"
 
 
 class Nmpc:
     """Nonlinear MPC of one PTO's force, maximising absorbed energy over a receding horizon.
 
-    wave: the sea the controller forecasts (excitation known exactly; required).
+    wave: the sea the controller forecasts (excitation known exactly; required): a
+    non-causal oracle, labelled as an upper bound in describe() ("oracle", "label").
     horizon_s (s), dt_s (s): prediction horizon and controller period; dt_s must divide
     horizon_s, and simulate's dt must divide dt_s. substeps: RK4 steps per dt_s in the model
     (RK4 is stable for |lambda| h <= 2.78: the sphere's fastest radiation pole, -16.7 1/s,
@@ -320,6 +324,7 @@ class Nmpc:
         times = np.asarray(self.solve_times)
         finite = (lambda v: v if v is None or math.isfinite(v) else None)   # JSON: no inf
         out = {"name": self.name, "state": STATE_NOTE, "wave": self.wave.describe(),
+               "forecast": "known", "oracle": True, "label": ORACLE_LABEL,
                "horizon_s": self.horizon_s, "dt_s": self.dt_s, "period_s": self.period,
                "substeps": self.substeps, "pto": getattr(self, "_pto_name", self.pto),
                "force_max": finite(getattr(self, "_fmax", self.force_max)),

@@ -15,12 +15,14 @@ __version__ = "0.1.0"
 _ENTRY_POINTS = {
     "load_scene": "mbcontrol.scene", "list_models": "mbcontrol.scene",
     "build_plant": "mbcontrol.plant", "Fidelity": "mbcontrol.plant",
-    "simulate": "mbcontrol.sim", "simulate_batch": "mbcontrol.sim",
+    "simulate": "mbcontrol.analysis", "simulate_batch": "mbcontrol.sim",
     "linearize": "mbcontrol.analysis", "frequency_domain_response": "mbcontrol.analysis",
     "pto_metrics": "mbcontrol.analysis",
     "make_controller": "mbcontrol.controllers",
 }
-_ALIASES = {"make_controller": "make"}
+# `mbcontrol.simulate` checks its result (mbcontrol.analysis.validity); the raw integrator is
+# mbcontrol.sim.simulate
+_ALIASES = {"make_controller": "make", "simulate": "simulate_checked"}
 
 __all__ = ["waves", *_ENTRY_POINTS]
 

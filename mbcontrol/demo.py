@@ -90,10 +90,10 @@ def main(argv=None) -> int:
     for label, controller in ((f"scene PTO law ({c_scene:g} N m s/rad)", None),
                               ("passive, designed", Passive(damping)),
                               ("reactive, designed", Reactive(c_r, k_r)),
-                              (f"MPC, {limit:g} N m, {rate:.0f} N m/s",
+                              (f"MPC (AR), {limit:g} N m, {rate:.0f} N m/s",
                                Mpc(horizon_s=1.2, dt_s=0.03, wave=sea, forecast="ar",
                                    rate_max=rate)),
-                              (f"MPC, {limit:g} N m, no rate limit",
+                              (f"MPC (AR), {limit:g} N m, no rate limit",
                                Mpc(horizon_s=1.2, dt_s=0.03, wave=sea, forecast="ar"))):
         ds = simulate(plant, sea, duration=args.duration, dt=0.005, controller=controller)
         runs[label], records[label] = summary(ds, plant), ds

@@ -69,9 +69,47 @@ def time_series(ds, names, *, title=None, path=None, units=None):
         ax.grid(alpha=0.3)
     axes[-1].set_xlabel("time (s)")
     axes[0].set_title(title or ds.attrs.get("model", ""))
+    mark_result(ds, axes, axes[0])
     if path:
         save(fig, path)
     return fig
+
+
+INVALID_FACE = "#fde4e4"        # axes of a result that failed its physics checks
+
+
+def result_label(ds) -> str:
+    """What a reader must know about a result beside its numbers: INVALID (failed its physics
+    checks) and oracle (a controller that saw the future wave), or ''."""
+    import json
+    notes = []
+    if ds.attrs.get("valid", 1) == 0:
+        notes.append("INVALID: " + "; ".join(json.loads(ds.attrs.get("invalid_reasons", "[]"))))
+    controller = json.loads(ds.attrs.get("controller", "null") or "null") or {}
+    if controller.get("oracle"):
+        notes.append("oracle forecast: a non-causal upper bound")
+    return " | ".join(notes)
+
+
+def mark_result(ds, axes, title_ax) -> None:
+    """Shade what the statistics leave out (the wave's ramp, the controller's warm-up) and
+    mark an invalid or oracle result on its axes (red faces, a note under the title)."""
+    import json
+    import textwrap
+    wave = json.loads(ds.attrs.get("wave", "{}") or "{}")
+    controller = json.loads(ds.attrs.get("controller", "null") or "null") or {}
+    start = max(float(wave.get("ramp_s", 0.0) or 0.0),
+                float(controller.get("warm_up_s", 0.0) or 0.0))
+    for ax in np.ravel(axes):
+        if start > 0 and wave.get("type") != "regular":
+            ax.axvspan(float(ds["time"].values[0]), start, color="0.85", lw=0, zorder=0)
+        if ds.attrs.get("valid", 1) == 0:
+            ax.set_facecolor(INVALID_FACE)
+    label = result_label(ds)
+    if label:
+        text = title_ax.get_title()
+        title_ax.set_title(text + "\n" + textwrap.shorten(label, 110), fontsize=8,
+                           color="C3" if ds.attrs.get("valid", 1) == 0 else "C1")
 
 
 def compare_runs(runs: dict, names, *, title=None, units=None, path=None):
@@ -87,6 +125,7 @@ def compare_runs(runs: dict, names, *, title=None, units=None, path=None):
             if j == 0:
                 axes[i, j].set_ylabel(f"{name}\n{(units or {}).get(name, '')}", fontsize=8)
         axes[-1, j].set_xlabel("time (s)")
+        mark_result(ds, axes[:, j], axes[0, j])
     if title:
         fig.suptitle(title)
     fig.tight_layout()

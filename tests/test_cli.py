@@ -74,7 +74,15 @@ def test_errors_are_clear(capsys):
     # text is taken only by a setting that is text (an MPC's forecast), not by a number
     code, _, err = run(capsys, "simulate", "hinged_barge", "--height", "0.02", "--period", "1",
                        "--controller", "passive", "--set", "damping=1.5x")
-    assert code == 1 and "--set damping: expected a number, got '1.5x'" in err
+    assert code == 1 and "--set damping: expected a number, true/false or none, got '1.5x'" in err
+    # booleans and none parse as such (an MPC's soft_stroke, a limit left to the scene)
+    code, out, err = run(capsys, "simulate", "sphere", "--wave", "jonswap", "--hs", "1",
+                         "--tp", "8", "--duration", "60", "--dt", "0.1", "--controller", "mpc",
+                         "--set", "soft_stroke=false", "--set", "force_max=none",
+                         "--set", "forecast=model", "--json")
+    assert code == 0, err
+    described = json.loads(out)["controller"]
+    assert described["soft_stroke"] is False and described["forecast"] == "model"
 
 
 def test_design_text_prints_parameters_margins_bounds_and_rerun(capsys):

@@ -58,23 +58,6 @@ class Thevenin:
     velocity_unit: str
 
 
-def _linear_params(plant, pto: str, params) -> dict:
-    """Parameter overrides for linear theory seen from `pto`.
-
-    Coulomb friction is removed (its smoothed slope at rest is not linear physics); the PTO's
-    own damping and stiffness are zero, so the decision force is the PTO's whole force. Other
-    PTOs keep their damping and stiffness (scene values unless `params` overrides them).
-    """
-    if params is not None and not isinstance(params, dict):
-        params = dict(zip(plant.parameters, np.asarray(params, float)))
-    out = dict(params or {})
-    for friction in plant.scene.frictions:
-        out[f"{friction.name}__coulomb"] = 0.0
-    out[f"{pto}__damping"] = 0.0
-    out[f"{pto}__stiffness"] = 0.0
-    return out
-
-
 def _pto_name(plant, pto: str | None) -> str:
     names = [p.name for p in plant.scene.ptos]
     if not names:
@@ -97,41 +80,12 @@ def pto_thevenin(plant, omega, pto: str | None = None, direction: float = 0.0,
     omega: rad/s, inside the hydro data's band. params: overrides (dict) of the plant's
     parameters for the other PTOs, mooring, friction. Raises NotPassiveError if Re Z_i < 0.
     """
-    from ..waves import interpolate_complex
-    from .frequency import mechanical_matrices
-    from .linearize import jacobians
+    from .ports import port_responses
 
     name = _pto_name(plant, pto)
-    if plant.hydro is None:
-        raise ValueError(f"{plant.name}: no hydrodynamic data, so no wave excitation")
     omega = np.atleast_1d(np.asarray(omega, float))
-    if np.any(omega <= 0):
-        raise ValueError("pto_thevenin: frequencies must be > 0 rad/s")
-    overrides = _linear_params(plant, name, params)
-    p = plant.params(**overrides)
-    mech = mechanical_matrices(plant, p)
-    n_q, n_s = plant.n_q, plant.topology.tree.n_s
-    _, Bu, _, _, Du, _ = (np.asarray(J) for J in jacobians(plant)(
-        plant.x0(), np.zeros(len(plant.inputs)), np.zeros(len(plant.disturbances)), p))
-    # generalised force of a unit PTO force: s' = M_tot^-1 (... + b u), so b = M_tot ds'/du
-    i_u = plant.inputs.index(f"u__{name}")
-    b = (mech.mass + mech.added_mass_inf) @ Bu[n_q:n_q + n_s, i_u]
-    i_v = plant.outputs.index(f"{name}__velocity")
-    c_q, c_s = mech.output_q[i_v], mech.output_s[i_v]
-    if abs(Du[i_v, i_u]) > 0:
-        raise ValueError(f"{plant.name}: {name}__velocity depends directly on the PTO force")
-
-    hyd, P = plant.hydro, mech.P_hydro
-    A_w, B_w = hyd.frequency_domain_matrices(omega)
-    F_exc = interpolate_complex(hyd.omega, hyd.excitation_coefficients(direction), omega)
-    H_u = np.empty(omega.size, complex)
-    H_w = np.empty(omega.size, complex)
-    for k, w in enumerate(omega):
-        Z = (-w**2 * (mech.mass + P @ A_w[k] @ P.T) - 1j * w * (mech.damping + P @ B_w[k] @ P.T)
-             + mech.stiffness)
-        X = np.linalg.solve(Z, np.column_stack([b, P @ F_exc[k]]))
-        V = c_q @ X + c_s @ (-1j * w * X)       # the velocity output's phasor, both cases
-        H_u[k], H_w[k] = V
+    Y, H = port_responses(plant, omega, [name], direction, params)
+    H_u, H_w = Y[:, 0, 0], H[:, 0]
     Z_i = 1.0 / H_u
     if check_passive:
         bad = Z_i.real < -PASSIVITY_TOL * np.abs(Z_i)

@@ -1,8 +1,11 @@
 """Summaries of simulation results: amplitudes, statistics, PTO power, force and stroke.
 
 Window: for a regular wave, the last 10 wave periods (steady state); for an irregular sea,
-the record after the ramp. Amplitude is half the peak-to-peak within the window. Absorbed
-power is positive.
+the record after the ramp (as WEC-Sim's statistics leave out its ramp); in both, no earlier
+than the end of the controller's warm-up (`warm_up_s` in its describe(), e.g. an MPC's
+passive start-up before its predictor's first fit). `statistics_window(ds)` says which, and
+the summary records it ("window_start_s", "window"). Amplitude is half the peak-to-peak
+within the window. Absorbed power is positive.
 
 PTO power is taken from the work the PTO does over each step, not from the sampled power
 -F v: a controller's force is held over each step (zero-order hold), and then the work
@@ -17,7 +20,6 @@ import math
 
 import numpy as np
 
-from ..results import jsonable
 
 _BODY_KEYS = {"Surge": "surge_amplitude_m", "Sway": "sway_amplitude_m",
               "Heave": "heave_amplitude_m", "Roll": "roll_amplitude_rad",
@@ -25,18 +27,38 @@ _BODY_KEYS = {"Surge": "surge_amplitude_m", "Sway": "sway_amplitude_m",
 
 
 def analysis_window(ds) -> np.ndarray:
-    """Boolean mask over time of the window the metrics use."""
+    """Boolean mask over time of the window the metrics use (see `statistics_window`)."""
+    t = ds["time"].values
+    info = statistics_window(ds)
+    start = info["start_s"]
+    mask = t >= start - 1e-9
+    if mask.sum() < 2:
+        raise ValueError(f"the record ({t[-1]:.4g} s) is too short for the metrics window "
+                         f"starting at {start:.4g} s ({info['note']}); simulate longer")
+    return mask
+
+
+def statistics_window(ds) -> dict:
+    """{"start_s", "note"}: where the statistics start (s) and why. Regular wave: the last 10
+    periods; a sea: after the ramp; either way not before the controller's warm-up ends
+    (its describe()["warm_up_s"] in ds.attrs["controller"])."""
     t = ds["time"].values
     wave = json.loads(ds.attrs.get("wave", "{}"))
     if wave.get("type") == "regular":
-        start = t[-1] - 10 * wave["period"]
+        start = float(t[-1] - 10 * wave["period"])
+        note = "the last 10 wave periods"
     else:
-        start = wave.get("ramp_s", 0.0)
-    mask = t >= start
-    if mask.sum() < 2:
-        raise ValueError(f"the record ({t[-1]:.4g} s) is too short for the metrics window "
-                         f"starting at {start:.4g} s; simulate longer")
-    return mask
+        start = float(wave.get("ramp_s", 0.0) or 0.0)
+        note = f"after the wave's ramp ({start:.4g} s)" if start > 0 else "the whole record"
+    controller = json.loads(ds.attrs.get("controller", "null") or "null")
+    warm_up = controller.get("warm_up_s") if isinstance(controller, dict) else None
+    if warm_up:
+        note += f", and after the controller's warm-up ({float(warm_up):.4g} s)"
+        if float(warm_up) > start:
+            start = float(warm_up)
+            if wave.get("type") == "regular":
+                note += ": fewer than 10 periods"
+    return {"start_s": start, "note": f"statistics over t >= {start:.4g} s: {note}"}
 
 
 def signal_stats(values) -> dict:
@@ -107,6 +129,10 @@ def pto_metrics(ds, pto, start: float | None = None, end: float | None = None) -
         "force_violation": float(max(force.max() - force_max, 0.0)),
         "stroke_violation": float(max(stroke.max() - stroke_max, 0.0)),
         "violation_fraction": float(outside.mean()),
+        # the run's physics verdict when it has one (mbcontrol.analysis.validity.assess)
+        **({"valid": bool(ds.attrs["valid"]),
+            "invalid_reasons": json.loads(ds.attrs.get("invalid_reasons", "[]"))}
+           if "valid" in ds.attrs else {}),
     }
 
 
@@ -126,20 +152,3 @@ def wecccomp_score(ds, pto, start: float = 25.0, end: float | None = None) -> di
     denominator = (2 + m["f98"] / m["force_max"] + m["z98"] / m["stroke_max"]
                    - m["mean_abs_power_W"] / m["p98_W"])
     return {**m, "EC": m["mean_electrical_power_W"] / denominator}
-
-
-def summary(ds, plant) -> dict:
-    """The `mbcontrol simulate --json` contract (see README)."""
-    mask = analysis_window(ds)
-    coords = plant.topology.tree.coordinate_names
-    dofs = {name: signal_stats(ds[name].values[mask]) for name in coords}
-    bodies = {}
-    for body in plant.topology.bodies:
-        bodies[body] = {key: 0.5 * float(np.ptp(ds[f"{body}__{dof}"].values[mask]))
-                        for dof, key in _BODY_KEYS.items()}
-    ptos = {pto.name: jsonable(pto_metrics(ds, pto)) for pto in plant.scene.ptos}
-    return {"model": ds.attrs["model"], "wave": json.loads(ds.attrs["wave"]),
-            "duration_s": float(ds.attrs["duration_s"]), "dt_s": float(ds.attrs["dt_s"]),
-            "wall_time_s": float(ds.attrs["wall_time_s"]), "method": ds.attrs["method"],
-            "controller": json.loads(ds.attrs.get("controller", "null")),
-            "dofs": dofs, "bodies": bodies, "ptos": ptos}

@@ -6,6 +6,7 @@ Examples:
   mbcontrol simulate hinged_barge --wave regular --height 0.02 --period 1.0 --duration 30 --json
   mbcontrol simulate hinged_barge --wave jonswap --hs 0.03 --tp 1.0 --seed 3 --out run.nc
   mbcontrol simulate hinged_barge --wave regular --height 0.02 --period 1 --controller passive --set damping=1.5
+  mbcontrol simulate rm3 --wave jonswap --hs 2 --tp 9 --controller mpc --set forecast=ar --json
   mbcontrol linearize hinged_barge --bode bode.png --json
   mbcontrol design sphere --controller reactive --wave regular --height 2.5 --period 9.6664
   mbcontrol design sphere --controller passive --wave jonswap --hs 2.5 --tp 8 --json
@@ -24,6 +25,22 @@ from .commands import (run_bench, run_design, run_fidelity, run_hydro, run_linea
                        run_simulate)
 from .identify import add_parser as add_identify_parser
 from .sweep import add_parser as add_sweep_parser
+
+SIMULATE_HELP = """Simulate a model in waves on the nonlinear process plant, open or closed loop.
+
+Every result is checked before it is printed: the PTOs' mean absorbed power against the
+complex-conjugate bound of the simulated wave (multiport, straight from the BEM data), the
+energy balance (the PTOs cannot absorb more than the waves did work), and the motions
+against the validity of linear hydrodynamics (significant heave relative to the free surface
+within the body's mean draft; roll and pitch within 30 deg). A result that fails is printed
+marked INVALID with its reasons ("valid": false, "invalid_reasons" in --json, at the top
+and per PTO) and the command exits with status 3, unless --allow-invalid.
+Statistics are over the record after the wave's ramp and the controller's warm-up.
+A predictive controller's forecast is causal unless asked (--set forecast=known: the true
+future wave, reported as a non-causal upper bound).
+
+--set values are numbers, true/false, none, or words (e.g. --set forecast=ar).
+"""
 
 DESIGN_HELP = """Tune a PTO controller for a sea, then check, bound and simulate it.
 
@@ -89,7 +106,7 @@ def _parser() -> argparse.ArgumentParser:
     p.set_defaults(run=run_hydro)
 
     p = sub.add_parser("simulate", help="simulate a model in waves (nonlinear process plant)",
-                       formatter_class=argparse.RawTextHelpFormatter)
+                       description=SIMULATE_HELP, formatter_class=argparse.RawTextHelpFormatter)
     _model_options(p)
     _wave_options(p)
     p.add_argument("--duration", type=float, default=None,
@@ -107,6 +124,11 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--out", help="write the full result to this netCDF file")
     p.add_argument("--plot", help="write a time-series figure (PNG) to this file")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
+    p.add_argument("--allow-invalid", action="store_true",
+                   help="exit 0 even when the result fails its physics checks (mean power\n"
+                        "above the complex-conjugate bound of its wave, energy balance,\n"
+                        "motions beyond linear hydrodynamics); it is still marked invalid\n"
+                        "(exit status 3 without this flag)")
     p.set_defaults(run=run_simulate)
 
     p = sub.add_parser("design", help="tune a controller for a sea; check its stability margins, "

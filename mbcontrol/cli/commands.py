@@ -95,6 +95,7 @@ def run_simulate(args) -> int:
     ds = simulate(plant, wave, duration=duration, dt=args.dt, controller=controller,
                   method=args.method, rtol=args.rtol, params=params or None,
                   progress=not args.json)
+    result = summary(ds, plant)             # checks the result; the verdict goes into ds.attrs
     if args.out:
         from ..results import save_dataset
         save_dataset(ds, args.out)
@@ -103,12 +104,20 @@ def run_simulate(args) -> int:
         names = list(plant.topology.tree.coordinate_names) + [
             f"{p.name}__power" for p in plant.scene.ptos]
         time_series(ds, ["eta"] + names, path=args.plot)
-    result = summary(ds, plant)
     if args.json:
         print(json.dumps(result, indent=2))
     else:
         _print_summary(result)
+    for note in result["validity_warnings"]:
+        print(f"mbcontrol: warning: {note}", file=sys.stderr)
+    if not result["valid"]:
+        for reason in result["invalid_reasons"]:
+            print(f"mbcontrol: INVALID result: {reason}", file=sys.stderr)
+        return 0 if args.allow_invalid else INVALID_EXIT
     return 0
+
+
+INVALID_EXIT = 3        # `simulate`'s exit status for a result that failed its physics checks
 
 
 def run_design(args) -> int:
@@ -200,6 +209,8 @@ def _print_design(plant, wave, result, command) -> None:
         print(f"    max force {m['max_force']:.4g} {F}, max stroke {m['max_stroke']:.4g} {X}, "
               f"peak/mean power {m['papr']:.3g}, samples outside the limits "
               f"{100 * m['violation_fraction']:.3g} %")
+        print("    result: valid (bound, energy balance, linear-hydrodynamics range checked)"
+              if result.valid else "    result: INVALID - " + "; ".join(result.invalid_reasons))
     print(f"  re-run: {command}")
 
 
@@ -272,16 +283,42 @@ def _controller(args, wave=None):
     from mbcontrol.controllers import REGISTRY, make
     cls = REGISTRY.get(args.controller)
     signature = inspect.signature(cls).parameters if cls is not None else {}
-    settings = {}
-    for item in args.set:
-        key, value = _key_value(item, "--set", text=True)
-        # text only for a setting that is text (a choice), so a typo in a number is caught
-        if isinstance(value, str) and not _takes_text(signature.get(key)):
-            raise ValueError(f"--set {key}: expected a number, got {value!r}")
-        settings[key] = value
+    settings = parse_settings(args.set, signature)
     if wave is not None and cls is not None and "wave" in inspect.signature(cls).parameters:
         settings.setdefault("wave", wave)
     return make(args.controller, **settings)
+
+
+def parse_settings(items, signature) -> dict:
+    """--set KEY=VALUE items as a controller's settings: numbers, true/false, none, or words
+    (for a setting that takes text, e.g. forecast=ar). A word for a numeric setting is an
+    error (a key the controller does not take is named by `make`)."""
+    settings = {}
+    for item in items:
+        if "=" not in item:
+            raise ValueError(f"--set expects KEY=VALUE, got {item!r}")
+        key, text = (part.strip() for part in item.split("=", 1))
+        value = _setting_value(text)
+        # text only for a setting that is text (a choice), so a typo in a number is caught
+        if isinstance(value, str) and not _takes_text(signature.get(key)):
+            raise ValueError(f"--set {key}: expected a number, true/false or none, got {text!r}")
+        settings[key] = value
+    return settings
+
+
+def _setting_value(text: str):
+    """'2.5' -> 2.5, '3' -> 3.0, 'true'/'false' -> bool, 'none' -> None, else the word."""
+    lowered = text.lower()
+    if lowered in ("true", "false"):
+        return lowered == "true"
+    if lowered in ("none", "null"):
+        return None
+    try:
+        return float(text)
+    except ValueError:
+        if not text:
+            raise ValueError("--set: empty value") from None
+        return text
 
 
 def _takes_text(parameter) -> bool:
@@ -314,4 +351,10 @@ def _print_summary(result: dict) -> None:
     for pto, values in result["ptos"].items():
         print(f"  {pto}: mean absorbed power {values['mean_power_W']:.4g} W, max force "
               f"{values['max_force']:.4g}, max stroke {values['max_stroke']:.4g}")
+    checks = result.get("validity", {})
+    if "bound_W" in checks:
+        print(f"  complex-conjugate bound of this wave {checks['bound_W']:.4g} W (all PTOs, "
+              f"linear theory)")
+    print("  result: valid (bound, energy balance, linear-hydrodynamics range checked)"
+          if result["valid"] else "  result: INVALID - " + "; ".join(result["invalid_reasons"]))
 

@@ -17,9 +17,23 @@ labelled result (xarray). --vary NAME=v1,v2 adds a dimension: NAME is a scene pa
 a plant parameter or a setting of the controller.
 
 The --json summary is a contract: {"model", "cases", "computed", "reused", "wall_time_s",
+"valid_cases", "invalid_cases", "invalid": [{"hs", "tp", "seed", "reasons"}], "notes",
 "seas": [{"hs", "tp", "weight", "mean_power_W", "capture_width_m", "energy_flux_W_per_m",
-...}], "weighted_mean_power_W", "annual_energy_MWh"} (per sea, means over seeds; lists over
-the varied values when --vary is given; weighted figures only for a weighted --seas file).
+"invalid_cases", ...}], "weighted_mean_power_W", "annual_energy_MWh",
+"annual_energy_coverage", "annual_energy_unchecked_MWh", "provenance":
+{"model", "version", "scene_sha256", "hydro_sha256", "radiation_sha256", "controller",
+"settings"}} (per sea, means over the valid seeds; lists over the varied values when --vary
+is given; weighted figures only for a weighted --seas file; a sea with no valid case counts
+as producing nothing there, the share of the year that is valid is annual_energy_coverage,
+and annual_energy_unchecked_MWh is the figure the failed cases would have given).
+
+Every case is checked like `simulate`'s results (power bound of its own wave, energy
+balance, linear-hydrodynamics range); a case that fails is counted and listed, never
+averaged. Controllers run causally: an MPC forecasts the excitation from what it measures
+(AR) unless --set forecast=known (an oracle: a non-causal upper bound, labelled so in
+provenance.settings). A store remembers the inputs it was made from (content hashes of the
+scene, hydro data and radiation fit, and the package version) and refuses others.
+--set values are numbers, true/false, none or words (--set forecast=ar).
 
 Examples:
   mbcontrol sweep rm3 --hs 1 2 3 --tp 8 10 12 --duration 300 --store out/rm3 --plot pm.png
@@ -63,8 +77,12 @@ def add_parser(sub) -> None:
 
 
 def run_sweep(args) -> int:
+    import inspect
+
+    from mbcontrol.controllers import REGISTRY
+
     from ..studies.sweep import grid, read_seas, sweep
-    from .commands import _key_value
+    from .commands import _key_value, parse_settings
     if args.hs is not None:
         if not args.tp:
             raise ValueError("--hs needs --tp (the grid's peak periods)")
@@ -73,6 +91,10 @@ def run_sweep(args) -> int:
         if args.tp:
             raise ValueError("--tp goes with --hs; a --seas file gives its own periods")
         seas = read_seas(args.seas, args.gamma)
+    if args.set and not args.controller:
+        raise ValueError("--set needs --controller")
+    cls = REGISTRY.get(args.controller) if args.controller else None
+    settings = parse_settings(args.set, inspect.signature(cls).parameters if cls else {})
     vary = {}
     for item in args.vary:
         name, _, values = item.partition("=")
@@ -86,7 +108,7 @@ def run_sweep(args) -> int:
         args.model, seas, seeds=args.seeds, vary=vary,
         params=dict(_key_value(s, "--param") for s in args.param),
         scene_params=dict(_key_value(s, "--scene-param") for s in args.scene_param),
-        controller=args.controller, settings=dict(_key_value(s, "--set") for s in args.set),
+        controller=args.controller, settings=settings,
         duration=args.duration, dt=args.dt, method=args.method, store=args.store,
         workers=args.workers, scheduler=args.scheduler, width=args.width,
         progress=not args.json)
@@ -107,9 +129,17 @@ def run_sweep(args) -> int:
         weight = f"{row['weight']:8.4f}" if row["weight"] is not None else "       -"
         print(f"  {row['hs']:6.3g} {row['tp']:6.3g} {weight} {text} {cw_text} "
               f"{row['energy_flux_W_per_m'] / 1e3:8.3g}")
+    for note in summary["notes"]:
+        print(f"  note: {note}")
+    for case in summary["invalid"][:10]:
+        print(f"  INVALID Hs {case['hs']:.3g} m, Tp {case['tp']:.3g} s, seed {case['seed']}: "
+              f"{case['reasons']}")
     if summary["annual_energy_MWh"] is not None:
+        share = summary["annual_energy_coverage"]
         print(f"  weighted mean power {summary['weighted_mean_power_W'] / 1e3:.4g} kW; annual "
-              f"energy {summary['annual_energy_MWh']:.4g} MWh")
+              f"energy {summary['annual_energy_MWh']:.4g} MWh"
+              + ("" if share == 1 else f" (valid seas only: {100 * share:.3g} % of the year; a "
+                                       f"lower bound)"))
     if args.store:
         print(f"wrote {args.store}/sweep.nc", file=sys.stderr)
     return 0

@@ -5,7 +5,8 @@ symbolic parameters. Modules: `process` (ProcessPlant and its assembly), `loads`
 friction, moorings, drag, end stops, gravity, hydrostatics), `catenary` and `catenary_line`
 (quasi-static mooring lines), `checks` (rest checks), `fidelity` (simplified models),
 `freeze` (DOFs removed: blocked by a rig, or not excited by the waves),
-`jacobians` (exact Jacobians, shared downstream), `build` (the entry point).
+`jacobians` (exact Jacobians, shared downstream), `provenance` (content hashes of what
+made a plant), `build` (the entry point).
 """
 from .build import build_plant
 from .catenary import CatenarySolution, solve_catenary
@@ -13,7 +14,8 @@ from .catenary_line import CatenaryLine, catenary_line
 from .fidelity import Fidelity, FidelityError, plant_for
 from .jacobians import jacobians
 from .process import ProcessPlant, active_hydro_dofs, dof_selector
+from .provenance import provenance
 
 __all__ = ["build_plant", "ProcessPlant", "active_hydro_dofs", "dof_selector", "jacobians",
            "Fidelity", "FidelityError", "plant_for", "CatenaryLine", "CatenarySolution",
-           "catenary_line", "solve_catenary"]
+           "catenary_line", "solve_catenary", "provenance"]

@@ -21,7 +21,9 @@ import numpy as np
 import xarray as xr
 
 from ..errors import SimulationError
-from . import integrators
+from ..plant import provenance
+from . import diagnose, integrators
+from .moorings import mooring_report
 
 
 def simulate(plant, wave=None, *, duration: float, dt: float = 0.01, controller=None,
@@ -51,7 +53,8 @@ def simulate(plant, wave=None, *, duration: float, dt: float = 0.01, controller=
     if spec.kind == "explicit":
         _warn_stiff(plant, dt)
     bar = _progress_bar(progress, n)
-    check = _divergence_check(plant, dt, method, bar)
+    why = diagnose.explainer(plant, wave, controller, p, x0, dt, method, duration, simulate)
+    check = _divergence_check(plant, dt, method, bar, why)
 
     # a controller with a CasADi law held for one step runs inside the compiled code
     law = controller.casadi_law(plant) if controller is not None and spec.fixed_step else None
@@ -81,7 +84,7 @@ def simulate(plant, wave=None, *, duration: float, dt: float = 0.01, controller=
     Y = integrators.outputs(plant, X, U_full, W, p, compiled=compiled)
     output_wall = time.perf_counter() - start
     if audit:
-        energy_audit(plant, t, Y, method, dt)
+        energy_audit(plant, t, Y, method, dt, why)
     eta = wave.elevation(t) if wave is not None else np.zeros_like(t)
     ds = _dataset(plant, t, X, U_full, W, Y, eta, wave, controller, method, dt, p, wall)
     ds.attrs["output_time_s"] = output_wall
@@ -113,10 +116,12 @@ def energy_budget(plant, t, Y):
     return Y[:, col["energy"]] - Y[0, col["energy"]], work
 
 
-def energy_audit(plant, t, Y, method: str, dt: float) -> None:
+def energy_audit(plant, t, Y, method: str, dt: float, why=None) -> None:
     """Raise SimulationError at the first sample whose energy gain exceeds ENERGY_MARGIN times
     the work put in so far (plus a floor: 5 % of the record's input, half the initial
-    energy), or whose outputs are not finite: the signature of an unstable step, not physics.
+    energy), or whose outputs are not finite: the signature of an unstable step or of an
+    unstable closed loop. why: the closed-loop diagnosis (sim.diagnose.explainer; None: the
+    step is blamed); the error's `t_fail` attribute is the time, s.
     """
     bad = np.flatnonzero(~np.isfinite(Y).all(axis=1))
     budget = energy_budget(plant, t, Y)
@@ -139,51 +144,23 @@ def energy_audit(plant, t, Y, method: str, dt: float) -> None:
     detail = "non-finite outputs" if not np.isfinite(Y[i]).all() else (
         f"mechanical energy grew by {gain[i]:.4g} J while the waves and PTOs had put in "
         f"{work[i]:.4g} J")
-    raise SimulationError(
-        f"{plant.name}: simulation diverged at t = {t[i]:.4g} s (step {i}, dt = {dt} s, "
-        f"method {method!r}): {detail}. Remedy: a smaller dt (try {dt / 4:g} s), "
+    head = (f"{plant.name}: simulation diverged at t = {t[i]:.4g} s (step {i}, dt = {dt} s, "
+            f"method {method!r}): {detail}")
+    cause = why(float(t[i])) if why is not None else None
+    if cause:
+        raise _diverged(f"{head}: {cause}", float(t[i]))
+    raise _diverged(
+        f"{head}. Remedy: a smaller dt (try {dt / 4:g} s), "
         f"method='exp-rk4' when fast radiation poles limit the step, method='cvodes' for "
         f"stiff loads (end stops, friction, latching), or `mbcontrol bench {plant.name} "
-        f"--stability` for each method's largest stable step")
+        f"--stability` for each method's largest stable step", float(t[i]))
 
 
-def mooring_report(plant, ds) -> dict:
-    """Per catenary line: tension range, the line's state at its most and least stretched
-    (exact solve), and warnings when it went slack or taut-out or its fairlead left the force
-    table's envelope (where the compiled force is extrapolated)."""
-    from ..plant import catenary_line
-
-    report = {}
-    for m in (m for m in plant.scene.moorings if m.kind == "catenary"):
-        line = catenary_line(m)
-        span, height = ds[f"{m.name}__span"].values, ds[f"{m.name}__height"].values
-        rest_span, rest_height, _ = line.offsets(line.fairlead)
-        t = ds["time"].values
-        entry = {"tension_min_N": float(ds[f"{m.name}__tension"].min()),
-                 "tension_max_N": float(ds[f"{m.name}__tension"].max())}
-        for key, i in (("most_stretched", int(np.argmax(np.hypot(span, height)))),
-                       ("least_stretched", int(np.argmin(np.hypot(span, height))))):
-            state = _solve_at(line, span[i], height[i])
-            entry[key] = {"time_s": float(t[i]), "status": state.status}
-            if state.status in ("slack", "taut-out"):
-                warnings.warn(f"{plant.name}: mooring '{m.name}' was {state.status} at t = {t[i]:.4g} s "
-                              f"(fairlead {span[i]:.4g} m across, {height[i]:.4g} m above the anchor)",
-                              RuntimeWarning, stacklevel=3)
-        outside = (np.abs(span - rest_span) > line.excursion) | (np.abs(height - rest_height) > line.excursion)
-        entry["left_envelope"] = bool(outside.any())
-        if outside.any():
-            i = int(np.argmax(outside))
-            warnings.warn(f"{plant.name}: mooring '{m.name}': the fairlead left the force table's envelope "
-                          f"(±{line.excursion:.4g} m about rest) at t = {t[i]:.4g} s, where the line force is "
-                          f"extrapolated; give the mooring a larger 'excursion'", RuntimeWarning, stacklevel=3)
-        report[m.name] = entry
-    return report
-
-
-def _solve_at(line, span: float, height: float):
-    from ..plant import solve_catenary
-    return solve_catenary(float(span), float(height), line.length, line.EA, line.weight,
-                          friction=line.friction, strain_limit=line.strain_limit, name=line.name)
+def _diverged(message: str, t_fail: float) -> SimulationError:
+    """A SimulationError carrying the time of the divergence (s) as `t_fail`."""
+    error = SimulationError(message)
+    error.t_fail = t_fail
+    return error
 
 
 def _last_command(plant, controller, t, x, U, w, p) -> np.ndarray:
@@ -302,9 +279,10 @@ def _euler_pitch_states(plant) -> dict:
             if j.type == "free" and len(j.dofs) == 6}
 
 
-def _divergence_check(plant, dt, method, bar):
+def _divergence_check(plant, dt, method, bar, why=None):
     """Stop with a clear SimulationError on the first non-finite or absurd state, or when a free
-    body's Euler pitch nears ±90°, where its kinematics q' = K(q) s are singular."""
+    body's Euler pitch nears ±90°, where its kinematics q' = K(q) s are singular. why: the
+    closed-loop diagnosis of a divergence (sim.diagnose.explainer; None: the step is blamed)."""
     pitch, checked = _euler_pitch_states(plant), [0]
 
     def check(i_end, X):           # X: the states from t = 0 up to step i_end
@@ -327,13 +305,17 @@ def _divergence_check(plant, dt, method, bar):
         i = int(bad[0]) if bad.size else i_end
         worst = plant.states[int(np.nanargmax(np.where(np.isfinite(X[i]), np.abs(X[i]),
                                                        np.inf)))]
-        raise SimulationError(
-            f"{plant.name}: simulation diverged at t = {i * dt:.4g} s (step {i}, dt = {dt} s, "
-            f"method {method!r}); state {worst!r} became non-finite or exceeded 1e8. Remedy: a "
+        head = (f"{plant.name}: simulation diverged at t = {i * dt:.4g} s (step {i}, dt = {dt} s, "
+                f"method {method!r}); state {worst!r} became non-finite or exceeded 1e8")
+        cause = why(i * dt) if why is not None else None
+        if cause:
+            raise _diverged(f"{head}: {cause}", i * dt)
+        raise _diverged(
+            f"{head}. Remedy: a "
             f"smaller dt (try {dt / 4:g} s), method='exp-rk4' when fast radiation poles limit "
             f"the step, method='cvodes' for stiff loads (end stops, friction velocity_scale, "
             f"mooring stiffness), or `mbcontrol bench {plant.name} --stability` for each "
-            f"method's largest stable step")
+            f"method's largest stable step", i * dt)
     return check
 
 
@@ -351,10 +333,20 @@ def _dataset(plant, t, X, U, W, Y, eta, wave, controller, method, dt, p, wall):
                      for i, name in enumerate(names)})
     data["eta"] = ("time", eta, {"units": "m", "long_name": "wave elevation at the origin, up"})
     data["state"] = (("time", "state_name"), X)
+    if wave is not None:        # the wave itself, so the result can be checked against its bound
+        data.update({f"wave_{name}": ("wave_component", np.asarray(getattr(wave, name), float),
+                                      {"units": unit})
+                     for name, unit in (("omega", "rad/s"), ("amplitude", "m"), ("phase", "rad"))})
+        if wave.d_omega:
+            data["wave_omega"][2]["d_omega"] = float(wave.d_omega)
     ds = xr.Dataset(data, coords={"time": ("time", t, {"units": "s"}),
                                   "state_name": list(plant.states)})
+    made_by = provenance(plant)
     ds.attrs.update({
-        "model": plant.name, "scene_sha256": plant.scene.digest(), "method": method, "dt_s": dt,
+        "model": plant.name, "scene_sha256": made_by["scene_sha256"],
+        "hydro_sha256": made_by["hydro_sha256"] or "none",
+        "radiation_sha256": made_by["radiation_sha256"] or "none",
+        "method": method, "dt_s": dt,
         "duration_s": float(t[-1]), "wall_time_s": wall,
         "wave": json.dumps(wave.describe() if wave is not None else {"type": "none"}),
         "controller": json.dumps(controller.describe() if controller is not None else None),
@@ -368,11 +360,17 @@ def _dataset(plant, t, X, U, W, Y, eta, wave, controller, method, dt, p, wall):
     return ds
 
 
+_VERSIONS: dict = {}
+
+
 def _versions() -> dict:
-    out = {"python": platform.python_version()}
-    for pkg in ("mbcontrol", "casadi", "numpy", "control", "capytaine"):
-        try:
-            out[pkg] = metadata.version(pkg)
-        except metadata.PackageNotFoundError:
-            pass
-    return out
+    """Python's and the packages' versions: looked up once per process (the package metadata
+    lookups cost ~2-4 ms, every run otherwise); a copy, so callers may change it."""
+    if not _VERSIONS:
+        _VERSIONS["python"] = platform.python_version()
+        for pkg in ("mbcontrol", "casadi", "numpy", "control", "capytaine"):
+            try:
+                _VERSIONS[pkg] = metadata.version(pkg)
+            except metadata.PackageNotFoundError:
+                pass
+    return dict(_VERSIONS)

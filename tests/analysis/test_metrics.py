@@ -79,3 +79,17 @@ def test_electrical_power_and_wecccomp_score_by_hand():
     assert score["EC"] == pytest.approx(ec, rel=1e-12)
     with pytest.raises(ValueError, match="finite force_max"):
         wecccomp_score(_record(t, force, x), "p")
+
+
+def test_statistics_start_after_the_ramp_and_the_controller_warm_up():
+    """A sea with a 10 s ramp and a controller whose warm-up ended at 30 s: the window starts
+    at the later (30 s) and says why; without a warm-up it starts after the ramp."""
+    from mbcontrol.analysis.metrics import analysis_window, statistics_window
+    t = np.arange(0.0, 100.0, 0.5)
+    ds = _record(t, np.zeros_like(t), np.zeros_like(t))
+    ds.attrs["wave"] = json.dumps({"type": "jonswap", "ramp_s": 10.0})
+    assert statistics_window(ds)["start_s"] == 10.0
+    ds.attrs["controller"] = json.dumps({"name": "mpc", "warm_up_s": 30.0})
+    info = statistics_window(ds)
+    assert info["start_s"] == 30.0 and "warm-up (30 s)" in info["note"]
+    assert analysis_window(ds).sum() == np.sum(t >= 30.0)

@@ -31,6 +31,8 @@ def test_identify_json_contract(capsys, tmp_path):
     assert set(s) >= {"model", "method", "cost", "parameters", "correlation", "fit",
                       "validation", "simulations", "wall_time_s"}
     assert (s["model"], s["method"], s["cost"]) == ("flume_section", "gauss-newton", "harmonic")
+    # the fitted model's forward runs pass the physics checks (mm-scale motions, passive)
+    assert s["valid"] is True and s["invalid_reasons"] == []
     assert list(s["parameters"]) == ["viscous__Roll_linear", "heave_rig__viscous"]
     for name, p in s["parameters"].items():
         assert set(p) == {"initial", "value", "std", "lo", "hi"}

@@ -22,7 +22,12 @@ def test_sweep_json_contract_and_annual_energy(capsys, tmp_path):
     assert code == 0, err
     s = json.loads(out)
     assert set(s) >= {"model", "cases", "computed", "reused", "wall_time_s", "seas",
-                      "weighted_mean_power_W", "annual_energy_MWh"}
+                      "weighted_mean_power_W", "annual_energy_MWh", "valid_cases",
+                      "invalid_cases", "invalid", "notes", "annual_energy_coverage",
+                      "annual_energy_unchecked_MWh", "provenance"}
+    assert s["invalid_cases"] == 0 and s["annual_energy_coverage"] == 1.0
+    assert set(s["provenance"]) >= {"version", "scene_sha256", "hydro_sha256",
+                                    "radiation_sha256", "controller", "settings"}
     assert (s["model"], s["cases"], s["computed"], s["reused"]) == ("sphere", 3, 3, 0)
     rows = s["seas"]
     assert [(r["hs"], r["tp"], r["weight"]) for r in rows] == [(1.0, 8.0, 0.5), (2.0, 10.0, 0.3),
@@ -55,3 +60,18 @@ def test_sweep_vary_gives_lists(capsys):
 def test_sweep_errors_are_clear(capsys, argv, message):
     code, _, err = run(capsys, "sweep", "sphere", "--workers", "0", *argv)
     assert code == 1 and message in err
+
+
+def test_sweep_set_takes_words_and_records_the_forecast(capsys):
+    # the complaint: --set forecast=ar failed (values parsed as numbers only); the
+    # forecast the cases ran with is in the provenance, causal unless asked
+    base = ["sweep", "sphere", "--hs", "1", "--tp", "8", "--controller", "mpc", "--duration",
+            "60", "--dt", "0.1", "--workers", "0", "--json"]
+    code, out, err = run(capsys, *base, "--set", "forecast=ar")
+    assert code == 0, err
+    settings = json.loads(out)["provenance"]["settings"]
+    assert settings["forecast"] == "ar" and settings["oracle"] is False
+    code, out, err = run(capsys, *base, "--set", "forecast=known")
+    assert code == 0, err
+    settings = json.loads(out)["provenance"]["settings"]
+    assert settings["oracle"] is True and "upper bound" in settings["label"]

@@ -57,14 +57,49 @@ def errors_block(rows: list[dict], residuals=None) -> dict:
             "channels": channel_errors(rows)}
 
 
+def forward_validity(problem, values: dict, rows: list[dict]) -> dict:
+    """The physics checks on an identified model's forward runs (`amplitude_rows` at
+    `values`): every model amplitude finite; a rotation within the angle where linear
+    hydrodynamics hold and a heave within the body's mean draft
+    (`mbcontrol.analysis.validity`); and no fitted hydro correction that makes the model
+    create energy (a negative radiation or damping scale). {"valid", "invalid_reasons"}."""
+    from ...analysis.validity import ANGLE_MAX_RAD, DRAFT_FACTOR, _mean_draft
+    reasons = []
+    for name, value in values.items():
+        dissipative = name.endswith(("__radiation_scale", "__damping")) or "viscous" in name
+        if dissipative and value < 0:
+            reasons.append(f"{name} = {value:.4g} < 0: the model would create energy")
+    drafts = {}
+    for plant in problem._plants.values():
+        data = plant.hydro.data if plant.hydro is not None else None
+        if data is not None and "body" in data.coords:
+            drafts.update({str(b): _mean_draft(data, str(b)) for b in data["body"].values})
+    draft = min((d for d in drafts.values() if d), default=None)
+    for row in rows:
+        model, where = row["model"], f"run {row['run']}, channel {row['channel']}"
+        if not np.isfinite(model):
+            reasons.append(f"{where}: the model's amplitude is not finite")
+        elif row["unit"] == "rad" and model > ANGLE_MAX_RAD:
+            reasons.append(f"{where}: model amplitude {np.degrees(model):.3g} deg beyond "
+                           f"{np.degrees(ANGLE_MAX_RAD):.0f} deg (linear hydrodynamics)")
+        elif (row["unit"] == "m" and "heave" in row["channel"].lower() and draft
+              and model > DRAFT_FACTOR * draft):
+            reasons.append(f"{where}: model amplitude {model:.3g} m beyond the mean draft "
+                           f"{draft:.3g} m (linear hydrodynamics)")
+    return {"valid": not reasons, "invalid_reasons": reasons}
+
+
 def summary(model: str, problem, result, fit_rows, validation_rows=None) -> dict:
-    """The JSON contract of `mbcontrol identify --json`."""
+    """The JSON contract of `mbcontrol identify --json`; "valid" and "invalid_reasons" check
+    the fitted model's forward runs (`forward_validity`) on the fit and validation runs."""
+    verdict = forward_validity(problem, result.values, fit_rows + (validation_rows or []))
     params = {}
     for p in problem.fit:
         params[p.name] = {"initial": p.initial, "value": result.values[p.name],
                           "std": result.std.get(p.name), "lo": p.lo, "hi": p.hi}
     return jsonable({
-        "model": model, "method": result.method, "cost": problem.cost,
+        "model": model, "valid": verdict["valid"], "invalid_reasons": verdict["invalid_reasons"],
+        "method": result.method, "cost": problem.cost,
         "parameters": params, "correlation": np.asarray(result.correlation).tolist(),
         "fit": errors_block(fit_rows),
         "validation": errors_block(validation_rows) if validation_rows else None,

@@ -3,12 +3,14 @@ scene parameters, closed loop, serially or on Dask, resumable from a store on di
 matrices, capture widths, annual energy at a site.
 
 Modules: `cases` (seas, grids, the seas CSV, cases and their keys), `store` (records on disk,
-the assembled Dataset), `runner` (serial and Dask execution), `power` (energy flux, annual
-energy, power matrix, NDBC spectra and occurrence tables), `study` (`sweep`), `plots`.
+the assembled Dataset), `runner` (serial and Dask execution), `power` (power matrix),
+`study` (`sweep`), `plots`. The seas, energy flux, annual energy, NDBC spectra and occurrence
+tables are `mbcontrol.waves`' (re-exported here).
 """
-from .cases import SeaState, grid, read_seas
-from .power import annual_energy_MWh, energy_flux, occurrence, power_matrix
+from ...waves import (SeaState, annual_energy_MWh, energy_flux, grid, occurrence, read_seas,
+                     site_energy_flux)
+from .power import power_matrix
 from .study import sweep
 
 __all__ = ["sweep", "SeaState", "grid", "read_seas", "energy_flux", "annual_energy_MWh",
-           "power_matrix", "occurrence"]
+           "power_matrix", "occurrence", "site_energy_flux"]

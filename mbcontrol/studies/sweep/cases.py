@@ -5,93 +5,15 @@ store on disk knows which cases it already holds.
 """
 from __future__ import annotations
 
-import csv
 import hashlib
 import itertools
 import json
-import math
 from dataclasses import asdict, dataclass, field
-from pathlib import Path
 
-import numpy as np
-
-WEIGHT_SUM_TOLERANCE = 0.02        # a weighted list's weights must sum to 1 within this
-
-
-@dataclass(frozen=True)
-class SeaState:
-    """A JONSWAP sea: significant height hs (m), peak period tp (s), peak enhancement gamma,
-    and its weight (share of the year; NaN on a grid that carries no occurrence)."""
-    hs: float
-    tp: float
-    gamma: float = 3.3
-    weight: float = math.nan
-    te: float = math.nan                 # energy period (s), when the source gave it
-
-
-def grid(hs, tp, gamma: float = 3.3) -> list[SeaState]:
-    """Every Hs with every Tp, unweighted."""
-    return [SeaState(float(h), float(t), gamma) for h in hs for t in tp]
-
-
-def te_over_tp(gamma: float) -> float:
-    """Te / Tp of a JONSWAP spectrum (m_-1 / m_0 over the peak period), by quadrature."""
-    from ...waves import jonswap_spectrum
-    w = np.geomspace(0.2, 50.0, 40001)           # in units of the peak frequency (Tp = 2 pi)
-    s = jonswap_spectrum(w, 1.0, 2 * math.pi, gamma)
-    return float(np.trapezoid(s / w, w) / np.trapezoid(s, w))
-
-
-def read_seas(path, gamma: float = 3.3) -> list[SeaState]:
-    """Sea states from a CSV with columns Hm0 and Tp (or Te: Tp = Te / (Te/Tp of the JONSWAP
-    spectrum)) and optional weights (summing to 1). Errors name the file, row and column."""
-    path = Path(path)
-    try:
-        with path.open(newline="") as fh:
-            rows = list(csv.DictReader(fh))
-    except OSError as exc:
-        raise ValueError(f"{path}: cannot read the seas file ({exc.strerror})") from None
-    if not rows:
-        raise ValueError(f"{path}: no sea states (expected a header with Hm0 and Tp or Te, "
-                         f"then one row per sea)")
-    columns = set(rows[0])
-    period = "Tp" if "Tp" in columns else "Te" if "Te" in columns else None
-    if "Hm0" not in columns or period is None:
-        raise ValueError(f"{path}: expected columns Hm0 and Tp (or Te), found "
-                         f"{', '.join(sorted(c for c in columns if c))}")
-    ratio = te_over_tp(gamma)
-    seas = []
-    for i, row in enumerate(rows, start=2):              # row 1 is the header
-        values = {}
-        for name in ("Hm0", period, "weights", "Te"):
-            text = (row.get(name) or "").strip()
-            if name in ("weights", "Te") and not text:
-                continue
-            try:
-                values[name] = float(text)
-            except ValueError:
-                raise ValueError(f"{path}: row {i}, column {name}: expected a number, got "
-                                 f"{text!r}") from None
-        for name in ("Hm0", period):
-            if not values[name] > 0 or not math.isfinite(values[name]):
-                raise ValueError(f"{path}: row {i}, column {name}: expected a positive "
-                                 f"number, got {values[name]:g}")
-        if values.get("weights", 0.0) < 0:
-            raise ValueError(f"{path}: row {i}, column weights: expected >= 0, got "
-                             f"{values['weights']:g}")
-        tp = values[period] if period == "Tp" else values[period] / ratio
-        seas.append(SeaState(values["Hm0"], tp, gamma, values.get("weights", math.nan),
-                             values.get("Te", math.nan)))
-    weights = [s.weight for s in seas]
-    if "weights" in columns:
-        if any(math.isnan(w) for w in weights):
-            row = 2 + next(k for k, w in enumerate(weights) if math.isnan(w))
-            raise ValueError(f"{path}: row {row}, column weights: missing (every row needs one)")
-        total = sum(weights)
-        if abs(total - 1.0) > WEIGHT_SUM_TOLERANCE:
-            raise ValueError(f"{path}: weights sum to {total:.4g}; expected 1 within "
-                             f"{WEIGHT_SUM_TOLERANCE} (shares of the year)")
-    return seas
+# The seas themselves (SeaState, grids, the site CSV, Te/Tp) live in the waves package;
+# re-exported here so that `from mbcontrol.studies.sweep.cases import SeaState` keeps working.
+from ...waves.sites import WEIGHT_SUM_TOLERANCE, SeaState, grid, read_seas  # noqa: F401
+from ...waves.spectra import te_over_tp  # noqa: F401
 
 
 @dataclass(frozen=True)
@@ -111,10 +33,14 @@ class Case:
     dt: float = 0.05
     method: str = "rk4"
     roles: dict = field(default_factory=dict, compare=False)   # varied name -> its kind
+    inputs: tuple = ()                  # content hashes of what made the plant ((name, sha), ...)
 
     @property
     def key(self) -> str:
-        """A hash of everything that decides the result (not of where it sits in the grid)."""
+        """A hash of everything that decides the result (not of where it sits in the grid):
+        the case's settings and the content of its inputs (scene, hydro data, radiation fit,
+        package version; `mbcontrol.plant.provenance`), so an edited scene never reuses a
+        stored result."""
         record = {k: v for k, v in asdict(self).items() if k not in ("index", "roles")}
         text = json.dumps(record, sort_keys=True, default=float)
         return hashlib.sha256(text.encode()).hexdigest()[:20]
@@ -129,9 +55,11 @@ class Case:
 
 def build_cases(model: str, seas, *, seeds: int = 1, vary: dict | None = None, roles=None,
                 params=None, scene_params=None, controller=None, settings=None,
-                duration: float = 600.0, dt: float = 0.05, method: str = "rk4") -> list[Case]:
+                duration: float = 600.0, dt: float = 0.05, method: str = "rk4",
+                inputs: dict | None = None) -> list[Case]:
     """Every sea x seed x combination of the varied values. roles: varied name -> "param",
-    "scene" or "setting" (see `roles_for`)."""
+    "scene" or "setting" (see `roles_for`); inputs: the plant's provenance (content hashes),
+    part of every case's key."""
     vary = dict(vary or {})
     names = list(vary)
     cases = []
@@ -143,7 +71,7 @@ def build_cases(model: str, seas, *, seeds: int = 1, vary: dict | None = None, r
                           tuple(sorted((params or {}).items())),
                           tuple(sorted((scene_params or {}).items())), controller,
                           tuple(sorted((settings or {}).items())), float(duration), float(dt),
-                          method, dict(roles or {})))
+                          method, dict(roles or {}), tuple(sorted((inputs or {}).items()))))
     return cases
 
 

@@ -7,6 +7,19 @@ import numpy as np
 from .power import power_matrix
 
 
+def _invalid_cells(ds, table, period: str) -> dict:
+    """(row, column) of the power matrix -> how many of its cases failed their checks."""
+    if "valid" not in ds:
+        return {}
+    bad = (~ds["valid"]).sum([d for d in ds["valid"].dims if d != "sea"]).values
+    cells = {}
+    for k in np.flatnonzero(bad):
+        i = int(np.searchsorted(table.hs.values, ds["hs"].values[k]))
+        j = int(np.searchsorted(table[period].values, round(float(ds[period].values[k]), 9)))
+        cells[(i, j)] = int(bad[k])
+    return cells
+
+
 def plot_sweep(ds, summary: dict, path=None):
     """Three panels (power matrix, capture width, annual energy by sea); returns the figure,
     written to path when given."""
@@ -27,10 +40,19 @@ def plot_sweep(ds, summary: dict, path=None):
             for (i, j), v in np.ndenumerate(table.values):
                 if np.isfinite(v):
                     ax.text(j, i, f"{v:.3g}", ha="center", va="center", fontsize=6, color="w")
+        invalid = _invalid_cells(ds, table, period)
+        for (i, j), n in invalid.items():        # failed physics checks: shown, never averaged
+            ax.add_patch(plt.Rectangle((j - 0.5, i - 0.5), 1, 1, fill=False, hatch="xx",
+                                       edgecolor="C3", lw=0))
+            ax.text(j, i - 0.3, f"{n} invalid", ha="center", va="center", fontsize=5,
+                    color="C3")
         fig.colorbar(image, ax=ax, label="mean power, kW")
         ax.set_xlabel("Tp, s")
         ax.set_ylabel("Hs, m")
-        ax.set_title(f"{ds.attrs.get('model')}: power matrix")
+        n_bad = summary.get("invalid_cases", 0)
+        ax.set_title(f"{ds.attrs.get('model')}: power matrix"
+                     + (f"\n{n_bad} invalid cases left out (hatched)" if n_bad else ""),
+                     fontsize=10)
     except ValueError as exc:                       # other quantities varied: no single table
         axes[0].text(0.5, 0.5, str(exc), ha="center", va="center", wrap=True, fontsize=8)
         axes[0].set_axis_off()

@@ -6,15 +6,25 @@ worker builds a plant once (its compiled code comes from the on-disk cache) and 
 group through it. Records are written by the calling process as tasks finish, so a killed
 sweep keeps what finished; a worker that dies loses its task in flight, which the scheduler
 runs again elsewhere. Both paths run the same function on the same cases: identical numbers.
+
+Light cases (rm3 for an hour at dt 0.05 s: 21 ms of stepping) are dominated by what surrounds
+the stepping, so a case without a controller skips the Dataset (`sim.light`), and a local
+cluster is started only when the sweep is long enough to pay for it (`execute`); on Linux
+its workers are forked from this process (imports, plant and compiled code inherited).
 """
 from __future__ import annotations
 
 import math
 import os
+import sys
 import time
 from collections import defaultdict
 
 _PLANTS: dict = {}
+# The last light run of this process, kept until the next one has its arrays: freed at once,
+# a run's records (35 MB for rm3 over an hour) top glibc's heap and go back to the kernel, and
+# the next case faults them in again page by page (rm3: 4,300 page faults, 12 ms of 70 a case)
+_LAST_RUN: list = []
 FAULT_ENV = "MBCONTROL_SWEEP_FAULT"     # test hook: "exit-after:N" (the sweep process) or
                                         # "kill-worker-once:PATH" (a worker, once)
 
@@ -32,20 +42,23 @@ def _plant(model: str, scene_params: tuple):
 def run_case(case) -> dict:
     """Simulate one case in closed loop and measure it: {"case": key, "metrics": {name:
     value} (per PTO `<pto>__<metric>` as `mbcontrol.analysis.metrics.pto_metrics`, and the
-    totals mean_power_W, mean_electrical_power_W), "wall_time_s"}."""
+    totals mean_power_W, mean_electrical_power_W), "valid", "invalid_reasons",
+    "wall_time_s"} (`case_record`). A case without a controller on a fixed-step method runs
+    through `mbcontrol.sim.light.simulate_arrays` (the arrays its metrics need, no Dataset),
+    any other through `simulate`; both give the same record to rounding."""
     import inspect
 
     from mbcontrol.controllers import REGISTRY, make
 
     from ... import waves
-    from ...analysis import summary
-    from ...sim import simulate
+    from ...sim import light, simulate
     params, scene_params, settings = case.resolved()
     plant = _plant(case.model, tuple(sorted(scene_params.items())))
     sea = case.sea
     headings = plant.hydro.data["wave_direction"].values
+    omega = plant.hydro.omega
     wave = waves.irregular(sea.hs, sea.tp, gamma=sea.gamma, seed=case.seed,
-                           duration=case.duration, band=_band(plant, sea.tp),
+                           duration=case.duration, data_band=(float(omega[0]), float(omega[-1])),
                            direction=float(headings[0]) if len(headings) == 1 else 0.0)
     controller = None
     if case.controller:
@@ -54,29 +67,37 @@ def run_case(case) -> dict:
             settings.setdefault("wave", wave)
         controller = make(case.controller, **settings)
     start = time.perf_counter()
-    ds = simulate(plant, wave, duration=case.duration, dt=case.dt, controller=controller,
-                  method=case.method, params=params or None)
-    result = summary(ds, plant)
+    if light.can_run(plant, controller, case.method):
+        run = light.simulate_arrays(plant, wave, duration=case.duration, dt=case.dt,
+                                    method=case.method, params=params or None)
+        _LAST_RUN[:] = [run]     # the previous run is let go only now (see _LAST_RUN)
+    else:
+        run = simulate(plant, wave, duration=case.duration, dt=case.dt, controller=controller,
+                       method=case.method, params=params or None)
+    return case_record(case, plant, wave, run, start)
+
+
+def case_record(case, plant, wave, run, start: float) -> dict:
+    """A case's record from its run: `run` is a Dataset from `simulate` or a Run from
+    `simulate_arrays` (both read as run[name].values and run.attrs), `start` the
+    perf_counter at the start of its simulation. The one place a record is made: metrics
+    (every numeric entry of `pto_metrics` per PTO, `<pto>__<key>`, and the totals), the
+    validity verdict (`mbcontrol.analysis.validity.assess` on the run and its wave)."""
+    from ...analysis.metrics import pto_metrics
+    from ...analysis.validity import assess
+    from ...results import jsonable
+    ptos = {pto.name: jsonable(pto_metrics(run, pto)) for pto in plant.scene.ptos}
     metrics = {}
-    for pto, m in result.get("ptos", {}).items():
+    for pto, m in ptos.items():
         for k, v in m.items():
-            if isinstance(v, (int, float)) and v is not None:
+            if isinstance(v, (int, float)) and not isinstance(v, bool):
                 metrics[f"{pto}__{k}"] = float(v)
-    ptos = result.get("ptos", {})
     metrics["mean_power_W"] = sum(m["mean_power_W"] for m in ptos.values())
     metrics["mean_electrical_power_W"] = sum(m["mean_electrical_power_W"] for m in ptos.values())
-    return {"case": case.key, "metrics": metrics, "wall_time_s": time.perf_counter() - start}
-
-
-def _band(plant, tp: float):
-    """The spectrum's band (multiples of the peak frequency) kept inside the hydro data."""
-    omega = plant.hydro.omega
-    wp = 2 * math.pi / tp
-    lo, hi = max(0.3, float(omega[0]) / wp), min(4.0, float(omega[-1]) / wp)
-    if not lo < hi:
-        raise ValueError(f"a sea with Tp {tp:g} s lies outside {plant.name}'s hydro data "
-                         f"({float(omega[0]):.3g}-{float(omega[-1]):.3g} rad/s)")
-    return (lo, hi)
+    verdict = assess(run, plant, wave, mean_power_W=metrics["mean_power_W"])
+    return {"case": case.key, "metrics": metrics, "valid": verdict["valid"],
+            "invalid_reasons": verdict["invalid_reasons"],
+            "wall_time_s": time.perf_counter() - start}
 
 
 def run_group(cases) -> list[dict]:
@@ -101,11 +122,37 @@ def groups(cases, per_task: int) -> list[list]:
     return out
 
 
+# A local cluster's fixed costs (start, close; s) by how its workers start, measured on 2
+# cores with rm3. "spawn": fresh interpreters (LocalCluster of 2 processes 1.3-1.5 s, then
+# each worker's imports, plant and compiled code 1.6-2.6 s; closing 0.5-1.4 s). "fork":
+# copies of this process, its imports, plants and loaded code included (0.13-0.31 s to start,
+# 0.03-0.05 s to close); taken while this process is idle, so that no thread of ours is
+# inside a library when it is copied. A sweep starts a cluster only when its cases, timed
+# here, would take longer serially (`_cluster_pays`).
+CLUSTER_COSTS = {"spawn": (3.0, 1.0), "fork": (0.5, 0.2)}
+CLOSE_MARGIN = 1.5          # the close counted 1.5 times: what the estimate leaves for noise
+CLUSTER_ENV = "MBCONTROL_SWEEP_CLUSTER"   # "always": start the local cluster whatever it costs
+START_ENV = "MBCONTROL_SWEEP_START"       # "fork" (the default on Linux) or "spawn"
+# Dask starts workers with MALLOC_TRIM_THRESHOLD_=65536, which also turns off glibc's
+# adaptive mmap threshold: every array over 128 kB is then fresh pages from the kernel, and a
+# light case's NumPy work (records of 72,000 samples) ran 2-3x slower on a worker than here
+# (rm3: 400 against 250 ms a case with its checks, 170 against 155 ms with these). These are
+# the adaptive threshold's own limits, fixed: big arrays reuse the heap, as in this process.
+WORKER_MALLOC = {"MALLOC_MMAP_THRESHOLD_": 1 << 25, "MALLOC_TRIM_THRESHOLD_": 1 << 26}
+
+
 def execute(cases, store, *, workers: int | None = None, scheduler: str | None = None,
             progress: bool = True, per_task: int | None = None) -> dict:
     """Run the cases the store lacks; workers=0 runs serially in this process, None or N
     on a local Dask cluster of N workers (default: one per core), scheduler an address.
-    Returns {"computed", "reused", "wall_time_s"}."""
+
+    A local cluster is started only when it pays: the first cases run here, timed; when the
+    rest would finish sooner serially than with the cluster's start and close
+    (CLUSTER_COSTS), they run here too (a small or light sweep, or one worker). Workers are
+    forked from this process on Linux (MBCONTROL_SWEEP_START=spawn for fresh interpreters,
+    which start in the background while this process keeps running cases). Same cases, same
+    function, same numbers wherever a case runs. Returns {"computed", "reused", "wall_time_s", "where"}: "serial",
+    "cluster" or "scheduler"."""
     todo = [c for c in cases if not store.has(c.key)]
     reused = len(cases) - len(todo)
     start = time.perf_counter()
@@ -123,38 +170,157 @@ def execute(cases, store, *, workers: int | None = None, scheduler: str | None =
             if stop_after is not None and done >= stop_after:
                 os._exit(9)                # the sweep process is killed part-way
 
-    if todo and workers == 0 and scheduler is None:
-        for group in groups(todo, per_task or len(todo)):
-            for case in group:
-                save([run_case(case)])
-    elif todo:
-        _on_dask(todo, save, workers, scheduler, per_task)
+    where = "serial"
+    queue = [c for group in groups(todo, len(todo) or 1) for c in group]   # a plant at a time
+    if queue and scheduler is not None:
+        from dask.distributed import Client
+        client = Client(scheduler)
+        try:
+            _on_dask(queue, save, client, per_task)
+        finally:
+            client.close()
+        where = "scheduler"
+    elif queue and workers != 0:
+        n = workers or os.cpu_count() or 1
+        where = _local(queue, save, n, per_task)
+    for case in queue:                     # serial, or what the local path left here
+        save([run_case(case)])
+    queue.clear()
     if bar is not None:
         bar.close()
-    return {"computed": len(todo), "reused": reused, "wall_time_s": time.perf_counter() - start}
+    return {"computed": len(todo), "reused": reused, "wall_time_s": time.perf_counter() - start,
+            "where": where}
 
 
-def _on_dask(todo, save, workers, scheduler, per_task) -> None:
-    from dask.distributed import Client, LocalCluster, as_completed
-    if scheduler:
-        client = Client(scheduler)
-        cluster = None
-    else:
-        n = workers or os.cpu_count() or 1
-        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                               dashboard_address=None, silence_logs=40)
-        client = Client(cluster)
+def _start_method() -> str:
+    chosen = os.environ.get(START_ENV, "")
+    if chosen in CLUSTER_COSTS:
+        return chosen
+    return "fork" if sys.platform.startswith("linux") else "spawn"
+
+
+def _cluster_pays(serial_s: float, n_workers: int, method: str = "spawn") -> bool:
+    """Whether n local workers started by `method` finish `serial_s` of work (as timed here)
+    sooner than this process: spawned workers start while this process keeps working, forked
+    ones while it waits; then the rest is shared."""
+    if n_workers < 2:
+        return False
+    start, close = CLUSTER_COSTS[method]
+    rest = max(0.0, serial_s - start) if method == "spawn" else serial_s
+    return start + rest / n_workers + CLOSE_MARGIN * close < serial_s
+
+
+def _local(queue: list, save, n: int, per_task) -> str:
+    """Run `queue` (emptied) on a local cluster of n workers when it pays, else leave it to
+    the caller's serial loop. Returns where the cases ran."""
+    forced = (os.environ.get(CLUSTER_ENV) == "always"
+              or os.environ.get(FAULT_ENV, "").startswith("kill-worker-once:"))
+    method = _start_method()
+    if not forced:
+        timed = []
+        while queue and len(timed) < 2:    # the first pays one-off costs (code, caches)
+            t0 = time.perf_counter()
+            save([run_case(queue.pop(0))])
+            timed.append(time.perf_counter() - t0)
+        if not queue or not _cluster_pays(min(timed) * len(queue), n, method):
+            return "serial"
+    first = queue[0]
+    starter = _ClusterStarter(n, (first.model, tuple(sorted(first.resolved()[1].items())),
+                                  int(round(first.duration / first.dt)), first.method), method)
+    starter.start()
     try:
-        n_workers = max(1, len(client.scheduler_info()["workers"]))
-        size = per_task or max(1, math.ceil(len(todo) / (4 * n_workers)))
-        tasks = groups(todo, size)
-        futures = [client.submit(run_group, g, pure=False, retries=2) for g in tasks]
-        for future in as_completed(futures):
-            save(future.result())
+        while queue and not forced and method == "spawn" and not starter.ready.is_set():
+            save([run_case(queue.pop(0))])  # while the workers start: nothing waits
+        starter.join()
+        if starter.error is not None:
+            import warnings
+            warnings.warn(f"sweep: the local Dask cluster did not start ({starter.error}); "
+                          f"running the remaining {len(queue)} cases here", RuntimeWarning,
+                          stacklevel=3)
+            return "serial"
+        if not queue:                       # this process finished them while it started
+            return "serial"
+        _on_dask(queue, save, starter.client, per_task)
+        return "cluster"
     finally:
-        client.close()
-        if cluster is not None:
-            cluster.close()
+        starter.join()
+        starter.close()
+
+
+class _ClusterStarter:
+    """A LocalCluster of n single-threaded worker processes, started by `method` ("spawn" or
+    "fork") on a thread (each worker's plant built and its compiled code loaded), so the
+    caller can keep computing."""
+
+    def __init__(self, n: int, warm: tuple, method: str = "spawn"):
+        import threading
+        self.n, self.warm, self.method = n, warm, method
+        self.cluster = self.client = self.error = None
+        self.ready = threading.Event()
+        self._thread = threading.Thread(target=self._run, name="sweep-cluster", daemon=True)
+
+    def start(self):
+        self._thread.start()
+
+    def join(self):
+        self._thread.join()
+
+    def _run(self):
+        try:
+            import dask
+            from dask.distributed import Client, LocalCluster
+            config = {f"distributed.nanny.pre-spawn-environ.{k}": v
+                      for k, v in WORKER_MALLOC.items()}
+            config["distributed.worker.multiprocessing-method"] = self.method
+            with dask.config.set(config):       # a worker restarted later is spawned
+                self.cluster = LocalCluster(n_workers=self.n, threads_per_worker=1,
+                                            processes=True, dashboard_address=None,
+                                            silence_logs=40)
+            self.client = Client(self.cluster)
+            self.client.run(_warm, *self.warm)
+        except Exception as exc:           # reported by the caller, which runs on serially
+            self.error = exc
+        finally:
+            self.ready.set()
+
+    def close(self):
+        if self.client is not None:
+            self.client.close()
+        if self.cluster is not None:
+            self.cluster.close()
+
+
+def _warm(model: str, scene_params: tuple, n_steps: int, method: str) -> None:
+    """On a worker: import what a case uses (the checks' control and scipy: ~1 s), build the
+    plant and load its compiled stepping and output code, before cases come."""
+    import numpy as np
+
+    import mbcontrol.controllers  # noqa: F401
+
+    from ...analysis import metrics, validity  # noqa: F401
+    from ...sim import integrators
+    plant = _plant(model, scene_params)
+    if integrators.method(method).fixed_step:
+        integrators.prepare(plant, n_steps, method)
+        rows = n_steps + 1
+        integrators.outputs(plant, np.zeros((rows, plant.nx)),
+                            np.zeros((rows, len(plant.inputs))),
+                            np.zeros((rows, len(plant.disturbances))), plant.p0)
+
+
+def _on_dask(queue: list, save, client, per_task) -> None:
+    """Run `queue` (emptied) on a Dask client's workers, in tasks of a plant's cases: by
+    default an eighth of each worker's share (at least one case; 13 light rm3 cases, ~1 s, in
+    a 200-case sweep on 2 workers), so a task amortises its scheduling (milliseconds) and the
+    last tasks still balance."""
+    from dask.distributed import as_completed
+    todo = list(queue)
+    queue.clear()
+    n_workers = max(1, len(client.scheduler_info()["workers"]))
+    size = per_task or max(1, math.ceil(len(todo) / (8 * n_workers)))
+    futures = [client.submit(run_group, g, pure=False, retries=2) for g in groups(todo, size)]
+    for future in as_completed(futures):
+        save(future.result())
 
 
 def _exit_after():

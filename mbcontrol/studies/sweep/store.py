@@ -14,14 +14,24 @@ import numpy as np
 import xarray as xr
 
 
-class CaseStore:
-    """The folder of case records; None as folder keeps them in memory only."""
+PROVENANCE_FILE = "provenance.json"
 
-    def __init__(self, folder=None):
+
+class CaseStore:
+    """The folder of case records; None as folder keeps them in memory only.
+
+    inputs: what made the plant (`mbcontrol.plant.provenance`: model, package version,
+    content hashes of the scene, hydro data and radiation fit). A store remembers the inputs
+    it was made from (`<store>/provenance.json`) and refuses others: its records would be
+    of another device (case keys include the hashes too, so nothing is ever mixed)."""
+
+    def __init__(self, folder=None, inputs: dict | None = None):
         self.folder = Path(folder) / "cases" if folder is not None else None
         self._memory: dict = {}
         if self.folder is not None:
             self.folder.mkdir(parents=True, exist_ok=True)
+            if inputs is not None:
+                _check_inputs(Path(folder), inputs)
 
     def has(self, key: str) -> bool:
         return key in self._memory or (self.folder is not None
@@ -31,10 +41,7 @@ class CaseStore:
         self._memory[key] = record
         if self.folder is None:
             return
-        fd, tmp = tempfile.mkstemp(dir=self.folder, suffix=".tmp")
-        with os.fdopen(fd, "w") as fh:
-            json.dump(record, fh, default=_number)
-        os.replace(tmp, self.folder / f"{key}.json")
+        _write_json(self.folder / f"{key}.json", record)
 
     def read(self, key: str) -> dict:
         if key not in self._memory:
@@ -43,6 +50,33 @@ class CaseStore:
 
     def keys_on_disk(self) -> list[str]:
         return sorted(p.stem for p in self.folder.glob("*.json")) if self.folder else []
+
+
+def _check_inputs(folder: Path, inputs: dict) -> None:
+    """Record the inputs in a new store; refuse a store made from other inputs."""
+    path = folder / PROVENANCE_FILE
+    if not path.exists():
+        _write_json(path, inputs)
+        return
+    try:
+        stored = json.loads(path.read_text())
+    except (OSError, ValueError) as exc:
+        raise ValueError(f"{path}: unreadable store provenance ({exc}); expected the JSON "
+                         f"the sweep wrote") from None
+    changed = [k for k in sorted(set(stored) | set(inputs)) if stored.get(k) != inputs.get(k)]
+    if changed:
+        detail = "; ".join(f"{k}: store {str(stored.get(k))[:16]}, now {str(inputs.get(k))[:16]}"
+                           for k in changed)
+        raise ValueError(f"{folder}: this store was made from other inputs ({detail}). Its "
+                         f"cases are not this model's: use a new --store, or delete {folder} "
+                         f"to recompute")
+
+
+def _write_json(path: Path, value) -> None:
+    fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp")
+    with os.fdopen(fd, "w") as fh:
+        json.dump(value, fh, indent=1, default=_number)
+    os.replace(tmp, path)
 
 
 def _number(value):
@@ -56,13 +90,27 @@ def assemble(cases, store: CaseStore, seas, vary: dict, seeds: int, attrs: dict)
     shape = (len(seas), seeds) + tuple(len(vary[n]) for n in names)
     records = {c.index: store.read(c.key) for c in cases}
     metrics = sorted({m for r in records.values() for m in r["metrics"]})
-    data = {}
+    dims = ("sea", "seed", *names)
+    valid = np.ones(shape, bool)
+    reasons = np.full(shape, "", dtype=object)
+    for index, r in records.items():
+        valid[index] = bool(r.get("valid", True))
+        reasons[index] = "; ".join(r.get("invalid_reasons", []))
+    data = {"valid": (dims, valid, {"long_name": "the case passed its physics checks "
+                                                 "(mbcontrol.analysis.validity)"}),
+            "invalid_reasons": (dims, reasons.astype(str))}
     for m in metrics:
         a = np.full(shape, np.nan)
+        raw = np.full(shape, np.nan)
         for index, r in records.items():
             value = r["metrics"].get(m)
-            a[index] = np.nan if value is None else float(value)
-        data[m] = (("sea", "seed", *names), a)
+            raw[index] = np.nan if value is None else float(value)
+        # an invalid case's numbers never enter a mean, matrix or annual energy: NaN here,
+        # counted in the sweep's summary; the reported values stay in <metric>__unchecked
+        a[valid] = raw[valid]
+        data[m] = (dims, a)
+        if not valid.all() and m in ("mean_power_W", "mean_electrical_power_W"):
+            data[f"{m}__unchecked"] = (dims, raw)
     coords = {"sea": np.arange(len(seas)), "seed": np.arange(seeds),
               "hs": ("sea", [s.hs for s in seas]), "tp": ("sea", [s.tp for s in seas]),
               "te": ("sea", [s.te for s in seas]), "gamma": ("sea", [s.gamma for s in seas]),

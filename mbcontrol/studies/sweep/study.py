@@ -11,8 +11,10 @@ from pathlib import Path
 
 import numpy as np
 
+from ...plant import provenance
+from ...results import jsonable
 from .cases import build_cases, roles_for
-from .power import annual_energy_MWh, energy_flux
+from ...waves import annual_energy_MWh, site_energy_flux
 from .runner import _PLANTS, execute
 from .store import CaseStore, assemble
 
@@ -45,19 +47,23 @@ def sweep(model: str, seas, *, seeds: int = 1, vary: dict | None = None, params=
     if unknown:
         raise ValueError(f"--param {unknown[0]}: not a parameter of {scene.name}; it has "
                          f"{', '.join(plant.parameters)}")
+    inputs = {"model": scene.name, **provenance(plant)}
     cases = build_cases(model, seas, seeds=seeds, vary=vary, roles=roles, params=params,
                         scene_params=scene_params, controller=controller, settings=settings,
-                        duration=duration, dt=dt, method=method)
-    case_store = CaseStore(store)
+                        duration=duration, dt=dt, method=method, inputs=inputs)
+    case_store = CaseStore(store, inputs)
     run = execute(cases, case_store, workers=workers, scheduler=scheduler, progress=progress)
     depth, rho, g = scene.water.depth, scene.water.rho, scene.water.g
+    made_by = {**inputs, "controller": controller,
+               "settings": resolved_settings(controller, settings, vary, roles)}
     attrs = {"model": scene.name, "controller": controller, "settings": dict(settings or {}),
+             "provenance": made_by,
              "params": dict(params or {}), "scene_params": dict(scene_params or {}),
              "duration_s": duration, "dt_s": dt, "method": method,
              "created": datetime.datetime.now().isoformat(timespec="seconds"),
              "metrics": "mbcontrol.analysis.metrics.pto_metrics over the record after the ramp"}
     ds = assemble(cases, case_store, seas, vary, seeds, attrs)
-    J = np.array([energy_flux(s.hs, s.tp, s.gamma, depth, rho, g) for s in seas])
+    J = np.array([site_energy_flux(s, depth, rho, g) for s in seas])   # the site's own J if given
     ds["energy_flux_W_per_m"] = ("sea", J)
     ds["capture_width_m"] = ds["mean_power_W"] / ds["energy_flux_W_per_m"]
     if width:
@@ -67,20 +73,48 @@ def sweep(model: str, seas, *, seeds: int = 1, vary: dict | None = None, params=
         from ...hydro import write_netcdf_atomic
         write_netcdf_atomic(ds, Path(store) / "sweep.nc")
     summary = _summary(ds, seas, run, time.perf_counter() - start, len(cases))
+    summary["provenance"] = made_by
     return ds, summary
+
+
+def resolved_settings(controller, settings, vary=None, roles=None) -> dict:
+    """The controller's settings as its cases run them, defaults included (its describe()
+    without run statistics; e.g. an MPC's forecast), for provenance; varied settings are
+    listed by name as "varied"."""
+    if controller is None:
+        return {}
+    import inspect
+
+    from mbcontrol.controllers import REGISTRY, make
+
+    from ...waves import regular
+    given = dict(settings or {})
+    if "wave" in inspect.signature(REGISTRY[controller]).parameters:
+        given.setdefault("wave", regular(1.0, 10.0))   # as the cases hand it a sea; its
+    try:                                                 # settings do not depend on which
+        described = make(controller, **given).describe()
+    except (TypeError, ValueError, AttributeError, KeyError):
+        described = dict(settings or {})  # a controller that describes itself only once reset
+    described = {k: v for k, v in described.items() if k not in ("stats", "name")}
+    for name, role in (roles or {}).items():
+        if role == "setting":
+            described[name] = "varied"
+    return jsonable(described)
 
 
 def _summary(ds, seas, run, wall, n_cases) -> dict:
     """The JSON contract of `mbcontrol sweep --json` (per sea: means over seeds; when other
     quantities are varied, per sea the values over them as lists in the sweep's order)."""
-    power = ds["mean_power_W"].mean("seed")
+    power = ds["mean_power_W"].mean("seed")          # over the valid seeds (invalid: NaN)
     cw = ds["capture_width_m"].mean("seed")
+    invalid = ~ds["valid"]
     rows = []
     for k, s in enumerate(seas):
         p, c = power.isel(sea=k).values, cw.isel(sea=k).values
         row = {"hs": s.hs, "tp": s.tp, "weight": None if math.isnan(s.weight) else s.weight,
                "mean_power_W": _plain(p), "capture_width_m": _plain(c),
-               "energy_flux_W_per_m": float(ds["energy_flux_W_per_m"].values[k])}
+               "energy_flux_W_per_m": float(ds["energy_flux_W_per_m"].values[k]),
+               "invalid_cases": int(invalid.isel(sea=k).sum())}
         if not math.isnan(s.te):
             row["te"] = s.te
         if "capture_width_ratio" in ds:
@@ -88,13 +122,41 @@ def _summary(ds, seas, run, wall, n_cases) -> dict:
                                                 .isel(sea=k).values)
         rows.append(row)
     weights = np.array([s.weight for s in seas])
-    weighted = aep = None
+    weighted = aep = unchecked = None
+    coverage = 1.0
+    notes = []
     if not np.any(np.isnan(weights)) and power.ndim == 1:
-        weighted = float(np.sum(weights * power.values))
-        aep = annual_energy_MWh(power.values, weights)
+        # a sea with no valid case counts as producing nothing (a device in survival mode):
+        # the annual figure is then a lower bound, said so with the share of the year it
+        # covers and the figure the failed cases would have given
+        missing = np.isnan(power.values) & (weights > 0)
+        valid_power = np.where(missing, 0.0, power.values)
+        weighted = float(np.nansum(weights * valid_power))
+        aep = annual_energy_MWh(valid_power, weights)
+        coverage = float(1.0 - weights[missing].sum())
+        raw = ds.get("mean_power_W__unchecked", ds["mean_power_W"]).mean("seed")
+        unchecked = annual_energy_MWh(raw.values, weights)
+        if missing.any():
+            notes.append(f"annual energy {aep:.4g} MWh counts {int(missing.sum())} weighted "
+                         f"seas ({100 * (1 - coverage):.3g} % of the year) with no valid case "
+                         f"as producing nothing: a lower bound; their failed cases would "
+                         f"have given {unchecked:.4g} MWh in all")
+    listed = []
+    for index in zip(*np.nonzero(invalid.values)):
+        entry = {"hs": float(ds["hs"].values[index[0]]), "tp": float(ds["tp"].values[index[0]]),
+                 "seed": int(index[1]),
+                 **{d: float(ds[d].values[i]) for d, i in zip(ds["valid"].dims[2:], index[2:])},
+                 "reasons": str(ds["invalid_reasons"].values[index])}
+        listed.append(entry)
+    if listed:
+        notes.append(f"{len(listed)} of {n_cases} cases failed their physics checks and are "
+                     f"left out of every mean, matrix and annual figure (listed in 'invalid')")
     return {"model": ds.attrs["model"], "cases": n_cases, "computed": run["computed"],
-            "reused": run["reused"], "wall_time_s": wall, "seas": rows,
-            "weighted_mean_power_W": weighted, "annual_energy_MWh": aep}
+            "reused": run["reused"], "wall_time_s": wall, "valid_cases": n_cases - len(listed),
+            "invalid_cases": len(listed), "invalid": listed, "notes": notes, "seas": rows,
+            "weighted_mean_power_W": weighted, "annual_energy_MWh": aep,
+            "annual_energy_coverage": coverage if aep is not None else None,
+            "annual_energy_unchecked_MWh": unchecked}
 
 
 def _plain(values):

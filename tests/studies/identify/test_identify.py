@@ -116,3 +116,18 @@ def test_unknown_parameter_is_named(clean_records):
     with pytest.raises(KeyError, match=r"unknown parameter\(s\) \['pto__dampin'\]"):
         Identification("sphere", runs_with_noise(clean_records, 0),
                        [FitParameter("pto__dampin", 1.0, 0.5, 2.0)], outputs={"Heave": "heave"})
+
+
+def test_forward_runs_are_checked(clean_records):
+    # the true values give the sphere's small motions (2 m waves, heave amplitudes of about a
+    # metre against a 3.3 m mean draft): valid. A negative PTO damping would create energy,
+    # and heave amplitudes beyond the draft leave linear hydrodynamics: both named
+    from mbcontrol.studies.identify.report import amplitude_rows, forward_validity
+    prob = problem(runs_with_noise(clean_records, 0))
+    rows = amplitude_rows(prob, TRUTH)
+    assert forward_validity(prob, TRUTH, rows) == {"valid": True, "invalid_reasons": []}
+    bad = forward_validity(prob, {**TRUTH, "pto__damping": -1e5},
+                           [{**row, "model": 4.0} for row in rows[:1]])
+    assert not bad["valid"]
+    text = " ".join(bad["invalid_reasons"])
+    assert "create energy" in text and "beyond the mean draft" in text

@@ -14,7 +14,7 @@ from mbcontrol.analysis import summary
 from mbcontrol.plant import build_plant
 from mbcontrol.sim import simulate
 from mbcontrol.studies.sweep import grid, sweep
-from mbcontrol.studies.sweep.runner import FAULT_ENV
+from mbcontrol.studies.sweep.runner import CLUSTER_ENV, FAULT_ENV
 
 SEAS = grid([1.0, 2.0], [8.0, 11.0])
 SHORT = dict(duration=120.0, dt=0.1, progress=False)
@@ -39,8 +39,9 @@ def test_cases_equal_separate_simulate_runs():
                 assert got == pytest.approx(expected, rel=1e-12)
 
 
-def test_serial_and_two_workers_agree():
+def test_serial_and_two_workers_agree(monkeypatch):
     serial, _ = sweep("sphere", SEAS, workers=0, **SHORT)
+    monkeypatch.setenv(CLUSTER_ENV, "always")        # too small to start one by itself
     dask, result = sweep("sphere", SEAS, workers=2, **SHORT)
     assert result["computed"] == len(SEAS)
     xr.testing.assert_identical(serial.drop_attrs(), dask.drop_attrs())

@@ -1,0 +1,139 @@
+"""The device seen from its PTOs: multiport frequency responses and the multiport
+complex-conjugate bound.
+
+Phasors of exp(-i omega t), as `analysis.bounds`. With every PTO's own damping and stiffness
+set to zero (so the PTO forces F are the whole forces the PTOs apply) and Coulomb friction
+removed, the PTO velocities are
+
+    V = Y F + H A,
+
+Y (n_pto x n_pto) the admittance from PTO forces to PTO velocities, H (n_pto) the velocities
+per unit wave amplitude with the PTOs free, A the complex wave amplitude. The mean power the
+PTOs absorb, P = -1/2 Re F^H V, is largest at F = -1/2 Y_h^-1 H A with Y_h = (Y + Y^H) / 2, and
+then P = 1/8 (H A)^H Y_h^-1 (H A) (Falnes' optimum for several oscillators; for one PTO it is
+|F_e A|^2 / (8 Re Z_i)). No set of PTO forces, causal or not, absorbs more in linear theory.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+def linear_params(plant, ptos, params=None) -> dict:
+    """Parameter overrides for linear theory seen from `ptos`: their own damping and
+    stiffness zero (the decision force is the PTO's whole force), Coulomb friction removed
+    (its smoothed slope at rest is not linear physics); `params` (dict or full vector) kept
+    for everything else."""
+    if params is not None and not isinstance(params, dict):
+        params = dict(zip(plant.parameters, np.asarray(params, float)))
+    out = dict(params or {})
+    for friction in plant.scene.frictions:
+        out[f"{friction.name}__coulomb"] = 0.0
+    for name in ptos:
+        out[f"{name}__damping"] = 0.0
+        out[f"{name}__stiffness"] = 0.0
+    return out
+
+
+def port_responses(plant, omega, ptos, direction: float = 0.0, params=None):
+    """(Y, H): admittance (n_omega, n_pto, n_pto) from PTO forces to PTO velocities (m/s per
+    N, or rad/s per N m) and free velocities per unit wave amplitude (n_omega, n_pto) (m/s
+    per m), straight from the BEM data at `omega` (rad/s). params: overrides as
+    `linear_params`; the PTOs named in `ptos` are freed."""
+    from ..waves import interpolate_complex
+    from .frequency import mechanical_matrices
+    from .linearize import jacobians
+
+    if plant.hydro is None:
+        raise ValueError(f"{plant.name}: no hydrodynamic data, so no wave excitation")
+    omega = np.atleast_1d(np.asarray(omega, float))
+    if np.any(omega <= 0):
+        raise ValueError("port_responses: frequencies must be > 0 rad/s")
+    p = plant.params(**linear_params(plant, ptos, params))
+    mech = mechanical_matrices(plant, p)
+    n_q, n_s = plant.n_q, plant.topology.tree.n_s
+    _, Bu, _, _, Du, _ = (np.asarray(J) for J in jacobians(plant)(
+        plant.x0(), np.zeros(len(plant.inputs)), np.zeros(len(plant.disturbances)), p))
+    i_u = [plant.inputs.index(f"u__{name}") for name in ptos]
+    i_v = [plant.outputs.index(f"{name}__velocity") for name in ptos]
+    if np.any(Du[np.ix_(i_v, i_u)] != 0):
+        raise ValueError(f"{plant.name}: a PTO velocity depends directly on a PTO force")
+    # generalised force of unit PTO forces: s' = M_tot^-1 (... + b u), so b = M_tot ds'/du
+    b = (mech.mass + mech.added_mass_inf) @ Bu[n_q:n_q + n_s][:, i_u]
+    c_q, c_s = mech.output_q[i_v], mech.output_s[i_v]
+    hyd, P = plant.hydro, mech.P_hydro
+    A_w, B_w = hyd.frequency_domain_matrices(omega)
+    F_exc = interpolate_complex(hyd.omega, hyd.excitation_coefficients(direction), omega)
+    n = len(ptos)
+    Y = np.empty((omega.size, n, n), complex)
+    H = np.empty((omega.size, n), complex)
+    for k, w in enumerate(omega):
+        Z = (-w**2 * (mech.mass + P @ A_w[k] @ P.T) - 1j * w * (mech.damping + P @ B_w[k] @ P.T)
+             + mech.stiffness)
+        X = np.linalg.solve(Z, np.column_stack([b, P @ F_exc[k]]))
+        V = c_q @ X + c_s @ (-1j * w * X)        # the velocity outputs' phasors
+        Y[k], H[k] = V[:, :n], V[:, n]
+    return Y, H
+
+
+@dataclass(frozen=True)
+class MultiportBound:
+    """The multiport complex-conjugate optimum of a wave: power (W, the spectral mean),
+    power_by_component (W), and the optimal PTO forces and velocities per component
+    (n_omega, n_pto; N or N m, m/s or rad/s) for windowed means (`window_mean_power`)."""
+    power: float
+    power_by_component: np.ndarray
+    omega: np.ndarray
+    force: np.ndarray
+    velocity: np.ndarray
+    ptos: tuple
+
+
+def multiport_bound(plant, wave, params=None, responses=None) -> MultiportBound:
+    """1/8 sum_k (H_k A_k)^H Y_h,k^-1 (H_k A_k) over the wave's components, every PTO free
+    (W). responses: (Y, H) at wave.omega when already computed. A PTO that sees no
+    dissipation at a frequency (Y_h singular there) makes the bound unbounded: inf."""
+    ptos = tuple(p.name for p in plant.scene.ptos)
+    Y, H = responses if responses is not None else port_responses(
+        plant, wave.omega, ptos, wave.direction, params)
+    A = np.asarray(wave.amplitude, float) * np.exp(-1j * np.asarray(wave.phase, float))
+    h = H * A[:, None]                                       # (n_omega, n_pto)
+    Yh = 0.5 * (Y + np.conj(np.swapaxes(Y, 1, 2)))
+    eig = np.linalg.eigvalsh(Yh)                             # (n_omega, n_pto), ascending
+    singular = eig[:, 0] <= 1e-12 * np.maximum(eig[:, -1], 1e-300)
+    excited = np.any(h != 0, axis=1)
+    force = np.zeros_like(h)
+    per = np.where(singular & excited, np.inf, 0.0)
+    ok = ~singular & excited
+    if ok.any():
+        solved = np.linalg.solve(Yh[ok], h[ok][..., None])[..., 0]
+        force[ok] = -0.5 * solved
+        per[ok] = 0.125 * np.real(np.sum(np.conj(h[ok]) * solved, axis=1))
+    velocity = np.einsum("kij,kj->ki", Y, force) + h
+    return MultiportBound(float(per.sum()), per, np.asarray(wave.omega, float), force,
+                          velocity, ptos)
+
+
+def window_mean_power(bound: MultiportBound, start: float, end: float) -> float:
+    """The optimal forces' mean absorbed power over [start, end] s of this realisation (W),
+    exactly: the cross terms between components that a finite record does not average out,
+    mean over the window of Re[F_j e^-iw_j t] Re[V_k e^-iw_k t] summed in closed form."""
+    w, F, V = bound.omega, bound.force, bound.velocity
+    if not np.all(np.isfinite(bound.power_by_component)):
+        return np.inf
+    T = end - start
+
+    def mean_phasor(Omega):                     # mean of exp(-i Omega t) over the window
+        out = np.ones_like(Omega, dtype=complex)
+        nz = np.abs(Omega) * T > 1e-9
+        Om = Omega[nz]
+        out[nz] = (np.exp(-1j * Om * end) - np.exp(-1j * Om * start)) / (-1j * Om * T)
+        return out
+
+    FV_diff = F @ np.conj(V).T                  # sum over PTOs of F_j conj(V_k)
+    FV_sum = F @ V.T                            # sum over PTOs of F_j V_k
+    diff = mean_phasor(w[:, None] - w[None, :])
+    total = mean_phasor(w[:, None] + w[None, :])
+    product = 0.5 * np.real(FV_diff * diff) + 0.5 * np.real(FV_sum * total)
+    return float(-product.sum())

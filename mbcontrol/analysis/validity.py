@@ -1,0 +1,272 @@
+"""Is a simulated result one a user can stake a project on? Checks against physics.
+
+Every result the toolbox reports (simulate, design, sweep, identification's forward runs) is
+checked here before it is printed, stored or averaged; a failed check marks it invalid, with
+its reasons. The checks, each independent of the time-domain model that made the numbers:
+
+1. **Power bound.** The PTOs' mean absorbed power over the metrics window may not exceed the
+   multiport complex-conjugate bound of the run's own wave (`analysis.ports`: linear theory
+   straight from the BEM data, every PTO free) by more than POWER_ALLOWANCE. When it exceeds
+   the spectral bound, the bound is recomputed for this realisation over the same window
+   (a finite record does not average the cross terms between components out: +3.5 % on
+   rm3, Hs 2 m, Tp 9 s, 600 s) and the larger is used. The allowance (10 %) covers what
+   linear theory leaves out that a nonlinear plant may show, and energy stored at the
+   window's edges; an unstable or non-causal run overshoots by orders of magnitude.
+2. **Energy balance.** Over the record, the work the PTOs absorb cannot exceed the work the
+   wave excitation did minus the mechanical energy gained: radiation (passive, from rest),
+   friction, drag and mooring damping only remove energy. ENERGY_TOLERANCE of the
+   excitation's absolute work absorbs time-discretisation error.
+3. **Validity of linear hydrodynamics.** A surface-piercing body's significant motion
+   relative to the free surface at its position (twice its standard deviation over the
+   window, the significant amplitude, as Hs / 2 is the sea's) may not exceed its mean draft
+   (in a regular wave, its amplitude) (displaced volume over waterplane area: beyond it the body leaves the water or buries
+   its deck, and constant added mass, damping and waterplane stiffness no longer describe
+   it); roll and pitch likewise within ANGLE_MAX_RAD (30 deg). The verdict is on a mean over
+   the record, so it is the typical motion that decides; a peak beyond the limit is
+   reported as a warning (with the share of time spent there), not an invalid result.
+
+`assess` works on a Dataset from `mbcontrol.sim.simulate` and writes the verdict into its
+attrs; `assess_values` works on plain numbers, for callers that keep no Dataset;
+`simulate_checked` (the package's `mbcontrol.simulate`) simulates and assesses in one call.
+"""
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+
+import numpy as np
+
+POWER_ALLOWANCE = 0.10            # share above the bound a reported mean power may reach
+ENERGY_TOLERANCE = 0.05           # of the excitation's absolute work over the record
+ANGLE_MAX_RAD = math.radians(30.0)
+DRAFT_FACTOR = 1.0                # relative heave limit in mean drafts
+
+_RESPONSES: dict = {}             # (plant id, params, direction, omega) -> (Y, H)
+
+
+def wave_of(ds):
+    """The wave a Dataset was simulated in, rebuilt from the components it records (None for
+    still water or a Dataset that does not record them)."""
+    from ..waves import Wave
+    if "wave_omega" not in ds:
+        return None
+    desc = json.loads(ds.attrs.get("wave", "{}"))
+    return Wave(desc.get("type", "components"), ds["wave_omega"].values,
+                ds["wave_amplitude"].values, ds["wave_phase"].values,
+                direction=float(desc.get("direction_rad", 0.0)),
+                ramp_time=float(desc.get("ramp_s", 0.0)),
+                d_omega=ds["wave_omega"].attrs.get("d_omega"))
+
+
+def power_bound(plant, wave, params, window=None) -> dict:
+    """{"bound_W": spectral multiport bound, "window_bound_W": the same over `window` (s)
+    for this realisation, or None when not asked}. Cached per plant, parameters, direction
+    and frequency grid (seeds of one sea share it)."""
+    from .ports import multiport_bound, port_responses, window_mean_power
+    p = np.asarray(params, float)
+    key = (id(plant), p.tobytes(), float(wave.direction), np.asarray(wave.omega).tobytes())
+    if key not in _RESPONSES:
+        if len(_RESPONSES) > 256:
+            _RESPONSES.clear()
+        names = [pto.name for pto in plant.scene.ptos]
+        _RESPONSES[key] = port_responses(plant, wave.omega, names, wave.direction,
+                                         dict(zip(plant.parameters, p)))
+    bound = multiport_bound(plant, wave, responses=_RESPONSES[key])
+    out = {"bound_W": bound.power, "window_bound_W": None}
+    if window is not None:
+        out["window_bound_W"] = window_mean_power(bound, *window)
+    return out
+
+
+def assess_values(plant, wave, params, *, window, mean_power_W: float, energy=None,
+                  excursions=None) -> dict:
+    """The verdict on one run from its numbers.
+
+    window: (start, end) s of the metrics; mean_power_W: the PTOs' total mean absorbed power
+    over it (W); energy: (excitation work, PTO absorbed work, mechanical energy gained,
+    absolute excitation work) over the record (J; `energy_record`), or None (not checked);
+    excursions: per body, what `excursions` returns. Returns {"valid", "invalid_reasons",
+    "warnings", "checks"}.
+    """
+    reasons, checks = [], {"power_allowance": POWER_ALLOWANCE}
+    if wave is not None and plant.hydro is not None and plant.scene.ptos:
+        bound = power_bound(plant, wave, params)
+        allowed = (1 + POWER_ALLOWANCE) * bound["bound_W"]
+        if mean_power_W > allowed:          # a finite record may beat the spectral mean
+            bound = power_bound(plant, wave, params, window)
+            allowed = (1 + POWER_ALLOWANCE) * max(bound["bound_W"], bound["window_bound_W"])
+        checks.update(bound, allowed_power_W=allowed, mean_power_W=mean_power_W)
+        if mean_power_W > allowed:
+            reasons.append(
+                f"mean absorbed power {_watts(mean_power_W)} exceeds the complex-conjugate "
+                f"bound of its wave ({_watts(bound['bound_W'])}; allowed "
+                f"{_watts(allowed)} with {POWER_ALLOWANCE:.0%} for finite records and "
+                f"nonlinear terms): no controller can absorb that")
+    if energy is not None:
+        exc, absorbed, gained, magnitude = energy
+        slack = ENERGY_TOLERANCE * magnitude
+        checks["energy_J"] = {"excitation_work": exc, "pto_work": absorbed, "gained": gained,
+                              "tolerance": slack}
+        if absorbed > exc - gained + slack:
+            reasons.append(
+                f"energy balance: the PTOs absorbed {absorbed:.4g} J while the waves did "
+                f"{exc:.4g} J of work and the device gained {gained:.4g} J")
+    warnings = []
+    for body, e in (excursions or {}).items():
+        limits = (("relative heave", "relative_heave", e.get("relative_heave_limit_m"), "m", 1.0),
+                  ("roll", "roll", ANGLE_MAX_RAD, "deg", 180 / math.pi),
+                  ("pitch", "pitch", ANGLE_MAX_RAD, "deg", 180 / math.pi))
+        for what, key, limit, unit, scale in limits:
+            if limit is None or f"{key}_significant" not in e:
+                continue
+            limit = DRAFT_FACTOR * limit if key == "relative_heave" else limit
+            where = "beyond its mean draft" if key == "relative_heave" else "beyond"
+            if e[f"{key}_significant"] > limit:
+                reasons.append(
+                    f"body {body!r}: significant {what} {e[f'{key}_significant'] * scale:.3g} "
+                    f"{unit}, {where} ({limit * scale:.3g} {unit}): linear hydrodynamics do "
+                    f"not hold there")
+            elif e[f"{key}_max"] > limit:
+                warnings.append(
+                    f"body {body!r}: {what} peaks at {e[f'{key}_max'] * scale:.3g} {unit}, "
+                    f"{where} ({limit * scale:.3g} {unit}) {100 * e[f'{key}_share_beyond']:.2g} "
+                    f"% of the time; linear hydrodynamics are approximate there")
+    checks["excursions"] = excursions or {}
+    return {"valid": not reasons, "invalid_reasons": reasons, "warnings": warnings,
+            "checks": checks}
+
+
+def excursions(plant, ds, wave, mask) -> dict:
+    """Per body with hydro data, over the samples in `mask`: its mean draft V / A_wp
+    (relative_heave_limit_m; None for a submerged body) and, for its heave relative to the
+    free surface at its centre of buoyancy (m, surface-piercing bodies only), roll and pitch
+    (rad): the significant amplitude (2 std; in a regular wave the amplitude), the largest |value| and the share of samples
+    beyond the limit (`<key>_significant`, `<key>_max`, `<key>_share_beyond`)."""
+    if plant.hydro is None:
+        return {}
+    data = plant.hydro.data
+    if "body" not in data.coords:
+        return {}
+    t = ds["time"].values
+    out, surface = {}, {}                   # surface: elevation at a point, once per point
+    for body in map(str, data["body"].values):
+        if f"{body}__Heave" not in ds:
+            continue
+        limit = _mean_draft(data, body)
+        entry = {"relative_heave_limit_m": limit}
+        signals = {key: ds[f"{body}__{name}"].values[mask] for key, name in
+                   (("roll", "Roll"), ("pitch", "Pitch"))}
+        if limit is not None:
+            up = -(ds[f"{body}__Heave"].values[mask] - ds[f"{body}__Heave"].values[0])
+            if wave is not None:
+                cob = data["center_of_buoyancy"].sel(body=body).values
+                point = (float(cob[0]), float(cob[1]))
+                if point not in surface:
+                    surface[point] = _elevation_at(plant, wave, t, *point)[mask]
+                up = up - surface[point]
+            signals["relative_heave"] = up
+        regular = wave is not None and np.size(wave.omega) == 1
+        for key, x in signals.items():
+            bound = limit if key == "relative_heave" else ANGLE_MAX_RAD
+            # a sea's significant amplitude is 2 std (Rayleigh peaks); a regular wave's is
+            # its amplitude
+            entry[f"{key}_significant"] = float(np.max(np.abs(x)) if regular else 2 * np.std(x))
+            entry[f"{key}_max"] = float(np.max(np.abs(x)))
+            entry[f"{key}_share_beyond"] = float(np.mean(np.abs(x) > bound))
+        out[body] = entry
+    return out
+
+
+def _mean_draft(data, body: str):
+    if "waterplane_area" not in data or "displaced_volume" not in data:
+        return None
+    area = float(data["waterplane_area"].sel(body=body))
+    volume = float(data["displaced_volume"].sel(body=body))
+    if area <= 1e-6 * max(volume, 1e-12) ** (2 / 3):
+        return None                        # submerged: no waterline to leave
+    return volume / area
+
+
+def _elevation_at(plant, wave, t, x: float, y: float) -> np.ndarray:
+    """Wave elevation (m, up) at the n-frame point (x, y): the origin's components delayed
+    by the phase k (x cos beta + y sin beta), k from the dispersion relation in the scene's
+    depth."""
+    from ..waves import wavenumber
+    if x == 0.0 and y == 0.0:
+        return wave.elevation(t)
+    water = plant.scene.water
+    omega = np.atleast_1d(np.asarray(wave.omega, float))
+    k = omega ** 2 / water.g if not math.isfinite(water.depth) else np.array(
+        [wavenumber(float(w), water.depth, water.g) for w in omega])
+    shift = k * (x * math.cos(wave.direction) + y * math.sin(wave.direction))
+    return dataclasses.replace(wave, phase=np.asarray(wave.phase) - shift).elevation(t)
+
+
+def energy_record(plant, ds):
+    """(excitation work, PTO absorbed work, mechanical energy gained, |excitation| work) over
+    the whole record (J), or None when the plant's energy is not audited (catenary)."""
+    from .metrics import step_power
+    col = set(ds.data_vars)
+    if "energy" not in col or "excitation_power" not in col or any(
+            m.kind == "catenary" for m in plant.scene.moorings):
+        return None
+    t = ds["time"].values
+    p_exc = ds["excitation_power"].values
+    exc = float(np.trapezoid(p_exc, t))
+    magnitude = float(np.trapezoid(np.abs(p_exc), t))
+    absorbed = 0.0
+    for pto in plant.scene.ptos:
+        t_k, p_k = step_power(ds, pto.name)
+        absorbed += float(np.sum(p_k * np.diff(t)))
+    gained = float(ds["energy"].values[-1] - ds["energy"].values[0])
+    return exc, absorbed, gained, magnitude
+
+
+def assess(ds, plant, wave=None, *, mean_power_W: float | None = None) -> dict:
+    """Check a simulated Dataset (see the module doc); the verdict goes into ds.attrs
+    ("valid": 1/0, "invalid_reasons" and "validity" as JSON) and is returned. mean_power_W:
+    the PTOs' total over the metrics window when the caller has it already (W)."""
+    from .metrics import analysis_window, pto_metrics
+    wave = wave if wave is not None else wave_of(ds)
+    mask = analysis_window(ds)
+    t = ds["time"].values[mask]
+    power = mean_power_W if mean_power_W is not None else sum(
+        pto_metrics(ds, pto)["mean_power_W"] for pto in plant.scene.ptos)
+    params = np.array([json.loads(ds.attrs["parameters"])[name] for name in plant.parameters])
+    verdict = assess_values(plant, wave, params, window=(float(t[0]), float(ds["time"][-1])),
+                            mean_power_W=power, energy=energy_record(plant, ds),
+                            excursions=excursions(plant, ds, wave, mask))
+    mark(ds, verdict)
+    return verdict
+
+
+def simulate_checked(plant, wave=None, **options):
+    """`mbcontrol.sim.simulate`, then `assess`: the Dataset carries its verdict in its attrs
+    ("valid", "invalid_reasons", "validity"), and an invalid result warns (RuntimeWarning)
+    with its reasons. The entry point `mbcontrol.simulate` is this function."""
+    import warnings
+
+    from ..sim import simulate
+    ds = simulate(plant, wave, **options)
+    verdict = assess(ds, plant, wave)
+    if not verdict["valid"]:
+        warnings.warn(f"{plant.name}: the result failed its physics checks: "
+                      + "; ".join(verdict["invalid_reasons"]), RuntimeWarning, stacklevel=2)
+    return ds
+
+
+def mark(ds, verdict: dict) -> None:
+    """Write a verdict into a Dataset's attrs."""
+    from ..results import jsonable
+    ds.attrs["valid"] = int(verdict["valid"])
+    ds.attrs["invalid_reasons"] = json.dumps(verdict["invalid_reasons"])
+    ds.attrs["validity_warnings"] = json.dumps(verdict.get("warnings", []))
+    ds.attrs["validity"] = json.dumps(jsonable(verdict["checks"]))
+
+
+def _watts(value: float) -> str:
+    for scale, unit in ((1e6, "MW"), (1e3, "kW"), (1.0, "W")):
+        if abs(value) >= scale:
+            return f"{value / scale:.4g} {unit}"
+    return f"{value * 1e3:.4g} mW"

@@ -1,0 +1,174 @@
+"""Wave realisations: regular waves, irregular seas with seeded random phases, measured records;
+and the one rule that keeps a spectrum's components inside a band (`band_limits`).
+
+Convention (as the hydro data, `exp(-i omega t)`): a wave of components (omega_i, a_i, phi_i)
+has the elevation at the n-frame origin eta(t) = sum a_i cos(omega_i t + phi_i) (m, positive
+up) and the excitation F(t) = Re sum a_i F_hat(omega_i) exp(-i(omega_i t + phi_i)), with F_hat
+the excitation per unit amplitude from the hydro data. Irregular seas use a uniform frequency
+grid d_omega = 2 pi / T_repeat, so a record shorter than T_repeat never repeats and the series
+is synthesised exactly with one FFT.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .spectra import jonswap_spectrum
+from .synthesis import _synthesise, ramp
+
+DEFAULT_BAND = (0.3, 4.0)       # an irregular sea's components: 0.3 to 4 times the peak frequency
+
+
+@dataclass(frozen=True)
+class Wave:
+    """A sum of regular components: frequencies (rad/s), amplitudes (m), phases (rad)."""
+    kind: str                                    # "regular" | "jonswap" | "pm" | "components"
+    omega: np.ndarray
+    amplitude: np.ndarray
+    phase: np.ndarray
+    direction: float = 0.0                       # rad, NED: travelling towards +x, +y starboard
+    ramp_time: float = 0.0                       # s, half-cosine ramp from zero
+    settings: dict = field(default_factory=dict)  # what made it (for provenance), incl. seed
+    d_omega: float | None = None                 # uniform grid spacing, when on one
+
+    def elevation(self, t) -> np.ndarray:
+        """Wave elevation at the n-frame origin (m, positive up), ramp included."""
+        t = np.asarray(t, dtype=float)
+        weights = (self.amplitude * np.exp(-1j * self.phase))[:, None]
+        return ramp(t, self.ramp_time) * _synthesise(self, weights, np.atleast_1d(t))[:, 0]
+
+    @property
+    def period(self) -> float:
+        """Regular wave period, or the peak period of a spectrum (s)."""
+        return self.settings.get("period") or self.settings.get("tp")
+
+    def describe(self) -> dict:
+        return {"type": self.kind, **self.settings, "direction_rad": self.direction,
+                "ramp_s": self.ramp_time, "n_components": int(self.omega.size)}
+
+
+def regular(height: float, period: float, *, phase: float = 0.0, direction: float = 0.0,
+            ramp_time: float | None = None) -> Wave:
+    """A regular wave of height H (m, crest to trough) and period T (s); ramp 2 T by default."""
+    if height < 0 or period <= 0:
+        raise ValueError(f"regular wave: expected height >= 0 and period > 0, got "
+                         f"H={height}, T={period}")
+    ramp_time = 2 * period if ramp_time is None else ramp_time
+    return Wave("regular", np.array([2 * np.pi / period]), np.array([height / 2]),
+                np.array([phase]), direction, ramp_time,
+                {"height": height, "period": period})
+
+
+def band_limits(tp: float, data_band=None, band=DEFAULT_BAND, what: str = "a sea"):
+    """The band (lo, hi) in multiples of the peak frequency 2 pi / tp that a spectrum's
+    components span: `band`, cut to the hydro data's band data_band = (lo, hi) rad/s when
+    given. ValueError when nothing is left (the sea lies outside the data).
+
+    This is the one place a spectrum is clipped; `irregular` (and so `from_args`, the CLI and
+    sweeps) calls it."""
+    if data_band is None:
+        return (float(band[0]), float(band[1]))
+    wp = 2 * math.pi / tp
+    lo, hi = max(band[0], data_band[0] / wp), min(band[1], data_band[1] / wp)
+    if not lo < hi:
+        raise ValueError(f"{what} with Tp {tp:g} s lies outside the hydro data's band "
+                         f"{data_band[0]:.3g}..{data_band[1]:.3g} rad/s")
+    return (float(lo), float(hi))
+
+
+def variance_outside(hs: float, tp: float, gamma: float, band, kept) -> float:
+    """Share of a JONSWAP spectrum's variance over `band` (multiples of the peak frequency)
+    that falls outside `kept` (4001-point trapezoids)."""
+    wp = 2 * np.pi / tp
+    w = np.linspace(band[0] * wp, band[1] * wp, 4001)
+    S = jonswap_spectrum(w, hs, tp, gamma)
+    inside = (w >= kept[0] * wp) & (w <= kept[1] * wp)
+    return float(1 - np.trapezoid(S * inside, w) / np.trapezoid(S, w))
+
+
+def irregular(hs: float, tp: float, *, gamma: float = 3.3, seed: int = 0,
+              duration: float = 600.0, band: tuple[float, float] = DEFAULT_BAND,
+              direction: float = 0.0, ramp_time: float | None = None,
+              kind: str = "jonswap", data_band=None) -> Wave:
+    """An irregular sea with random phases (seeded) on a uniform grid covering `duration`.
+
+    Components span band[0]..band[1] times the peak frequency, cut to data_band (rad/s, the
+    hydro data's) when given (`band_limits`; settings["spectrum_outside_data"] then records
+    the share of the variance left out); amplitudes a = sqrt(2 S dw) are scaled so that
+    4 sqrt(m0) equals hs exactly on the kept grid. Ramp: 2 Tp by default.
+    """
+    if hs <= 0 or tp <= 0 or gamma < 1:
+        raise ValueError(f"{kind}: expected hs > 0, tp > 0, gamma >= 1; got {hs}, {tp}, {gamma}")
+    gamma_used = gamma if kind == "jonswap" else 1.0
+    kept = band_limits(tp, data_band, band, what=f"a {kind} sea")
+    wp = 2 * np.pi / tp
+    repeat = max(duration, 20 * tp)
+    d_omega = 2 * np.pi / repeat
+    k = np.arange(math.ceil(kept[0] * wp / d_omega), math.floor(kept[1] * wp / d_omega) + 1)
+    omega = k * d_omega
+    density = jonswap_spectrum(omega, hs, tp, gamma_used)
+    amplitude = np.sqrt(2 * density * d_omega)
+    amplitude *= hs / (4 * np.sqrt(0.5 * np.sum(amplitude**2)))
+    phase = np.random.default_rng(seed).uniform(0, 2 * np.pi, omega.size)
+    ramp_time = 2 * tp if ramp_time is None else ramp_time
+    settings = {"hs": hs, "tp": tp, "gamma": gamma_used, "seed": seed}
+    if data_band is not None:
+        settings["spectrum_outside_data"] = variance_outside(hs, tp, gamma_used, band, kept)
+    return Wave(kind, omega, amplitude, phase, direction, ramp_time, settings, d_omega)
+
+
+def from_args(kind: str, *, height=None, period=None, hs=None, tp=None, gamma=3.3, seed=0,
+              duration=600.0, data_band=None) -> Wave:
+    """The wave a CLI or config describes: 'regular', 'jonswap' or 'pm'.
+
+    data_band: (lo, hi) rad/s of the model's hydro data; an irregular sea's components are kept
+    inside it (Hs stays exact on the kept components; settings["spectrum_outside_data"] records
+    the fraction of the spectrum's variance that fell outside)."""
+    if kind == "regular":
+        if height is None or period is None:
+            raise ValueError("a regular wave needs --height and --period")
+        return regular(height, period)
+    if kind in ("jonswap", "pm"):
+        if hs is None or tp is None:
+            raise ValueError(f"a {kind} sea needs --hs and --tp")
+        return irregular(hs, tp, gamma=gamma, seed=seed, duration=duration, kind=kind,
+                         data_band=data_band)
+    raise ValueError(f"unknown wave type {kind!r}; expected regular, jonswap or pm")
+
+
+def from_elevation(t, eta, *, band: tuple[float, float] | None = None,
+                   ramp_time: float = 0.0, direction: float = 0.0) -> Wave:
+    """A wave reproducing a measured elevation record eta(t) at the n-frame origin (m, up).
+
+    t must be uniform. The record is decomposed by FFT into components omega_k = 2 pi k / T
+    (T = record length): exactly the periodic extension of the record. Components outside
+    `band` (rad/s; e.g. the hydro data's) and the mean are dropped, and the fraction of the
+    variance dropped is recorded in settings["dropped_variance"]. Excitation from this wave
+    equals the (non-causal) convolution of the record with the excitation impulse response.
+    """
+    t, eta = np.asarray(t, float), np.asarray(eta, float)
+    if t.ndim != 1 or t.size != eta.size or t.size < 4:
+        raise ValueError("from_elevation: expected 1-D t and eta of equal length (>= 4)")
+    step = t[1] - t[0]
+    if not np.allclose(np.diff(t), step, rtol=1e-6, atol=0):
+        raise ValueError("from_elevation: t must be uniformly spaced")
+    n = t.size
+    spectrum = np.fft.rfft(eta - eta.mean())
+    k = np.arange(spectrum.size)
+    d_omega = 2 * np.pi / (n * step)
+    omega = k * d_omega
+    amplitude = 2 * np.abs(spectrum) / n
+    if n % 2 == 0:
+        amplitude[-1] /= 2                       # the Nyquist term is not doubled
+    phase = np.angle(spectrum) - omega * t[0]    # the record may start at t0 != 0
+    keep = k > 0
+    if band is not None:
+        keep &= (omega >= band[0]) & (omega <= band[1])
+    total = np.sum(amplitude[k > 0] ** 2)
+    dropped = 1 - np.sum(amplitude[keep] ** 2) / total if total > 0 else 0.0
+    settings = {"record_s": float(n * step), "samples": int(n), "mean_m": float(eta.mean()),
+                "dropped_variance": float(dropped)}
+    return Wave("elevation", omega[keep], amplitude[keep], phase[keep], direction, ramp_time,
+                settings, d_omega)

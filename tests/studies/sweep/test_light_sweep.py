@@ -1,0 +1,70 @@
+"""Light sweeps: a case run without a Dataset gives the record a `simulate` run gives (same
+keys, same numbers to 1e-9); a local cluster starts only when the sweep pays for it."""
+import pytest
+
+from mbcontrol.sim import light
+from mbcontrol.studies.sweep import grid
+from mbcontrol.studies.sweep import runner
+from mbcontrol.studies.sweep.cases import build_cases
+from mbcontrol.studies.sweep.store import CaseStore
+
+
+def _full_path(monkeypatch):
+    monkeypatch.setattr(light, "can_run", lambda *args: False)
+
+
+@pytest.mark.parametrize("model,vary", [("rm3", {"pto__damping": [6e5, 2e6]}),
+                                        ("sphere", {})])
+def test_light_record_equals_the_simulate_record(monkeypatch, model, vary):
+    roles = {name: "param" for name in vary}
+    cases = build_cases(model, grid([1.5, 3.0], [9.0]), seeds=1, vary=vary, roles=roles,
+                        duration=300.0, dt=0.05)
+    fast = [runner.run_case(c) for c in cases]
+    _full_path(monkeypatch)
+    full = [runner.run_case(c) for c in cases]
+    for a, b in zip(fast, full):
+        assert set(a) == set(b) == {"case", "metrics", "valid", "invalid_reasons",
+                                    "wall_time_s"}
+        assert a["case"] == b["case"]
+        assert a["valid"] == b["valid"] and a["invalid_reasons"] == b["invalid_reasons"]
+        assert a["metrics"].keys() == b["metrics"].keys()
+        for k, v in b["metrics"].items():
+            assert a["metrics"][k] == pytest.approx(v, rel=1e-9, abs=1e-9), k
+
+
+def test_cluster_pays_only_for_long_sweeps():
+    assert not runner._cluster_pays(4.0, 2, "spawn")  # 64 light cases: seconds
+    assert runner._cluster_pays(4.0, 2, "fork")       # a forked cluster starts in 0.3 s
+    assert not runner._cluster_pays(0.8, 2, "fork")
+    for method in ("spawn", "fork"):
+        assert not runner._cluster_pays(1000.0, 1, method)   # one worker never beats this
+        assert runner._cluster_pays(60.0, 2, method)
+
+
+@pytest.mark.parametrize("method", ["fork", "spawn"])
+def test_forked_and_spawned_workers_agree_with_serial(monkeypatch, method):
+    cases = build_cases("rm3", grid([1.5, 3.0], [8.0, 11.0]), duration=200.0, dt=0.05)
+    serial = CaseStore(None)
+    runner.execute(cases, serial, workers=0, progress=False)
+    monkeypatch.setenv(runner.CLUSTER_ENV, "always")
+    monkeypatch.setenv(runner.START_ENV, method)
+    clustered = CaseStore(None)
+    assert runner.execute(cases, clustered, workers=2, progress=False)["where"] == "cluster"
+    for c in cases:
+        assert clustered.read(c.key)["metrics"] == serial.read(c.key)["metrics"]
+
+
+def test_small_sweep_on_workers_runs_here_and_forced_cluster_agrees(monkeypatch):
+    cases = build_cases("sphere", grid([1.0, 2.0], [8.0, 10.0]), duration=100.0, dt=0.1)
+    serial = CaseStore(None)
+    assert runner.execute(cases, serial, workers=0, progress=False)["where"] == "serial"
+    small = CaseStore(None)
+    assert runner.execute(cases, small, workers=2, progress=False)["where"] == "serial"
+    monkeypatch.setenv(runner.CLUSTER_ENV, "always")
+    clustered = CaseStore(None)
+    result = runner.execute(cases, clustered, workers=2, progress=False)
+    assert result["where"] == "cluster" and result["computed"] == len(cases)
+    for c in cases:
+        a, b, d = serial.read(c.key), small.read(c.key), clustered.read(c.key)
+        assert a["metrics"] == b["metrics"] == d["metrics"]
+        assert a["valid"] == d["valid"]
