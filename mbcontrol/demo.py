@@ -100,6 +100,10 @@ def main(argv=None) -> int:
         print(f"  {label:34s} mean power {runs[label]['ptos']['hinge_pto']['mean_power_W'] * 1e3:7.3f}"
               f" mW, max torque {runs[label]['ptos']['hinge_pto']['max_force']:.3f} N m, "
               f"simulated at {args.duration / runs[label]['wall_time_s']:,.0f}x real time")
+    failed = {k: r["invalid_reasons"] for k, r in runs.items() if not r["valid"]}
+    print("  every run passed its physics checks (power bound of its wave, energy balance, "
+          "linear range)" if not failed else
+          "\n".join(f"  INVALID {k}: {'; '.join(v)}" for k, v in failed.items()))
     limited, free = (runs[k]["ptos"]["hinge_pto"]["mean_power_W"] for k in list(runs)[-2:])
     report["design"].update(mpc_rate_limit=rate, mpc_power_change_by_rate_limit=limited / free - 1)
     print(f"  the {rate:.0f} N m/s torque-rate limit changes the MPC's power by "

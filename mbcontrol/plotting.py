@@ -64,7 +64,7 @@ def time_series(ds, names, *, title=None, path=None, units=None):
     axes = np.atleast_1d(axes)
     for ax, name in zip(axes, names):
         ax.plot(ds["time"].values, ds[name].values, lw=0.9)
-        unit = (units or {}).get(name, "")
+        unit = (units or {}).get(name, ds[name].attrs.get("units", ""))
         ax.set_ylabel(f"{name}\n{unit}", fontsize=8)
         ax.grid(alpha=0.3)
     axes[-1].set_xlabel("time (s)")
@@ -100,9 +100,10 @@ def mark_result(ds, axes, title_ax) -> None:
     controller = json.loads(ds.attrs.get("controller", "null") or "null") or {}
     start = max(float(wave.get("ramp_s", 0.0) or 0.0),
                 float(controller.get("warm_up_s", 0.0) or 0.0))
+    first = float(ds["time"].values[0])
     for ax in np.ravel(axes):
-        if start > 0 and wave.get("type") != "regular":
-            ax.axvspan(float(ds["time"].values[0]), start, color="0.85", lw=0, zorder=0)
+        if start > first and wave.get("type") != "regular":
+            ax.axvspan(first, start, color="0.85", lw=0, zorder=0, label="not in statistics")
         if ds.attrs.get("valid", 1) == 0:
             ax.set_facecolor(INVALID_FACE)
     label = result_label(ds)

@@ -42,7 +42,7 @@ ENERGY_TOLERANCE = 0.05           # of the excitation's absolute work over the r
 ANGLE_MAX_RAD = math.radians(30.0)
 DRAFT_FACTOR = 1.0                # relative heave limit in mean drafts
 
-_RESPONSES: dict = {}             # (plant id, params, direction, omega) -> (Y, H)
+_RESPONSES: dict = {}             # (plant id, params, direction, omega) -> (plant, (Y, H))
 
 
 def wave_of(ds):
@@ -70,9 +70,10 @@ def power_bound(plant, wave, params, window=None) -> dict:
         if len(_RESPONSES) > 256:
             _RESPONSES.clear()
         names = [pto.name for pto in plant.scene.ptos]
-        _RESPONSES[key] = port_responses(plant, wave.omega, names, wave.direction,
-                                         dict(zip(plant.parameters, p)))
-    bound = multiport_bound(plant, wave, responses=_RESPONSES[key])
+        # the plant is kept with its responses, so that its id is not reused while cached
+        _RESPONSES[key] = (plant, port_responses(plant, wave.omega, names, wave.direction,
+                                                 dict(zip(plant.parameters, p))))
+    bound = multiport_bound(plant, wave, responses=_RESPONSES[key][1])
     out = {"bound_W": bound.power, "window_bound_W": None}
     if window is not None:
         out["window_bound_W"] = window_mean_power(bound, *window)

@@ -44,8 +44,8 @@ def plot_sweep(ds, summary: dict, path=None):
         for (i, j), n in invalid.items():        # failed physics checks: shown, never averaged
             ax.add_patch(plt.Rectangle((j - 0.5, i - 0.5), 1, 1, fill=False, hatch="xx",
                                        edgecolor="C3", lw=0))
-            ax.text(j, i - 0.3, f"{n} invalid", ha="center", va="center", fontsize=5,
-                    color="C3")
+            ax.text(j, i, f"{n} invalid", ha="center", va="center", fontsize=7, color="C3",
+                    bbox={"facecolor": "white", "edgecolor": "none", "pad": 1.5})
         fig.colorbar(image, ax=ax, label="mean power, kW")
         ax.set_xlabel("Tp, s")
         ax.set_ylabel("Hs, m")
@@ -64,7 +64,8 @@ def plot_sweep(ds, summary: dict, path=None):
     ax.set_xlabel("Te, s" if np.all(np.isfinite(ds["te"].values)) else "Tp, s")
     ax.set_ylabel("capture width ratio" if ratio == "capture_width_ratio" else "capture width, m")
     ax.grid(alpha=0.3)
-    ax.set_title("capture width (colour: Hs)")
+    ax.set_title("capture width (colour: Hs)" + (", valid cases only"
+                                                  if summary.get("invalid_cases") else ""))
     if weighted:
         ax = axes[2]
         power = ds["mean_power_W"].mean([d for d in ds["mean_power_W"].dims if d != "sea"])
