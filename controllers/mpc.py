@@ -31,7 +31,8 @@ oracle, only when asked; describe() then labels the run an upper bound). A `wave
 a causal forecast only sets the Kalman wave model's frequencies and the warm-up damper.
 
 Start-up (warm-up). Until the AR predictor has its first fit the controller applies the
-tuned passive damper instead (per PTO, computed once in reset(): `optimal_damping` for the
+tuned passive damper instead, then blends over to the MPC in one peak period (per PTO,
+computed once in reset(): `optimal_damping` for the
 sea by linear theory, or |Z_i| at the wave model's frequency without a wave), clipped to the
 force limit. The first fit waits for WARM_UP_PERIODS peak periods of estimates (at least
 4 x ar_order samples): an AR(8) fitted to the first 32 samples (6.4 s, during the wave's
@@ -207,7 +208,14 @@ class Mpc:
             self._failed(t, status)
             U = self._shifted_plan()
         self._plan = U
-        self.u_prev = np.clip(U[0], -self.limits["force"], self.limits["force"])
+        u = U[0]
+        if self.warm_up_end is not None and t < self.warm_up_end + self.blend_s:
+            # bumpless take-over: from the damper to the MPC over one peak period (its first
+            # plan alone kicked rm3's PTO with 12 MN, 4x its later peaks)
+            share = (t - self.warm_up_end) / self.blend_s
+            u = share * u - (1 - share) * self.warm_up_damping * np.asarray(y, float)[
+                self._velocity]
+        self.u_prev = np.clip(u, -self.limits["force"], self.limits["force"])
         return self.u_prev.copy()
 
     def _forecast(self, known) -> np.ndarray:
@@ -233,15 +241,18 @@ class Mpc:
 
     def _warm_up_time(self, cp) -> float:
         """Planned warm-up, s: the setting, or WARM_UP_PERIODS peak periods (AR forecast)."""
-        if self.warm_up_setting is not None:
-            return float(self.warm_up_setting)
-        if self.forecast != "ar":
-            return 0.0
         if self.wave is not None:
             period = float(self.wave.period)
         else:
             period = 2 * np.pi / float(np.median(wave_frequencies(None, _natural_frequency(cp))))
-        return max(WARM_UP_PERIODS * period, (4 * self.ar_order - 1) * self.dt_s)
+        if self.warm_up_setting is not None:
+            planned = float(self.warm_up_setting)
+        elif self.forecast != "ar":
+            planned = 0.0
+        else:
+            planned = max(WARM_UP_PERIODS * period, (4 * self.ar_order - 1) * self.dt_s)
+        self.blend_s = period if planned > 0 else 0.0      # the take-over's length, s
+        return planned
 
     def _warm_up_damping(self, plant, cp, omega) -> np.ndarray:
         """The warm-up damper per PTO, N s/m: optimal_damping for the sea (linear theory, the
@@ -338,6 +349,7 @@ class Mpc:
                             if self.ar is not None else "passive damper u = -c v",
                             "damping": [float(c) for c in self.warm_up_damping],
                             "planned_s": float(self.warm_up_planned),
+                            "take_over_s": float(self.blend_s),
                             "completed": self.warm_up_end is not None}}
 
 
