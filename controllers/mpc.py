@@ -57,7 +57,7 @@ import numpy as np
 from mbcontrol.results import jsonable
 
 from .base import per_pto, signal_indices
-from .control_plant import build_control_plant
+from .control_plant import build_control_plant, device_frequency, pto_impedance
 from .estimation import ArPredictor, ExcitationKalman, wave_frequencies
 from .mpc_qp import CondensedQp
 
@@ -145,15 +145,21 @@ class Mpc:
         }
         self.N = int(round(self.horizon_s / self.dt_s))
         efficiency = _limits(plant, self.efficiency, [p.efficiency for p in ptos], "efficiency")
-        omega = wave_frequencies(self.wave, _natural_frequency(cp))
+        self.device_omega = device_frequency(cp, _band(plant))
+        if self.wave is None:
+            warnings.warn(f"mpc: no sea state given (wave=...): the Kalman wave model is centred "
+                          f"on the device's resonance seen from its PTO ({self.device_omega:.3g} "
+                          f"rad/s, period {2 * np.pi / self.device_omega:.3g} s), a guess; the "
+                          f"sea's own spectrum estimates the excitation better", RuntimeWarning,
+                          stacklevel=3)
+        omega = wave_frequencies(self.wave, self.device_omega)
         self.qp = CondensedQp(cp, self.N, self.limits, efficiency=efficiency,
-                              loss_damping=_impedance(cp, float(np.median(omega))),
+                              loss_damping=pto_impedance(cp, float(np.median(omega))),
                               force_penalty=self.force_penalty,
                               stroke_penalty=self.stroke_penalty, soft_stroke=self.soft_stroke,
                               solver=self.solver)
         if self.estimator == "kalman":
-            fallback = _natural_frequency(cp)
-            self.kalman = ExcitationKalman(cp, wave_frequencies(self.wave, fallback),
+            self.kalman = ExcitationKalman(cp, omega,
                                            measurement_noise=self.measurement_noise)
         else:
             self.kalman = None
@@ -244,7 +250,7 @@ class Mpc:
         if self.wave is not None:
             period = float(self.wave.period)
         else:
-            period = 2 * np.pi / float(np.median(wave_frequencies(None, _natural_frequency(cp))))
+            period = 2 * np.pi / self.device_omega
         if self.warm_up_setting is not None:
             planned = float(self.warm_up_setting)
         elif self.forecast != "ar":
@@ -258,7 +264,7 @@ class Mpc:
         """The warm-up damper per PTO, N s/m: optimal_damping for the sea (linear theory, the
         other PTOs free), or |Z_i| at the wave model's median frequency (the regular-wave
         optimum) without a wave or when the sea lies outside the hydro data."""
-        fallback = _impedance(cp, float(np.median(omega)))
+        fallback = pto_impedance(cp, float(np.median(omega)))
         if self.wave is None:
             return fallback
         from .passive import optimal_damping
@@ -357,6 +363,10 @@ def _limits(plant, value, scene_values, what) -> np.ndarray:
     """Per-PTO limits: the setting (number or dict by PTO name) or the scene's; > 0."""
     if value is None:
         out = np.asarray(scene_values, float)
+    elif isinstance(value, dict):    # the PTOs it names; the others keep the scene's value
+        names = [p.name for p in plant.scene.ptos][:len(scene_values)]
+        per_pto(plant, value, f"mpc {what}")                    # unknown names: KeyError
+        out = np.array([float(value.get(n, s)) for n, s in zip(names, scene_values)])
     else:
         out = per_pto(plant, value, f"mpc {what}")[:len(scene_values)]
     if np.any(out <= 0):
@@ -378,20 +388,11 @@ def _linear_range(plant, pto: str) -> float:
     return LINEAR_RANGE_SHARE * min(drafts) if drafts else math.inf
 
 
-def _impedance(cp, omega: float) -> np.ndarray:
-    """|Z_i| per PTO at omega (rad/s): 1 / |force -> velocity| of the control plant (N s/m)."""
-    Y = cp.Cv @ np.linalg.solve(1j * omega * np.eye(cp.nz) - cp.A, cp.Bu_c)
-    return 1.0 / np.abs(np.diag(Y))
-
-
-def _natural_frequency(cp) -> float:
-    """The lightly damped mode the PTO sees: the pole of A nearest the imaginary axis among
-    those with a visible imaginary part (rad/s), for the Kalman wave model without a wave."""
-    poles = np.linalg.eigvals(cp.A)
-    osc = poles[np.abs(poles.imag) > 1e-6]
-    if osc.size == 0:
-        return 1.0
-    return float(np.abs(osc[np.argmin(np.abs(osc.real) / np.abs(osc))]))
+def _band(plant) -> tuple[float, float]:
+    """The frequencies the device's hydro data cover (rad/s); 0.1-10 rad/s without data."""
+    if plant.hydro is None:
+        return (0.1, 10.0)
+    return (float(plant.hydro.omega[0]), float(plant.hydro.omega[-1]))
 
 
 def _choice(what, value, allowed):
