@@ -77,7 +77,6 @@ WARM_UP_PERIODS = 5.0
 # pitched the flap 85 deg and "absorbed" 130 % of the complex-conjugate bound, the AR one
 # diverged 14 s after its warm-up; at 0.8 x 30 deg all three test seas run, stroke on the limit
 LINEAR_RANGE_SHARE = 0.8
-LINEAR_RANGE_ANGLE = math.radians(30.0)
 ORACLE_LABEL = "non-causal upper bound (true future wave)"
 
 
@@ -377,14 +376,13 @@ def _limits(plant, value, scene_values, what) -> np.ndarray:
 def _linear_range(plant, pto: str) -> float:
     """Default stroke limit (rad or m) of a PTO the scene leaves unlimited: LINEAR_RANGE_SHARE
     of the linear-hydrodynamics range (see the constants); inf without hydro data."""
+    from mbcontrol.analysis.validity import ANGLE_MAX_RAD, mean_draft
     if plant.units(f"{pto}__position") == "rad":
-        return LINEAR_RANGE_SHARE * LINEAR_RANGE_ANGLE
+        return LINEAR_RANGE_SHARE * ANGLE_MAX_RAD
     data = plant.hydro.data if plant.hydro is not None else None
-    if data is None or "waterplane_area" not in data or "displaced_volume" not in data:
+    if data is None or "body" not in data.coords:
         return math.inf
-    volume, area = data["displaced_volume"], data["waterplane_area"]
-    drafts = [float(volume.sel(body=b)) / float(area.sel(body=b))
-              for b in data["body"].values if float(area.sel(body=b)) > 0]
+    drafts = [d for d in (mean_draft(data, str(b)) for b in data["body"].values) if d]
     return LINEAR_RANGE_SHARE * min(drafts) if drafts else math.inf
 
 

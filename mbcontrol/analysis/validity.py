@@ -154,7 +154,7 @@ def excursions(plant, ds, wave, mask) -> dict:
     for body in map(str, data["body"].values):
         if f"{body}__Heave" not in ds:
             continue
-        limit = _mean_draft(data, body)
+        limit = mean_draft(data, body)
         entry = {"relative_heave_limit_m": limit}
         signals = {key: ds[f"{body}__{name}"].values[mask] for key, name in
                    (("roll", "Roll"), ("pitch", "Pitch"))}
@@ -179,7 +179,9 @@ def excursions(plant, ds, wave, mask) -> dict:
     return out
 
 
-def _mean_draft(data, body: str):
+def mean_draft(data, body: str):
+    """A body's mean draft V / A_wp (m) from its hydro data, where linear hydrodynamics hold;
+    None for a submerged body (no waterplane) or data without hydrostatics."""
     if "waterplane_area" not in data or "displaced_volume" not in data:
         return None
     area = float(data["waterplane_area"].sel(body=body))

@@ -63,7 +63,7 @@ def forward_validity(problem, values: dict, rows: list[dict]) -> dict:
     hydrodynamics hold and a heave within the body's mean draft
     (`mbcontrol.analysis.validity`); and no fitted hydro correction that makes the model
     create energy (a negative radiation or damping scale). {"valid", "invalid_reasons"}."""
-    from ...analysis.validity import ANGLE_MAX_RAD, DRAFT_FACTOR, _mean_draft
+    from ...analysis.validity import ANGLE_MAX_RAD, DRAFT_FACTOR, mean_draft
     reasons = []
     for name, value in values.items():
         dissipative = name.endswith(("__radiation_scale", "__damping")) or "viscous" in name
@@ -73,7 +73,7 @@ def forward_validity(problem, values: dict, rows: list[dict]) -> dict:
     for plant in problem._plants.values():
         data = plant.hydro.data if plant.hydro is not None else None
         if data is not None and "body" in data.coords:
-            drafts.update({str(b): _mean_draft(data, str(b)) for b in data["body"].values})
+            drafts.update({str(b): mean_draft(data, str(b)) for b in data["body"].values})
     draft = min((d for d in drafts.values() if d), default=None)
     for row in rows:
         model, where = row["model"], f"run {row['run']}, channel {row['channel']}"
