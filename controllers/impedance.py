@@ -119,7 +119,16 @@ def fd_statistics(Z, F, wave, damping, stiffness, *, efficiency: float | None = 
     k = np.asarray(stiffness, float)[..., None]
     V = F * a / (Z + c - 1j * k / w)
     X = V / (1j * w)
-    U = -(c * V + k * X)
+    return phasor_statistics(V, X, -(c * V + k * X), c, wave, efficiency=efficiency,
+                             exceedance=exceedance)
+
+
+def phasor_statistics(V, X, U, c, wave, *, efficiency: float | None = None,
+                      exceedance: float = 0.01) -> dict:
+    """fd_statistics' keys from one PTO's velocity, position and force phasors per wave
+    component (V, X, U: (..., n_omega), m/s, m, N; either time convention, only moduli and
+    c enter) and its damping c (N s/m, broadcast against V): see fd_statistics."""
+    w = np.asarray(wave.omega, float)
     power = np.sum(0.5 * c * np.abs(V) ** 2, axis=-1)
     var = {name: 0.5 * np.sum(np.abs(z) ** 2, axis=-1) for name, z in
            (("x", X), ("v", V), ("u", U), ("du", w * U))}

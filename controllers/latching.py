@@ -43,6 +43,7 @@ from .limits import force_limits, limits_report, saturate
 class _Switching:
     """Common machinery: per-PTO crossing detection, a timer, and a damper when engaged."""
     name = "switching"
+    _moves_while_held = False     # the hold stops the PTO (latching) or frees it (declutching)
 
     def __init__(self, damping: float = 0.0, hold_time: float = 0.0,
                  period: float | None = None, force_max=None):
@@ -81,7 +82,9 @@ class _Switching:
             if self._held[i] and t >= self._release[i] - 0.5 * (h or 0.0):
                 self._held[i] = False                 # release at the nearest sample
                 self.holds[i][-1] = (self.holds[i][-1][0], t)
-                self._sign[i] = 0.0                   # v ~ 0 now: take its sign afresh
+                # latched, v is the brake's residual: take its sign afresh; declutched, v is
+                # real, and a crossing in the step after the release must count
+                self._sign[i] = np.sign(v[i]) if self._moves_while_held else 0.0
             elif not self._held[i]:
                 s = np.sign(v[i])
                 if self._sign[i] != 0 and s != self._sign[i] and h is not None:
@@ -146,6 +149,7 @@ class Declutching(_Switching):
     force_max: N (or N m), the damper's saturation (None: the scene PTO's force_max).
     """
     name = "declutching"
+    _moves_while_held = True
 
     def __init__(self, damping: float = 0.0, declutch_time: float = 0.0,
                  period: float | None = None, force_max=None):

@@ -9,6 +9,15 @@ import numpy as np
 
 from .base import per_pto
 
+# default stroke limit of a PTO whose scene sets none: this share of the range where linear
+# hydrodynamics hold (analysis.validity's: 30 deg of roll or pitch; the mean draft of the
+# shallowest surface-piercing body). Unlimited, an optimiser chases motions no linear model
+# describes: measured on the OSWEC (JONSWAP Hs 2 m, Tp 10 s) the oracle MPC pitched the flap
+# 85 deg and "absorbed" 130 % of the complex-conjugate bound, the AR one diverged 14 s after
+# its warm-up (at 0.8 x 30 deg all three test seas run, stroke on the limit); flap_pair's
+# jointly tuned reactive laws at T 4 s pitched the flaps 64 deg
+LINEAR_RANGE_SHARE = 0.8
+
 
 def force_limits(plant, force_max=None) -> np.ndarray:
     """Per-PTO force limit (N or N m, > 0, inf: none), scene order.
@@ -48,3 +57,17 @@ def limits_report(limits) -> list | None:
     if limits is None:
         return None
     return [float(f) if math.isfinite(f) else None for f in limits]
+
+
+def linear_range(plant, pto: str) -> float:
+    """Default stroke limit (rad or m) of a PTO the scene leaves unlimited: LINEAR_RANGE_SHARE
+    of the range where linear hydrodynamics hold (ANGLE_MAX_RAD for a rotary PTO, the
+    shallowest body's mean draft for a linear one); inf without hydro data."""
+    from mbcontrol.analysis.validity import ANGLE_MAX_RAD, mean_draft
+    if plant.units(f"{pto}__position") == "rad":
+        return LINEAR_RANGE_SHARE * ANGLE_MAX_RAD
+    data = plant.hydro.data if plant.hydro is not None else None
+    if data is None or "body" not in data.coords:
+        return math.inf
+    drafts = [d for d in (mean_draft(data, str(b)) for b in data["body"].values) if d]
+    return LINEAR_RANGE_SHARE * min(drafts) if drafts else math.inf

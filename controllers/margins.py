@@ -45,11 +45,6 @@ from dataclasses import dataclass, field
 import control
 import numpy as np
 
-# a loop gain this small relative to the loop's peak is a zero of L, not a crossing of the
-# negative real axis (velocity feedback has L(0) = 0, which round-off puts at -1e-16)
-_ZERO_GAIN = 1e-9
-
-
 @dataclass(frozen=True)
 class Margins:
     """Stability margins of one PTO's linear loop L(s) = K(s) G(s), negative feedback.
@@ -58,7 +53,9 @@ class Margins:
     unsigned, deg (inf: |L| never reaches 1); stability_margin: min |1 + L(i omega)|;
     frequencies in rad/s (nan where there is none; 0 is a crossing at DC); gain_crossovers_rad_s
     and phase_margins_deg: every |L| = 1 crossing and its margin; stable and pole_margin (1/s)
-    from the closed-loop poles; message: a sentence saying all that.
+    from the closed-loop poles; message: a sentence saying all that. A sampled law (period_s
+    set) has L(z), z = exp(i omega period_s), and pole_margin = -ln(spectral radius) /
+    period_s, the equivalent continuous decay rate (controllers.sampled).
     """
     pto: str
     law: str
@@ -73,7 +70,8 @@ class Margins:
     stable: bool
     pole_margin: float
     message: str
-    loop: object = field(default=None, repr=False, compare=False)   # L(s), control.StateSpace
+    loop: object = field(default=None, repr=False, compare=False)   # L(s) or L(z)
+    period_s: float | None = None   # the controller's sample period (s); None: continuous
 
     def to_dict(self) -> dict:
         """JSON-ready: no L(s); inf and nan become None."""
@@ -81,7 +79,7 @@ class Margins:
         for key in ("pto", "law", "gain_margin", "phase_crossover_rad_s", "phase_margin_deg",
                     "gain_crossover_rad_s", "stability_margin", "stability_margin_rad_s",
                     "gain_crossovers_rad_s", "phase_margins_deg", "stable", "pole_margin",
-                    "message"):
+                    "message", "period_s"):
             value = getattr(self, key)
             out[key] = [_finite(v) for v in value] if isinstance(value, tuple) else _finite(value)
         return out
@@ -135,7 +133,8 @@ def _gains(law, pto: str):
     return label, (one(settings.get("damping", 0.0)), one(settings.get("stiffness", 0.0)))
 
 
-def loop_margins(plant, law, *, pto: str | None = None, params=None) -> Margins:
+def loop_margins(plant, law, *, pto: str | None = None, params=None,
+                 period: float | None = None, others: dict | None = None) -> Margins:
     """Gain, phase and stability margins and closed-loop poles of a linear PTO law.
 
     law: a Passive or Reactive controller, a dict {"damping": N s/m, "stiffness": N/m} (or
@@ -144,9 +143,21 @@ def loop_margins(plant, law, *, pto: str | None = None, params=None) -> Margins:
     overrides, e.g. the other PTOs' damping and stiffness when their loops are closed too (the
     default leaves them free). Never raises on an unstable loop: it says so in `stable` and
     `message`.
+
+    period (s; default the law's own `period`): a sampled law, its command held over each
+    period as simulate holds it. Then every PTO's loop is closed, jointly and in discrete
+    time (controllers.sampled): the other PTOs with the law's gains for them,
+    or others = {pto: (damping, stiffness)}; static laws only. Without a period, `others`
+    closes the other PTOs continuously (as their scene damping and stiffness).
     """
     from .impedance import closed_loop_stability
     name = pto or plant.scene.ptos[0].name
+    period = period if period is not None else getattr(law, "period", None)
+    if period:
+        return _sampled_margins(plant, law, float(period), name, params, others)
+    if others:                  # a continuous law on the other PTOs is their scene law
+        params = {**{f"{p}__{key}": float(v) for p, (c, k) in others.items()
+                     for key, v in (("damping", c), ("stiffness", k))}, **(params or {})}
     G = plant_loop(plant, pto=name, params=params)
     label, K = _gains(law, name)
     if label == "lti":
@@ -169,42 +180,66 @@ def loop_margins(plant, law, *, pto: str | None = None, params=None) -> Margins:
                    bool(stable), float(pole_margin), message, L)
 
 
+def pto_gains(plant, law, others: dict | None = None) -> dict:
+    """{pto: (damping, stiffness)} for every PTO (scene order), as a passive or reactive law
+    (a controller or a dict of damping and stiffness, each a number or a dict by PTO) applies
+    them in simulation; others = {pto: (damping, stiffness)} overrides."""
+    names = [p.name for p in plant.scene.ptos]
+    gains = {}
+    for n in names:
+        label, K = _gains(law, n)
+        if label == "lti":
+            raise ValueError("margins: a sampled loop takes a static law (damping, stiffness); "
+                             "an LTI K(s) has no hold model here")
+        gains[n] = K
+    unknown = set(others or {}) - set(names)
+    if unknown:
+        raise KeyError(f"{plant.name}: gains for unknown PTO(s) {sorted(unknown)}")
+    gains.update({n: tuple(map(float, v)) for n, v in (others or {}).items()})
+    return gains
+
+
+def _sampled_margins(plant, law, period, name, params, others) -> Margins:
+    """loop_margins of a sampled law: stable and pole_margin (-ln(rho) / period, 1/s) from
+    every PTO's loop closed jointly (controllers.sampled.sampled_closed_loop), the margins
+    from PTO `name`'s L(z) with the other loops closed in discrete time."""
+    from .sampled import discrete_loop, loop_response_margins, sampled_closed_loop
+    gains = pto_gains(plant, law, others)
+    joint = sampled_closed_loop(plant, gains, period, params=params)
+    L = discrete_loop(plant, gains, period, name, params=params)
+    gm, w180, pms, wcs, sm, wsm = loop_response_margins(L)
+    k = int(np.argmin(pms)) if pms else None
+    pm, wc = (pms[k], wcs[k]) if pms else (math.inf, math.nan)
+    label = _gains(law, name)[0]
+    text = _message(name, label, joint.stable, joint.decay_rate, gm, w180, pm, wc, sm, L)
+    message = (f"sampled at {period:g} s (zero-order hold), every PTO's loop closed "
+               f"(spectral radius {joint.spectral_radius:.6g}): {text}")
+    return Margins(name, label, gm, w180, pm, wc, sm, wsm, tuple(wcs), tuple(pms),
+                   bool(joint.stable), float(joint.decay_rate), message, L, period)
+
+
 def _margins(L):
-    """(gm, w_gm, [pm], [w_c], sm, w_sm) of a SISO loop, from control.stability_margins with
-    the crossings python-control's polynomial method finds, checked on a frequency grid."""
-    gms, pms, sms, w180, wc, wstab = control.stability_margins(L, returnall=True)
-    poles = np.abs(np.linalg.eigvals(np.asarray(L.A))) if L.nstates else np.array([1.0])
-    poles = poles[poles > 0] if np.any(poles > 0) else np.array([1.0])
-    grid = np.logspace(np.log10(poles.min() / 100), np.log10(poles.max() * 100), 2000)
-    response = np.asarray(L(1j * grid)).ravel()
-    peak = float(np.max(np.abs(response)))
-    # gain margin: the crossings of the negative real axis with a loop gain that is not zero
-    w180 = np.atleast_1d(w180)
-    at = np.asarray(L(1j * w180)).ravel() if w180.size else np.zeros(0)
-    real = (at.real < 0) & (np.abs(at) > _ZERO_GAIN * peak)
-    gm, w_gm = math.inf, math.nan
-    if np.any(real):
-        candidates = 1.0 / np.abs(at[real])
-        j = int(np.argmin(np.abs(np.log(candidates))))
-        gm, w_gm = float(candidates[j]), float(w180[real][j])
-    # phase margins, unsigned: python-control's pm is angle - 180 in [-180, 180)
-    pm_list = [float(abs(p)) for p in np.atleast_1d(pms)]
-    wc_list = [float(w) for w in np.atleast_1d(wc)]
-    # stability margin: python-control's interior minima of |1 + L|, plus DC, infinity and
-    # the grid (which only guards: a grid point is never below the true minimum)
-    candidates = [(float(s), float(w)) for s, w in zip(np.atleast_1d(sms), np.atleast_1d(wstab))]
-    D = float(np.asarray(L.D).ravel()[0])
-    candidates.append((abs(1 + D), math.inf))
+    """(gm, w_gm, [pm], [w_c], sm, w_sm) of a continuous SISO loop, read off its frequency
+    response (controllers.sampled.loop_response_margins). python-control's polynomial method
+    (control.stability_margins) reports crossings that are not there on high-order loops
+    (wavestar, hinged_barge, flap_pair: |L| = 1 at frequencies where a direct evaluation of
+    L(i omega) stays below 0.46) and overflows on raft3's."""
+    from .sampled import loop_response_margins
+    if not L.nstates:                           # a static gain: its value is the response
+        value = float(np.asarray(L.D).ravel()[0])
+        gm = 1 / abs(value) if value < 0 else math.inf
+        return gm, (0.0 if value < 0 else math.nan), [], [], abs(1 + value), 0.0
+    return loop_response_margins(L)
+
+
+def _dc(L):
+    """L at zero frequency (s = 0, or z = 1 when sampled); None where a pole sits there."""
     try:
-        dc = complex(np.asarray(L(0j)).ravel()[0])
-        if np.isfinite(dc):
-            candidates.append((abs(1 + dc), 0.0))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            dc = complex(np.asarray(L(1.0 if L.isdtime(strict=True) else 0j)).ravel()[0])
     except (ZeroDivisionError, np.linalg.LinAlgError):
-        pass                                   # a pole at s = 0: |L(0)| is infinite
-    j = int(np.argmin(np.abs(1 + response)))
-    candidates.append((float(np.abs(1 + response[j])), float(grid[j])))
-    sm, w_sm = min(candidates)
-    return gm, w_gm, pm_list, wc_list, sm, w_sm
+        return None
+    return dc if np.isfinite(dc) else None
 
 
 def _message(pto, label, stable, pole_margin, gm, w_gm, pm, wc, sm, L) -> str:
@@ -216,13 +251,10 @@ def _message(pto, label, stable, pole_margin, gm, w_gm, pm, wc, sm, L) -> str:
     if stable:
         return (f"stable closed loop (slowest pole decays at {pole_margin:.3g} 1/s). " + text)
     hint = ""
-    try:
-        dc = complex(np.asarray(L(0j)).ravel()[0])
-        if np.isfinite(dc) and dc.real < -1 and abs(dc.imag) < 1e-9 * abs(dc):
-            hint = (f" L(0) = {dc.real:.4g} < -1: the PTO's negative stiffness outweighs the "
-                    f"restoring stiffness it sees, so nothing holds the device at rest.")
-    except (ZeroDivisionError, np.linalg.LinAlgError):
-        pass
+    dc = _dc(L)
+    if dc is not None and dc.real < -1 and abs(dc.imag) < 1e-9 * abs(dc):
+        hint = (f" L(0) = {dc.real:.4g} < -1: the PTO's negative stiffness outweighs the "
+                f"restoring stiffness it sees, so nothing holds the device at rest.")
     growth = (f"a pole with real part {-pole_margin:.3g} 1/s (grows e-fold in "
               f"{1 / -pole_margin:.3g} s)" if pole_margin < 0 else "a pole on the imaginary axis")
     return f"UNSTABLE closed loop: {growth}.{hint} {text}"

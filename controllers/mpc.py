@@ -58,7 +58,8 @@ from mbcontrol.results import jsonable
 
 from .base import per_pto, signal_indices
 from .control_plant import build_control_plant, device_frequency, pto_impedance
-from .estimation import ArPredictor, ExcitationKalman, wave_frequencies
+from .estimation import ArPredictor, ExcitationKalman, excitation_error, wave_frequencies
+from .limits import LINEAR_RANGE_SHARE, linear_range
 from .mpc_qp import CondensedQp
 
 # warm-up before the first AR fit, in peak periods of the sea (or of the wave model without
@@ -70,13 +71,6 @@ from .mpc_qp import CondensedQp
 # fits 10 -> 3, 12 -> 6, 7 -> 1 from 0 to 5 periods; 8 periods gave +0.6 % to +4.4 % power
 # but costs another 27 s of every record's statistics
 WARM_UP_PERIODS = 5.0
-# default (soft) stroke limit of a PTO whose scene sets none: this share of the range where
-# the MPC's linear model holds (mbcontrol.analysis.validity's: 30 deg of roll or pitch; the
-# mean draft of the shallowest surface-piercing body). Unlimited, the MPC chases motions no
-# linear model describes: measured on the OSWEC (JONSWAP Hs 2 m, Tp 10 s) the oracle MPC
-# pitched the flap 85 deg and "absorbed" 130 % of the complex-conjugate bound, the AR one
-# diverged 14 s after its warm-up; at 0.8 x 30 deg all three test seas run, stroke on the limit
-LINEAR_RANGE_SHARE = 0.8
 ORACLE_LABEL = "non-causal upper bound (true future wave)"
 
 
@@ -133,7 +127,7 @@ class Mpc:
         self.cp = cp = build_control_plant(plant, self.dt_s, measured=self.measured,
                                            order=self.order)
         ptos = [p for p in plant.scene.ptos if p.name in cp.ptos]
-        strokes = [p.stroke_max if math.isfinite(p.stroke_max) else _linear_range(plant, p.name)
+        strokes = [p.stroke_max if math.isfinite(p.stroke_max) else linear_range(plant, p.name)
                    for p in ptos]
         self.stroke_default = None if self.stroke_max is not None else {
             p.name: s for p, s in zip(ptos, strokes) if not math.isfinite(p.stroke_max)}
@@ -306,6 +300,15 @@ class Mpc:
     def casadi_law(self, plant):
         return None                      # dynamic (estimator, horizon): runs in Python
 
+    def estimation_report(self, t, W) -> dict | None:
+        """The Kalman excitation estimate's accuracy against the simulation's true excitation
+        W (on times t, s), after the warm-up (estimation.excitation_error); simulate calls it."""
+        if not self.history:
+            return None
+        start = self.warm_up_end if self.warm_up_end is not None else self.warm_up_planned
+        times, estimates = zip(*self.history)
+        return excitation_error(times, np.array(estimates), t, W, self.cp.S, start)
+
     def describe(self) -> dict:
         times = np.asarray(self.__dict__.get("stats", {}).get("solve_s", [])) * 1e3
         stats = dict(self.__dict__.get("stats", {}))
@@ -371,19 +374,6 @@ def _limits(plant, value, scene_values, what) -> np.ndarray:
     if np.any(out <= 0):
         raise ValueError(f"mpc: {what} must be > 0, got {out}")
     return out
-
-
-def _linear_range(plant, pto: str) -> float:
-    """Default stroke limit (rad or m) of a PTO the scene leaves unlimited: LINEAR_RANGE_SHARE
-    of the linear-hydrodynamics range (see the constants); inf without hydro data."""
-    from mbcontrol.analysis.validity import ANGLE_MAX_RAD, mean_draft
-    if plant.units(f"{pto}__position") == "rad":
-        return LINEAR_RANGE_SHARE * ANGLE_MAX_RAD
-    data = plant.hydro.data if plant.hydro is not None else None
-    if data is None or "body" not in data.coords:
-        return math.inf
-    drafts = [d for d in (mean_draft(data, str(b)) for b in data["body"].values) if d]
-    return LINEAR_RANGE_SHARE * min(drafts) if drafts else math.inf
 
 
 def _band(plant) -> tuple[float, float]:

@@ -151,7 +151,9 @@ class PseudoSpectralBound:
     m or rad); max_force, max_position: their largest absolute values on the grid;
     omega, force_coefficients: the force's complex amplitudes (exp(-i omega t));
     unconstrained_power: the complex-conjugate bound (W); solve_time: wall time of the
-    cvxpy solve, canonicalisation included (s); solver_time: the solver's own (s).
+    cvxpy solve, canonicalisation included (s); solver_time: the solver's own (s);
+    certified_power: an upper bound on the QP's optimum from its dual (W; solver "IPM" only,
+    else nan): what no force on the grid can beat, whatever the solver's accuracy.
     """
     mean_power: float
     unconstrained_power: float
@@ -167,6 +169,7 @@ class PseudoSpectralBound:
     solve_time: float
     solver_time: float | None
     period: float
+    certified_power: float = math.nan
 
 
 def repeat_period(wave) -> tuple[float, np.ndarray]:
@@ -201,10 +204,15 @@ class PseudoSpectralProblem:
     floor keeps a single sinusoid's overshoot between points below 1/cos(pi/32) - 1 = 0.5 %.
     harmonics (regular waves only): the force may also hold 2..harmonics times the wave
     frequency (no excitation there), which can raise the constrained bound (a flatter force).
+    omega_max (rad/s): the force may hold every multiple of 2 pi / T from the hydro data's
+    lowest frequency up to omega_max, as any T-periodic force does (a saturating force's
+    harmonics and the gaps between a sea's components): only then is the figure a bound on
+    every controller whose force stays in that band.
     """
 
     def __init__(self, plant, wave, *, pto: str | None = None, params=None,
-                 oversample: float = 2.0, harmonics: int = 1, min_points: int = 32):
+                 oversample: float = 2.0, harmonics: int = 1, min_points: int = 32,
+                 omega_max: float | None = None):
         T, k_wave = repeat_period(wave)
         if harmonics > 1 and wave.omega.size != 1:
             raise ValueError("harmonics > 1 needs a regular wave")
@@ -212,11 +220,15 @@ class PseudoSpectralProblem:
         cc = complex_conjugate_bound(plant, wave, pto, params)
         self.conjugate = cc
         k = np.arange(1, harmonics + 1) if harmonics > 1 else k_wave
+        if omega_max is not None:
+            lowest = math.ceil(float(plant.hydro.omega[0]) * T / (2 * np.pi) * (1 - 1e-9))
+            k = np.union1d(k, np.arange(max(lowest, 1),
+                                        math.floor(omega_max * T / (2 * np.pi) * (1 + 1e-9)) + 1))
         self.omega = 2 * np.pi * k / T
-        th = cc.thevenin if harmonics == 1 else pto_thevenin(plant, self.omega, pto,
-                                                             wave.direction, params)
+        th = cc.thevenin if k.size == k_wave.size else pto_thevenin(plant, self.omega, pto,
+                                                                    wave.direction, params)
         E = np.zeros(k.size, complex)
-        E[:k_wave.size] = cc.thevenin.excitation * _wave_phasors(wave)   # k_wave leads k
+        E[np.searchsorted(k, k_wave)] = cc.thevenin.excitation * _wave_phasors(wave)
         Z = th.impedance
         self.thevenin, self.E = th, E
         n_t = max(math.ceil(oversample * (2 * int(k.max()) + 1)), int(min_points))
@@ -234,7 +246,10 @@ class PseudoSpectralProblem:
         self.position_map = affine(gain * E, gain)
         G = 1 / np.conj(Z)
         gamma = G * np.conj(E)
-        self.rho = np.concatenate([G.real, G.real])                      # 1/(N s/m) each
+        # Re G < 0 only as BEM noise (PASSIVITY_TOL): as ~zero (1e-12 of the largest, so the
+        # QP stays convex and its dual finite; it lowers the figure by ~1e-12 of it)
+        rho = np.concatenate([G.real, G.real])
+        self.rho = np.maximum(rho, 1e-12 * rho.max())                    # 1/(N s/m) each
         self.linear = np.concatenate([gamma.real, -gamma.imag])          # m/s per N
         # scaling: forces in units of the largest conjugate-optimal component, power in units
         # of the conjugate bound, so the interior-point solver sees numbers of order one
@@ -268,11 +283,16 @@ class PseudoSpectralProblem:
 
     def solve(self, force_max: float = np.inf, stroke_max: float = np.inf,
               solver: str = "CLARABEL", **solver_options) -> PseudoSpectralBound:
-        """Solve for limits |F| <= force_max (N or N m) and |x| <= stroke_max (m or rad)."""
+        """Solve for limits |F| <= force_max (N or N m) and |x| <= stroke_max (m or rad).
+
+        solver: a cvxpy solver name, or "IPM" (analysis.box_qp: dense, fast on wide grids,
+        and with a certified upper bound, PseudoSpectralBound.certified_power)."""
         if force_max <= 0 or stroke_max <= 0:
             raise ValueError(f"limits must be > 0, got force_max={force_max}, "
                              f"stroke_max={stroke_max}")
         key = (bool(np.isfinite(force_max)), bool(np.isfinite(stroke_max)))
+        if solver == "IPM" and any(key):
+            return self._solve_ipm(force_max, stroke_max, **solver_options)
         if key not in self._problems:
             self._problems[key] = self._build(*key)
         problem, z, limits = self._problems[key]
@@ -287,6 +307,10 @@ class PseudoSpectralProblem:
         # no optimum (e.g. infeasible: the force limit cannot hold the stroke): nan throughout
         coeffs = (np.asarray(z.value) * self.F0 if ok and z.value is not None
                   else np.full(self.rho.size, math.nan))
+        stats = problem.solver_stats
+        return self._result(coeffs, problem.status, wall, getattr(stats, "solve_time", None))
+
+    def _result(self, coeffs, status, wall, solver_time, certified=math.nan):
         half = coeffs.size // 2
         F_k = coeffs[:half] + 1j * coeffs[half:]
         V_k = (self.E + F_k) / self.thevenin.impedance
@@ -294,12 +318,38 @@ class PseudoSpectralProblem:
         power = float(-0.5 * np.sum((F_k * np.conj(V_k)).real))
         series = [m[0] + m[1] @ coeffs for m in (self.force_map, self.velocity_map,
                                                  self.position_map)]
-        stats = problem.solver_stats
         return PseudoSpectralBound(
             power, self.conjugate.power, self.time, *series,
             float(np.max(np.abs(series[0]))), float(np.max(np.abs(series[2]))),
-            self.omega, F_k, problem.status, wall,
-            getattr(stats, "solve_time", None), self.period)
+            self.omega, F_k, status, wall, solver_time, self.period, certified)
+
+    def _solve_ipm(self, force_max, stroke_max, **options):
+        from .box_qp import fourier_gram, solve_box_qp
+        rows, offsets, limits, grams = [], [], [], []   # z in units of F0, power of P0
+        n_t, k = self.time.size, np.rint(self.omega * self.period / (2 * np.pi)).astype(int)
+        if np.isfinite(force_max):
+            rows.append(self.force_map[1])
+            offsets.append(np.zeros(n_t))
+            limits.append(np.full(n_t, force_max / self.F0))
+            grams.append(fourier_gram(k, np.ones(k.size), n_t))
+        if np.isfinite(stroke_max):
+            rows.append(self.F0 * self.position_map[1])
+            offsets.append(self.position_map[0])
+            limits.append(np.full(n_t, stroke_max))
+            grams.append(fourier_gram(k, self.F0 * 1j / (self.omega * self.thevenin.impedance),
+                                      n_t))
+        d, lim = np.concatenate(offsets), np.concatenate(limits)
+
+        def gram(w):
+            return sum(g(w[i * n_t:(i + 1) * n_t]) for i, g in enumerate(grams))
+        start = time.perf_counter()
+        r = solve_box_qp(self.rho * self.F0**2 / self.P0, 0.5 * self.F0 / self.P0 * self.linear,
+                         np.vstack(rows), d, -lim, lim, gram=gram, **options)
+        wall = time.perf_counter() - start
+        ok = r.status == "optimal"
+        coeffs = r.z * self.F0 if ok else np.full(self.rho.size, math.nan)
+        return self._result(coeffs, r.status, wall, wall,
+                            -r.dual_bound * self.P0 if ok else math.nan)
 
     def series(self, result: PseudoSpectralBound, t) -> dict:
         """Force, velocity and position (as in the result) at any times t (s), e.g. finer."""
@@ -315,20 +365,26 @@ class PseudoSpectralProblem:
 def pseudo_spectral_bound(plant, wave, *, pto: str | None = None, force_max: float = np.inf,
                           stroke_max: float = np.inf, params=None, oversample: float = 2.0,
                           harmonics: int = 1, min_points: int = 32, solver: str = "CLARABEL",
+                          omega_max: float | None = None,
                           **solver_options) -> PseudoSpectralBound:
     """Optimal constrained mean absorbed power (W) for a periodic sea, non-causal.
 
-    Optimises the PTO force's Fourier coefficients on the wave's own frequency grid (as
-    WecOptTool does), with |F(t_j)| <= force_max (N or N m) and |x(t_j)| <= stroke_max (m or
-    rad) at collocation times over one repeat period; a convex QP solved by cvxpy (default
-    Clarabel; solver_options go to it, e.g. max_threads=1). With no limits it equals
-    complex_conjugate_bound. The wave's ramp is ignored (steady periodic state). oversample,
-    min_points, harmonics: see PseudoSpectralProblem. Limits may be exceeded between
-    collocation points (a few % at oversample 2 in an irregular sea; check on a finer grid
-    with PseudoSpectralProblem.series). Solve time grows like n_points x n_components^2:
-    0.02 s for a regular wave, about 0.6 s for 75 components, 12-25 s for 278 (a 600 s sea).
+    Optimises the PTO force's Fourier coefficients, by default on the wave's own frequency
+    grid (as WecOptTool does; no bound on a saturating controller, whose force fills the gaps
+    and the harmonics: give omega_max, rad/s, for every multiple of 2 pi / T up to it), with
+    |F(t_j)| <= force_max (N or N m) and |x(t_j)| <= stroke_max (m or rad) at collocation
+    times over one repeat period; a convex QP solved by cvxpy (default Clarabel;
+    solver_options go to it, e.g. max_threads=1) or by analysis.box_qp (solver="IPM"). With
+    no limits it equals complex_conjugate_bound. The wave's ramp is ignored (steady periodic
+    state). oversample, min_points, harmonics: see PseudoSpectralProblem. Limits may be
+    exceeded between collocation points (a few % at oversample 2 in an irregular sea; check
+    on a finer grid with PseudoSpectralProblem.series), which only raises the figure.
+    Clarabel's time grows like n_points x n_components^2: 0.02 s for a regular wave, about
+    0.6 s for 75 components, 12-25 s for 278 (a 600 s sea); "IPM" like n_points x n^2 with a
+    BLAS constant (300 s sea to 12 rad/s, 573 components: see analysis.box_qp).
     For several limits on one sea, build one PseudoSpectralProblem and call solve repeatedly.
     """
     problem = PseudoSpectralProblem(plant, wave, pto=pto, params=params, oversample=oversample,
-                                    harmonics=harmonics, min_points=min_points)
+                                    harmonics=harmonics, min_points=min_points,
+                                    omega_max=omega_max)
     return problem.solve(force_max, stroke_max, solver, **solver_options)

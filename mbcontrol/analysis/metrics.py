@@ -41,10 +41,15 @@ def analysis_window(ds) -> np.ndarray:
 def statistics_window(ds) -> dict:
     """{"start_s", "note"}: where the statistics start (s) and why. Regular wave: the last 10
     periods; a sea: after the ramp; either way not before the controller's warm-up ends
-    (its describe()["warm_up_s"] in ds.attrs["controller"])."""
+    (its describe()["warm_up_s"] in ds.attrs["controller"]). A caller may set the start in
+    ds.attrs["statistics_from_s"] with its reason in ds.attrs["statistics_note"] (design
+    scores a sea over its last whole repeat period, as the bounds it is compared with)."""
     t = ds["time"].values
     wave = json.loads(ds.attrs.get("wave", "{}"))
-    if wave.get("type") == "regular":
+    if "statistics_from_s" in ds.attrs:
+        start = float(ds.attrs["statistics_from_s"])
+        note = str(ds.attrs.get("statistics_note", "set by the caller"))
+    elif wave.get("type") == "regular":
         start = float(t[-1] - 10 * wave["period"])
         note = "the last 10 wave periods"
     else:

@@ -32,6 +32,7 @@ def summary(ds, plant) -> dict:
             "wall_time_s": float(ds.attrs["wall_time_s"]), "method": ds.attrs["method"],
             "window_start_s": stats_window["start_s"], "window": stats_window["note"],
             "controller": json.loads(ds.attrs.get("controller", "null")),
+            "estimator": json.loads(ds.attrs.get("estimator", "null")),
             "provenance": {k: ds.attrs.get(k) for k in ("scene_sha256", "hydro_sha256",
                                                         "radiation_sha256")},
             "dofs": dofs, "bodies": bodies, "ptos": ptos,

@@ -24,6 +24,9 @@ its reasons. The checks, each independent of the time-domain model that made the
    it); roll and pitch likewise within ANGLE_MAX_RAD (30 deg). The verdict is on a mean over
    the record, so it is the typical motion that decides; a peak beyond the limit is
    reported as a warning (with the share of time spent there), not an invalid result.
+4. **Sampled loop.** A controller with a period whose held linear loop is unstable at rest
+   (attrs["sampled_loop"], from mbcontrol.sim.sampled before the run) makes the result
+   invalid: what it shows is a transient of a diverging loop, however short the record.
 
 `assess` works on a Dataset from `mbcontrol.sim.simulate` and writes the verdict into its
 attrs; `assess_values` works on plain numbers, for callers that keep no Dataset;
@@ -240,6 +243,12 @@ def assess(ds, plant, wave=None, *, mean_power_W: float | None = None) -> dict:
     verdict = assess_values(plant, wave, params, window=(float(t[0]), float(ds["time"][-1])),
                             mean_power_W=power, energy=energy_record(plant, ds),
                             excursions=excursions(plant, ds, wave, mask))
+    loop = json.loads(ds.attrs.get("sampled_loop", "null"))
+    if loop is not None and not loop["stable"]:       # sim.sampled, checked before the run
+        verdict["valid"] = False
+        verdict["invalid_reasons"].append(f"sampled control loop: {loop['message']}")
+    if loop is not None:
+        verdict["checks"]["sampled_loop"] = loop
     mark(ds, verdict)
     return verdict
 

@@ -149,8 +149,9 @@ def _parser() -> argparse.ArgumentParser:
                         "control) and with no controller saturation; the limits are still\n"
                         "reported (violations, constrained bound)")
     p.add_argument("--bounds", choices=("auto", "full", "off"), default="auto",
-                   help="auto: complex-conjugate, and pseudo-spectral unless the sea has more than\n"
-                        "150 components; full: always both (slow for long seas); off: none")
+                   help="auto: complex-conjugate and pseudo-spectral, a sea's force band cut to\n"
+                        "600 frequencies (then a reference, not a bound); full: the whole\n"
+                        "band (minutes for long seas); off: none")
     p.add_argument("--json", action="store_true", help="print the design as JSON")
     p.set_defaults(run=run_design)
 

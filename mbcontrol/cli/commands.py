@@ -159,7 +159,9 @@ def _simulate_command(args, result) -> str:
         words += ["--duration", repr(sim["duration_s"]), "--dt", repr(sim["dt_s"])]
     words += ["--controller", result.name]
     for key, value in result.parameters.items():
-        words += ["--set", f"{key}={value!r}"]
+        items = value.items() if isinstance(value, dict) else [(None, value)]
+        for pto, v in items:          # per-PTO values as KEY.PTO=VALUE
+            words += ["--set", f"{key}{'' if pto is None else '.' + pto}={v!r}"]
     return shlex.join(words)
 
 
@@ -186,6 +188,8 @@ def _print_design(plant, wave, result, command) -> None:
     for key, value in result.parameters.items():
         print(f"    {key} = {value!r} {units.get(key, 's')}")
     print(f"  predicted (linear theory): {_power(result.predicted_power_W)}")
+    if "other_ptos" in result.tuner:
+        print(f"  other PTOs: {result.tuner['other_ptos']}")
     if "simulated_power_W" in result.tuner:
         print(f"  tuner's own simulation: {_power(result.tuner['simulated_power_W'])}")
     if result.margins is not None:
@@ -194,21 +198,36 @@ def _print_design(plant, wave, result, command) -> None:
     limits = f"|F| <= {b['force_max']:.4g} {F}, |x| <= {b['stroke_max']:.4g} {X}"
     constrained = (_power(b["constrained_W"]) if b["constrained_W"] is not None
                    else f"n/a ({b['constrained_reason']})")
+    if b.get("constrained_kind") == "reference":        # not a bound on what was simulated
+        constrained += f" - a REFERENCE, not a bound: {b['constrained_kind_reason']}"
     print(f"  bounds: complex-conjugate {_power(b['complex_conjugate_W'])}; constrained "
           f"({limits}) {constrained}")
+    if b.get("total_complex_conjugate_W") is not None:
+        print(f"  bound on all PTOs together (multiport complex-conjugate): "
+              f"{_power(b['total_complex_conjugate_W'])}")
     m = result.metrics
     if m is None:
         print("  not simulated (see the warning)")
     else:
         sim = result.simulation
         pct = result.percent_of_bound
-        share = ", ".join(f"{v:.1f} % of the {k.replace('_', '-')} bound"
+        kind = {"constrained": "reference" if b.get("constrained_kind") == "reference"
+                else "bound"}
+        share = ", ".join(f"{v:.1f} % of the {k.replace('_', '-')} {kind.get(k, 'bound')}"
                           for k, v in pct.items() if v is not None)
         print(f"  simulated ({sim['duration_s']:.4g} s, dt {sim['dt_s']:.4g} s, nonlinear plant): "
               f"mean absorbed power {_power(m['mean_power_W'])} ({share})")
+        if "total_mean_power_W" in m:
+            print(f"    all PTOs together: {_power(m['total_mean_power_W'])} "
+                  f"({pct['total_complex_conjugate']:.1f} % of their bound)")
         print(f"    max force {m['max_force']:.4g} {F}, max stroke {m['max_stroke']:.4g} {X}, "
               f"peak/mean power {m['papr']:.3g}, samples outside the limits "
               f"{100 * m['violation_fraction']:.3g} %")
+        estimator = sim["summary"].get("estimator")
+        if estimator:
+            print(f"    excitation estimate error {100 * estimator['excitation_error']:.3g} % "
+                  f"(RMS, against the simulation's true excitation, after "
+                  f"{estimator['window_start_s']:.4g} s)")
         print("    result: valid (bound, energy balance, linear-hydrodynamics range checked)"
               if result.valid else "    result: INVALID - " + "; ".join(result.invalid_reasons))
     print(f"  re-run: {command}")
@@ -291,18 +310,25 @@ def _controller(args, wave=None):
 
 def parse_settings(items, signature) -> dict:
     """--set KEY=VALUE items as a controller's settings: numbers, true/false, none, or words
-    (for a setting that takes text, e.g. forecast=ar). A word for a numeric setting is an
-    error (a key the controller does not take is named by `make`)."""
+    (for a setting that takes text, e.g. forecast=ar). KEY.PTO=VALUE sets one PTO's value
+    (a dict by PTO name, e.g. damping.pto1=3.5). A word for a numeric setting is an error (a
+    key the controller does not take, or an unknown PTO, is named by the controller)."""
     settings = {}
     for item in items:
         if "=" not in item:
             raise ValueError(f"--set expects KEY=VALUE, got {item!r}")
         key, text = (part.strip() for part in item.split("=", 1))
+        key, _, pto = key.partition(".")
         value = _setting_value(text)
         # text only for a setting that is text (a choice), so a typo in a number is caught
         if isinstance(value, str) and not _takes_text(signature.get(key)):
             raise ValueError(f"--set {key}: expected a number, true/false or none, got {text!r}")
-        settings[key] = value
+        if not pto:
+            settings[key] = value
+        elif not isinstance(settings.setdefault(key, {}), dict):
+            raise ValueError(f"--set {key}.{pto}: {key} was already set for every PTO")
+        else:
+            settings[key][pto] = value
     return settings
 
 
@@ -355,6 +381,9 @@ def _print_summary(result: dict) -> None:
     if "bound_W" in checks:
         print(f"  complex-conjugate bound of this wave {checks['bound_W']:.4g} W (all PTOs, "
               f"linear theory)")
+    if result.get("estimator"):
+        print(f"  excitation estimate error {100 * result['estimator']['excitation_error']:.3g} %"
+              f" (RMS, against the simulation's true excitation)")
     print("  result: valid (bound, energy balance, linear-hydrodynamics range checked)"
           if result["valid"] else "  result: INVALID - " + "; ".join(result["invalid_reasons"]))
 

@@ -22,7 +22,8 @@ import xarray as xr
 
 from ..errors import SimulationError
 from ..plant import provenance
-from . import diagnose, integrators
+from ..results import jsonable
+from . import diagnose, integrators, sampled
 from .moorings import mooring_report
 
 
@@ -39,7 +40,9 @@ def simulate(plant, wave=None, *, duration: float, dt: float = 0.01, controller=
     `energy_audit`). Returns a Dataset over time with every plant output, the applied
     inputs u, the excitation w, the wave elevation `eta` and the states, plus provenance in
     attrs: wall_time_s is the excitation synthesis and the time-stepping (compilation and
-    the output evaluation excluded; output_time_s is the latter).
+    the output evaluation excluded; output_time_s is the latter). A controller with a period
+    and a static law has its held loop checked first (sim.sampled: a RuntimeWarning when
+    unstable; the verdict in attrs["sampled_loop"], which analysis.validity reads).
     """
     if duration <= 0 or dt <= 0 or dt > duration:
         raise ValueError(f"expected 0 < dt <= duration, got dt={dt}, duration={duration}")
@@ -50,6 +53,9 @@ def simulate(plant, wave=None, *, duration: float, dt: float = 0.01, controller=
     x0 = plant.x0() if x0 is None else np.asarray(x0, float)
     if controller is not None:
         controller.reset(plant)
+    loop = sampled.check(plant, controller, p, dt)   # a held law's loop, before it runs
+    if loop is not None and not loop["stable"]:
+        warnings.warn(f"{plant.name}: {loop['message']}", RuntimeWarning, stacklevel=2)
     if spec.kind == "explicit":
         _warn_stiff(plant, dt)
     bar = _progress_bar(progress, n)
@@ -91,6 +97,11 @@ def simulate(plant, wave=None, *, duration: float, dt: float = 0.01, controller=
     if not spec.fixed_step:
         ds.attrs["rtol"] = rtol
     ds.attrs["moorings"] = json.dumps(mooring_report(plant, ds))
+    report = getattr(controller, "estimation_report", None)    # an estimator's accuracy
+    if report is not None:
+        ds.attrs["estimator"] = json.dumps(jsonable(report(t, W)))
+    if loop is not None:                 # analysis.validity reads it
+        ds.attrs["sampled_loop"] = json.dumps(loop)
     return ds
 
 

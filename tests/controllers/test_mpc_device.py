@@ -11,6 +11,7 @@ import pytest
 from mbcontrol import build_plant, waves
 from mbcontrol.controllers.control_plant import build_control_plant, device_frequency
 from mbcontrol.controllers.mpc import Mpc
+from mbcontrol.analysis import summary
 from mbcontrol.sim import simulate
 
 from ..sphere_reference import heave_impedance
@@ -40,9 +41,12 @@ def test_mpc_without_the_sea_warns_and_still_absorbs():
     sea = waves.irregular(2.5, 8.0, seed=2, duration=200,
                           data_band=(float(omega[0]), float(omega[-1])))
 
+    runs = {}
+
     def power(**settings):
         controller = Mpc(horizon_s=8, dt_s=0.2, force_max=2e6, stroke_max=4, **settings)
         ds = simulate(plant, sea, duration=200, dt=0.02, controller=controller)
+        runs[tuple(settings)] = ds, controller
         t = ds.time.values[:-1]
         work = -ds["pto__force"].values[:-1] * np.diff(ds["pto__position"].values)
         return float(np.mean(work[t >= 60] / 0.02))
@@ -57,6 +61,21 @@ def test_mpc_without_the_sea_warns_and_still_absorbs():
     assert given > 0
     assert guessed_ar == pytest.approx(given, rel=0.05)
     assert guessed_model == pytest.approx(given, rel=0.05)
+
+    # the estimator's accuracy is in the run's JSON; checked here against the simulation's
+    # own excitation on the sphere's single heave DOF (d = S w, S a 1 x 1 scale). Measured:
+    # 0.94 % given the sea, 2.4 % without (36 % when the wave model sat on a radiation pole)
+    for key, limit in ((("wave",), 0.02), ((), 0.05)):
+        ds, controller = runs[key]
+        report = summary(ds, plant)["estimator"]
+        assert report["excitation_error"] < limit
+        times = np.array([h[0] for h in controller.history])
+        d_hat = np.array([h[1][0] for h in controller.history])
+        k = times >= report["window_start_s"]
+        true = controller.cp.S[0, 0] * np.interp(times[k], ds.time.values,
+                                                 ds[plant.disturbances[0]].values)
+        by_hand = np.linalg.norm(d_hat[k] - true) / np.linalg.norm(true)
+        assert report["excitation_error"] == pytest.approx(by_hand, rel=1e-6)
 
 
 def test_limits_for_some_ptos_leave_the_others_at_the_scene():

@@ -1,0 +1,125 @@
+"""Tuning by controller name for `controllers.design`: each controller's tuner, the PTO's
+limits handed to the tuners that take them, and the parameters that rebuild the controller
+(`make(name, **parameters)`). See controllers.design for what the limits mean."""
+from __future__ import annotations
+
+import inspect
+import math
+
+from mbcontrol.results import jsonable
+
+from . import REGISTRY, make
+
+# the tuned parameters of each controller (the contract of make(name, **parameters))
+CONTRACT = {"passive": ("damping",), "reactive": ("damping", "stiffness"),
+            "latching": ("damping", "latch_time"), "declutching": ("damping", "declutch_time"),
+            "mpc": ("horizon_s", "dt_s", "force_max", "stroke_max", "rate_max"),
+            "nmpc": ("horizon_s", "dt_s", "force_max", "stroke_max", "rate_max")}
+# MPC's default force-rate limit (with a force limit): a full reversal, -F_max to +F_max, takes
+# a fifth of the wave period at the least; a real drive cannot switch within a few samples
+RATE_REVERSALS_PER_PERIOD = 5
+
+
+def _accepts(func, keyword: str) -> bool:
+    try:
+        return keyword in inspect.signature(func).parameters
+    except (TypeError, ValueError):
+        return False
+
+
+def _limit_kwargs(func, finite: dict, what: str, notes: list) -> dict:
+    """The finite limits `func` takes; a note for each one it does not."""
+    taken = {k: v for k, v in finite.items() if _accepts(func, k)}
+    missing = sorted(set(finite) - set(taken))
+    if missing:
+        notes.append(f"{what} does not take {', '.join(missing)}: tuned without "
+                     f"{'that limit' if len(missing) == 1 else 'those limits'}")
+    return taken
+
+
+def tune(plant, wave, name, pto_obj, limits, model_params, notes):
+    """(parameters, predicted W or None, tuner info, extra controller settings)."""
+    cls = REGISTRY[name]
+    pto = pto_obj.name
+    scene = {"force_max": float(pto_obj.force_max), "stroke_max": float(pto_obj.stroke_max)}
+    finite = {k: v for k, v in scene.items() if limits and math.isfinite(v)}
+    # the controller's own limits, explicit (its default, None, would mean the scene's): the
+    # scene's with limits, none without, so make(name, **parameters) is the very controller
+    own = {k: (v if limits else math.inf) for k, v in scene.items() if _accepts(cls, k)}
+    if name == "mpc" and limits:     # no scene limit: the MPC's own default (a soft stroke
+        own = {k: v for k, v in own.items() if math.isfinite(v)}   # limit in its linear range)
+    # the wave is a setting beyond the parameters: a predictive controller's preview
+    extra = {"wave": wave} if _accepts(cls, "wave") else {}
+    if name in ("passive", "reactive") and len(plant.scene.ptos) > 1:
+        return _tune_jointly(plant, wave, name, limits, model_params, own, extra)
+    if name in ("passive", "reactive"):
+        from .passive import optimal_damping
+        from .reactive import reactive_tuning
+        tuner = optimal_damping if name == "passive" else reactive_tuning
+        kw = _limit_kwargs(tuner, finite, tuner.__name__, notes)
+        if pto_obj.efficiency != 1 and _accepts(tuner, "efficiency"):
+            kw["efficiency"] = float(pto_obj.efficiency)    # tune for electrical power
+        if name == "passive":
+            damping, predicted = tuner(plant, wave, pto=pto, params=model_params, **kw)
+            tuned = {"damping": damping}
+        else:
+            damping, stiffness, predicted = tuner(plant, wave, pto, params=model_params, **kw)
+            tuned = {"damping": damping, "stiffness": stiffness}
+        return ({**tuned, **own}, predicted, {"function": tuner.__name__, "settings": kw},
+                extra)
+    if name in ("latching", "declutching"):
+        from .latching import optimal_declutch, optimal_latch_time
+        if model_params:
+            raise ValueError("model_params: latching and declutching tune by simulating the "
+                             "plant itself")
+        tuner, key = ((optimal_latch_time, "latch_time") if name == "latching"
+                      else (optimal_declutch, "declutch_time"))
+        kw = _limit_kwargs(tuner, finite, tuner.__name__, notes)
+        hold, damping, simulated = tuner(plant, wave, pto=pto, **kw)
+        return ({"damping": damping, key: hold, **own}, None,
+                {"function": tuner.__name__, "settings": kw, "simulated_power_W": simulated,
+                 "dt_s": wave.period / 500}, extra)
+    # mpc (or another registered controller): no tuner; its defaults and the PTO's limits
+    if model_params:
+        raise ValueError("model_params: this controller is not tuned, so there is no model "
+                         "to get wrong")
+    if name in ("mpc", "nmpc"):
+        # one wave period ahead in 40 steps: the horizon that reaches the constrained bound
+        # on the sphere (tests/test_mpc.py) and a QP of real-time size
+        own.setdefault("horizon_s", float(wave.period))
+        own.setdefault("dt_s", float(wave.period) / 40)
+        if "force_max" in finite:      # a drive's slew: a full reversal in a fifth of a period
+            own.setdefault("rate_max", RATE_REVERSALS_PER_PERIOD * 2 * finite["force_max"]
+                           / float(wave.period))
+    controller = make(name, **own, **extra)
+    parameters = {}
+    for key in CONTRACT.get(name, ()):
+        value = own.get(key, getattr(controller, key, None))
+        if isinstance(value, (int, float)):
+            parameters[key] = float(value)
+    return parameters, None, {"function": None, "settings": "defaults"}, extra
+
+
+def _tune_jointly(plant, wave, name, limits, model_params, own, extra):
+    """Every PTO tuned together for their total power (controllers.joint), each with its
+    own law and, with limits, its own force and stroke limits."""
+    from .joint import joint_tuning
+    from .limits import linear_range
+    ptos = plant.scene.ptos
+    kw = {}
+    if limits:       # a stroke the scene leaves free: within the linear model's range
+        kw = {"force_max": {p.name: p.force_max for p in ptos},
+              "stroke_max": {p.name: p.stroke_max if math.isfinite(p.stroke_max)
+                             else linear_range(plant, p.name) for p in ptos}}
+        own = {k: {p.name: getattr(p, k) for p in ptos} for k in own}    # each PTO's own
+    if any(p.efficiency != 1 for p in ptos):
+        kw["efficiency"] = {p.name: float(p.efficiency) for p in ptos}
+    tuned = joint_tuning(plant, wave, passive=name == "passive", params=model_params, **kw)
+    parameters = {"damping": tuned.damping}
+    if name == "reactive":
+        parameters["stiffness"] = tuned.stiffness
+    tuner = {"function": "joint_tuning", "method": tuned.method,
+             "objective": "the total mean power of all PTOs, each closed by its own law",
+             "settings": jsonable(kw), "predicted_by_pto_W": tuned.predicted_W,
+             "predicted_total_W": tuned.total_W}
+    return {**parameters, **own}, tuned.predicted_W, tuner, extra
