@@ -155,3 +155,26 @@ def test_first_use_messages_name_the_file_and_the_settings(capsys, tmp_path):
                        "--controller", "passive", "--set", "dampin=3")
     assert code == 1 and "has no setting 'dampin'" in err
     assert "damping, period, force_max" in err and "__init__" not in err
+
+
+def test_simulate_warns_of_an_unstable_sampled_loop_and_exits_3(capsys):
+    # flap_pair's reactive law held over 0.1 s: the spring's hold removes more damping than
+    # the law adds (tests/controllers/test_sampled.py has the discrete-time reference)
+    with pytest.warns(RuntimeWarning, match="sampled at 0.1 s .*UNSTABLE"):
+        code, out, err = run(capsys, "simulate", "flap_pair", "--wave", "regular", "--height",
+                             "0.01", "--period", "2.5", "--duration", "20", "--dt", "0.005",
+                             "--controller", "reactive", "--set", "damping=4.872", "--set",
+                             "stiffness=234.4", "--set", "period=0.1", "--json")
+    assert code == 3
+    assert json.loads(out)["valid"] is False and "sampled control loop" in err
+
+
+def test_the_toolboxs_warnings_read_as_sentences():
+    import os
+
+    from mbcontrol.cli import _format_warning
+    ours = os.path.join(os.sep, "x", "mbcontrol", "cli", "commands.py")
+    assert _format_warning("it diverges", RuntimeWarning, ours, 95) == \
+        "mbcontrol: warning: it diverges\n"
+    theirs = os.path.join(os.sep, "x", "numpy", "lib.py")
+    assert "RuntimeWarning" in _format_warning("overflow", RuntimeWarning, theirs, 1)

@@ -17,7 +17,9 @@ Examples:
 from __future__ import annotations
 
 import argparse
+import os
 import sys
+import warnings
 
 from ..errors import MbcontrolError
 from ..sim.methods import METHODS
@@ -76,7 +78,26 @@ Example:
 """
 
 
+def _format_warning(message, category, filename, lineno, line=None) -> str:
+    """The toolbox's own warnings as sentences for the user, without the source line that
+    issued them; anything else (numpy, a dependency) in Python's usual form."""
+    if os.sep + "mbcontrol" + os.sep in filename or os.sep + "controllers" + os.sep in filename:
+        return f"mbcontrol: warning: {message}\n"
+    return _python_format(message, category, filename, lineno, line)
+
+
+_python_format = warnings.formatwarning
+
+
 def main(argv=None) -> int:
+    previous, warnings.formatwarning = warnings.formatwarning, _format_warning
+    try:
+        return _main(argv)
+    finally:
+        warnings.formatwarning = previous
+
+
+def _main(argv) -> int:
     parser = _parser()
     args = parser.parse_args(argv)
     if not hasattr(args, "run"):
