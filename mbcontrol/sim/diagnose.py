@@ -37,9 +37,10 @@ def controller_name(controller) -> str:
     return repr(name)
 
 
-def closed_loop_poles(plant, law, p, x=None) -> tuple[np.ndarray, np.ndarray]:
-    """(closed-loop poles, open-loop poles), 1/s: the plant linearised at x (default: rest,
-    no command, still water) with u = law(y) closed around it and without it."""
+def law_loop(plant, law, p, x=None):
+    """(A, B_u, C, D_u, K): the plant's exact Jacobians at x (default: rest, no command,
+    still water) and K = d law / d y there (u = K y), for the continuous loop here and the
+    sampled one (sim.sampled)."""
     from ..plant.jacobians import jacobians
     x = plant.x0() if x is None else np.asarray(x, float)
     nu, nw = len(plant.inputs), len(plant.disturbances)
@@ -48,8 +49,14 @@ def closed_loop_poles(plant, law, p, x=None) -> tuple[np.ndarray, np.ndarray]:
     y0 = np.asarray(plant.h(x, u0, w0, p)).ravel()
     ys = ca.SX.sym("y", y0.size)
     K = np.asarray(ca.Function("dlaw", [ys], [ca.jacobian(law(ys), ys)])(y0))
-    K = K.reshape(nu, y0.size)
-    closed = A + Bu @ np.linalg.solve(np.eye(nu) - K @ Du, K @ C)
+    return A, Bu, C, Du, K.reshape(nu, y0.size)
+
+
+def closed_loop_poles(plant, law, p, x=None) -> tuple[np.ndarray, np.ndarray]:
+    """(closed-loop poles, open-loop poles), 1/s: the plant linearised at x (default: rest,
+    no command, still water) with u = law(y) closed around it and without it."""
+    A, Bu, C, Du, K = law_loop(plant, law, p, x)
+    closed = A + Bu @ np.linalg.solve(np.eye(Bu.shape[1]) - K @ Du, K @ C)
     return np.linalg.eigvals(closed), np.linalg.eigvals(A)
 
 
@@ -79,7 +86,7 @@ def explainer(plant, wave, controller, p, x0, dt, method, duration, simulate=Non
 
 def _explain(plant, wave, controller, p, x0, dt, method, duration, t_fail, simulate):
     who = f"controller {controller_name(controller)}"
-    law = _static_law(plant, controller)
+    law = static_law(plant, controller)
     if law is not None:
         closed, open_ = closed_loop_poles(plant, law, p)
         bad = unstable(closed)
@@ -102,7 +109,7 @@ def _explain(plant, wave, controller, p, x0, dt, method, duration, t_fail, simul
     return None
 
 
-def _static_law(plant, controller):
+def static_law(plant, controller):
     try:
         return controller.casadi_law(plant)
     except Exception:                        # noqa: BLE001 - no law, no linear check

@@ -22,7 +22,6 @@ invalid when the loop is unstable.
 """
 from __future__ import annotations
 
-import casadi as ca
 import numpy as np
 import scipy.linalg
 
@@ -105,21 +104,6 @@ def _z(value) -> str:
     return f"{value.real:+.4g} {'+' if value.imag >= 0 else '-'} {abs(value.imag):.4g}i"
 
 
-def law_loop(plant, law, p, x=None):
-    """(A, B_u, C, D_u, K): the plant's exact Jacobians at x (default rest, no command, still
-    water) and K = d law / d y there, u = K y (the same linearisation as
-    diagnose.closed_loop_poles)."""
-    from ..plant.jacobians import jacobians
-    x = plant.x0() if x is None else np.asarray(x, float)
-    nu, nw = len(plant.inputs), len(plant.disturbances)
-    u0, w0 = np.zeros(nu), np.zeros(nw)
-    A, Bu, _, C, Du, _ = (np.asarray(M) for M in jacobians(plant)(x, u0, w0, p))
-    y0 = np.asarray(plant.h(x, u0, w0, p)).ravel()
-    ys = ca.SX.sym("y", y0.size)
-    K = np.asarray(ca.Function("dlaw", [ys], [ca.jacobian(law(ys), ys)])(y0)).reshape(nu, -1)
-    return A, Bu, C, Du, K
-
-
 def check(plant, controller, p, dt: float):
     """The sampled-loop verdict (`verdict`) of a controller with a period and a static CasADi
     law, linearised at rest with parameters p; None when there is nothing to check (no
@@ -127,11 +111,11 @@ def check(plant, controller, p, dt: float):
     period = getattr(controller, "period", None) if controller is not None else None
     if not period or getattr(controller, "uses_state", False):
         return None
-    law = diagnose._static_law(plant, controller)
+    law = diagnose.static_law(plant, controller)
     if law is None:
         return None
     try:
-        A, Bu, C, Du, K = law_loop(plant, law, p)
+        A, Bu, C, Du, K = diagnose.law_loop(plant, law, p)
     except (RuntimeError, ValueError):       # a law CasADi cannot differentiate: no check
         return None
     closed = np.linalg.eigvals(closed_loop_map(A, Bu, C, Du, K, float(period)))
