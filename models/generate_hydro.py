@@ -38,11 +38,13 @@ def bem_inputs(scene, panel_size: float | None = None) -> dict:
 
     from mbcontrol.hydro import BemBody
     from mbcontrol.hydro import geometry_dict
+    from mbcontrol.hydro.model import obstacle_bodies
 
     h = scene.hydro
     bodies = [BemBody(name=b.name, geometry=geometry_dict(b.geometry), cog=b.cog, mass=b.mass,
                       panel_size=panel_size or h.panel_size, dofs=h.dofs)
               for b in scene.bodies if b.hydro and b.geometry is not None]
+    bodies += obstacle_bodies(scene, panel_size)   # fixed structures: scatter, no DOFs
     return dict(bodies=bodies, rho=scene.water.rho, g=scene.water.g, depth=scene.water.depth,
                 omegas=np.array(h.omega), headings=h.headings, lid=h.lid)
 

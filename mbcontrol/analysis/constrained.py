@@ -48,19 +48,26 @@ def window_share(conjugate, start: float, end: float) -> float:
 
 def constrained_figure(plant, wave, pto, force_max: float, stroke_max: float, *,
                        params=None, harmonics: int = 1, full: bool = False,
-                       conjugate=None, whole_period: bool = False) -> dict:
+                       conjugate=None, whole_period: bool = False,
+                       oversample: float | None = None) -> dict:
     """The constrained figure (W) and what it is, as the keys of design's bound:
 
     constrained_W: the pseudo-spectral optimum (its dual certificate where the solver gives
     one), None on failure with constrained_reason; constrained_kind: "bound" or "reference";
     constrained_kind_reason: why; constrained_omega_max_rad_s, constrained_components: the
-    force's grid (top frequency, rad/s; number); constrained_solve_time_s (s); for a sea also
+    force's grid (top frequency, rad/s; number); constrained_solve_time_s (s);
+    constrained_points: the collocation times the limits hold at;
+    constrained_max_force_dense, constrained_max_position_dense (N or N m, m or rad) and
+    constrained_force_overshoot_pct, constrained_position_overshoot_pct: the optimal force and
+    its position between the collocation points (analysis.dense; a figure whose force breaks
+    a limit there is higher than the dense grid's, so still a bound); for a sea also
     window_s ([ramp, repeat period], s) and window_share (the complex-conjugate optimum's
     mean over that window over its period mean). harmonics: a regular wave's force grid
     (the design's choice); a sea's grid is every multiple of 2 pi / T in the hydro data's band,
     cut to MAX_FORCE_COMPONENTS unless full. conjugate: the complex_conjugate_bound, if known.
     whole_period: a sea's metrics are a mean over a whole repeat period (design's default),
-    so the figure bounds them; else they are a window's and it is a reference.
+    so the figure bounds them; else they are a window's and it is a reference. oversample:
+    collocation density (default analysis.dense.OVERSAMPLE).
     """
     from .bounds import PseudoSpectralProblem, complex_conjugate_bound, repeat_period
     out: dict = {"constrained_W": None, "constrained_reason": None}
@@ -86,6 +93,8 @@ def constrained_figure(plant, wave, pto, force_max: float, stroke_max: float, *,
             reasons.append(f"the force's harmonics stop at {harmonics} ({omega_max:.3g} rad/s), "
                            f"below the data's {top:.3g} rad/s")
     try:
+        if oversample is not None:
+            grid["oversample"] = oversample
         problem = PseudoSpectralProblem(plant, wave, pto=pto, params=params, **grid)
         result = problem.solve(force_max, stroke_max, "IPM")
     except Exception as exc:        # a solver failure is reported, not raised: # noqa: BLE001
@@ -93,7 +102,12 @@ def constrained_figure(plant, wave, pto, force_max: float, stroke_max: float, *,
         return out
     out.update(constrained_omega_max_rad_s=float(problem.omega[-1]),
                constrained_components=int(problem.omega.size),
-               constrained_solve_time_s=result.solve_time)
+               constrained_solve_time_s=result.solve_time,
+               constrained_points=int(problem.time.size),
+               constrained_max_force_dense=result.max_force_dense,
+               constrained_max_position_dense=result.max_position_dense,
+               constrained_force_overshoot_pct=result.force_overshoot_pct,
+               constrained_position_overshoot_pct=result.position_overshoot_pct)
     if not math.isfinite(result.mean_power):
         out["constrained_reason"] = f"no optimum under the limits (solver status {result.status})"
         return out

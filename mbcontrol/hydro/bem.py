@@ -2,8 +2,9 @@
 
 :func:`compute` solves one multibody problem (full 6N×6N radiation coupling), the diffraction
 problems, and the radiation problems at ω = 0 and ω = ∞ directly (ERRATA G17), then maps
-everything to NED body frames at each CoG (:mod:`.frames`). Results are cached as netCDF,
-keyed by a hash of every input that changes them.
+everything to NED body frames at each CoG (:mod:`.frames`). Bodies without DOFs are obstacles
+(:mod:`.obstacles`): in every problem's boundary, absent from the results. Results are cached
+as netCDF, keyed by a hash of every input that changes them.
 """
 from __future__ import annotations
 
@@ -23,9 +24,12 @@ from mbcontrol.errors import HydroError
 from . import _io
 from .frames import to_body_frames
 from .geometry import NED_TO_ZUP, RIGID_DOFS, BemBody, hull_mesh, lid_mesh, mirror_symmetric, validate_body
+from .obstacles import drop_seabed_faces, refine, remove_contact_faces
 
 LOG = logging.getLogger(__name__)
 CACHE_VERSION = 2  # bump when the dataset layout or content for given inputs changes: old caches miss
+OBSTACLE_MESHING = 2  # bump when .obstacles changes how obstacle results are made
+CONTACT_TOL = 1e-3    # m per m of panel size: a face centre this close to a facing panel touches it
 REQUIRED_VARS = ("added_mass", "radiation_damping", "added_mass_inf", "added_mass_zero", "excitation_force",
                  "froude_krylov_force", "diffraction_force", "hydrostatic_stiffness", "displaced_volume",
                  "waterplane_area", "center_of_buoyancy")
@@ -66,6 +70,8 @@ def cache_key(bodies, *, rho, g, depth, omegas, headings, lid) -> str:
         "omegas": [float(w) for w in omegas], "headings": [float(h) for h in headings],
         "lid": bool(lid), "capytaine": _capytaine_version(), "cache_version": CACHE_VERSION,
     }
+    if any(not b.dofs for b in bodies):  # only then: keys of scenes without obstacles stay valid
+        payload["obstacle_meshing"] = OBSTACLE_MESHING
     return hashlib.sha256(json.dumps(payload, sort_keys=True, default=str).encode()).hexdigest()
 
 
@@ -76,6 +82,8 @@ def _check_inputs(bodies, rho, g, depth, omegas, headings):
         if not isinstance(b, BemBody):
             raise HydroError(f"compute: bodies contains {type(b).__name__}; expected BemBody")
         validate_body(b)
+    if all(not b.dofs for b in bodies):
+        raise HydroError("compute: every body is an obstacle (no dofs); expected at least one body with DOFs")
     names = [b.name for b in bodies]
     if len(set(names)) != len(names):
         raise HydroError(f"compute: body names {names} are not distinct")
@@ -95,32 +103,52 @@ def _check_inputs(bodies, rho, g, depth, omegas, headings):
 
 
 def _capytaine_bodies(bodies, lid: bool, depth: float):
-    """Capytaine FloatingBodies (z-up), rotation centre = CoG, and per-body mesh data."""
+    """Capytaine FloatingBodies (z-up; obstacles without DOFs), rotation centre = CoG; the
+    hydrostatics bodies of the moving ones; whether mirror symmetry is used; contact faces removed."""
     import capytaine as cpt
 
     meshes = []
     for b in bodies:
         hull, sym, waterplane = hull_mesh(b)
-        if hull.vertices[:, 2].min() <= -depth:
+        if not b.dofs:       # an obstacle may stand on the sea bed; a CAD mesh may be coarse
+            n = hull.nb_faces
+            hull = refine(hull, b.panel_size)
+            hull = drop_seabed_faces(hull, depth, b.name) if np.isfinite(depth) else hull
+            sym = sym and hull.nb_faces == n
+        elif hull.vertices[:, 2].min() <= -depth:
             raise HydroError(f"body '{b.name}': geometry reaches below the sea bed (depth {depth} m)")
-        meshes.append((hull, lid_mesh(hull, b.panel_size, waterplane) if lid else None, sym))
+        meshes.append([hull, lid_mesh(hull, b.panel_size, waterplane) if lid else None, sym, hull])
+    removed = {}
+    if any(not b.dofs for b in bodies):  # lids above come from the closed hulls
+        order = [i for i, b in enumerate(bodies) if b.dofs] + [i for i, b in enumerate(bodies) if not b.dofs]
+        n_moving = sum(1 for b in bodies if b.dofs)
+        tol = CONTACT_TOL * min(b.panel_size for b in bodies)
+        kept_m, kept_o, counts = remove_contact_faces([meshes[i][0] for i in order[:n_moving]],
+                                                      [meshes[i][0] for i in order[n_moving:]], tol)
+        for i, m, c in zip(order, kept_m + kept_o, counts):
+            meshes[i][2] = meshes[i][2] and m is meshes[i][0]  # a changed mesh may be asymmetric
+            meshes[i][0] = m
+            removed[bodies[i].name] = c
     # Mirror symmetry survives the multibody join only if every body has it.
-    use_sym = all(s for _, _, s in meshes)
+    use_sym = all(s for _, _, s, _ in meshes)
     fbs, hydro = [], []
-    for b, (hull, lidm, _) in zip(bodies, meshes):
+    for b, (hull, lidm, _, closed) in zip(bodies, meshes):
         cog = NED_TO_ZUP @ np.asarray(b.cog, dtype=float)
-        # Gauss-Legendre 2 integrates the waterplane moments exactly on flat quads (the default
-        # one-point rule underestimates ∫x² dA by O(h²)); used for hydrostatics only.
-        full = cpt.FloatingBody(mesh=hull.with_quadrature("Gauss-Legendre 2"),
-                                dofs=cpt.rigid_body_dofs(rotation_center=cog),
-                                center_of_mass=cog, mass=float(b.mass), name=b.name)
-        hydro.append(full)
         m, lm = hull, lidm
         if use_sym:
             m, lm = mirror_symmetric(hull), mirror_symmetric(lidm) if lidm is not None else None
+        if not b.dofs:       # no DOFs, no hydrostatics: it only scatters
+            fbs.append(cpt.FloatingBody(mesh=m, lid_mesh=lm, name=b.name, dofs={}))
+            continue
+        # Gauss-Legendre 2 integrates the waterplane moments exactly on flat quads (the default
+        # one-point rule underestimates ∫x² dA by O(h²)); used for hydrostatics only.
+        full = cpt.FloatingBody(mesh=closed.with_quadrature("Gauss-Legendre 2"),  # before contact removal
+                                dofs=cpt.rigid_body_dofs(rotation_center=cog),
+                                center_of_mass=cog, mass=float(b.mass), name=b.name)
+        hydro.append(full)
         fbs.append(cpt.FloatingBody(mesh=m, lid_mesh=lm, name=b.name, center_of_mass=cog, mass=float(b.mass),
                                     dofs=cpt.rigid_body_dofs(only=list(b.dofs), rotation_center=cog)))
-    return fbs, hydro, use_sym
+    return fbs, hydro, use_sym, removed
 
 
 def _solve(solver, problems, *, progress: bool, n_jobs: int):
@@ -246,7 +274,7 @@ def compute(bodies: list[BemBody], *, rho: float, g: float, depth: float, omegas
 
     import capytaine as cpt
 
-    fbs, hydro, use_sym = _capytaine_bodies(bodies, lid, depth)
+    fbs, hydro, use_sym, removed = _capytaine_bodies(bodies, lid, depth)
     mb = cpt.Multibody(fbs)
     dof_names = [f"{b.name}__{d}" for b in bodies for d in RIGID_DOFS if d in b.dofs]
     if list(mb.dofs) != dof_names:  # Multibody keeps the order of rigid_body_dofs
@@ -269,6 +297,9 @@ def compute(bodies: list[BemBody], *, rho: float, g: float, depth: float, omegas
         raise HydroError(f"Capytaine failed ({type(exc).__name__}: {exc})") from exc
     _failed(results)
     seconds = (datetime.datetime.now() - t0).total_seconds()
+    obstacles = [b.name for b in bodies if not b.dofs]
+    everything, bodies = dict(zip((b.name for b in bodies), fbs)), [b for b in bodies if b.dofs]
+    fbs = [everything[b.name] for b in bodies]  # per-body variables: the moving bodies only
     data = _assemble_data_frame(results, dof_names, omegas, bem_headings, hydro, bodies, rho, g, depth)
     cogs = {b.name: np.asarray(b.cog, dtype=float) for b in bodies}
     ds = to_body_frames(data, refs=cogs, cogs=cogs, z_up=True)  # rotation centre = CoG: r_k = 0
@@ -286,16 +317,19 @@ def compute(bodies: list[BemBody], *, rho: float, g: float, depth: float, omegas
         ds["added_mass_zero"].attrs["note"] = "NaN: Capytaine 3.0 cannot solve ω = 0 in finite depth"
     ds["omega"].attrs.update(units="rad/s", long_name="wave angular frequency")
     ds["wave_direction"].attrs.update(units="rad", long_name="NED heading waves travel to, +x towards +y (starboard)")
-    lam_min = max(mb.minimal_computable_wavelength, 1e-12)  # Capytaine: 8 panel radii per wavelength
+    # Capytaine: 8 panel radii per wavelength. Its Multibody takes the least over the bodies;
+    # the coarsest one (a CAD obstacle, say) limits the whole solve
+    lam_min = max(max(fb.minimal_computable_wavelength for fb in mb.bodies), 1e-12)
     ds.attrs.update({
         "rho": rho, "g": g, "depth": depth, "frame": "NED body frames at CoG",
         "time_convention": "exp(-i omega t)",
         "excitation_reference": "unit wave amplitude, elevation positive up, at the n-frame origin",
         "matrix_layout": "X[radiating_dof, influenced_dof]; force_i = -sum_j X[j, i] * motion_j",
         "source": f"capytaine {_capytaine_version()}", "lid": bool(lid), "mirror_symmetry_used": bool(use_sym),
-        "hull_panels": {b.name: int(fb.mesh.nb_faces) for b, fb in zip(bodies, fbs)},
-        "lid_panels": {b.name: int(fb.lid_mesh.nb_faces) if fb.lid_mesh is not None else 0
-                       for b, fb in zip(bodies, fbs)},
+        "hull_panels": {k: int(fb.mesh.nb_faces) for k, fb in everything.items()},
+        "lid_panels": {k: int(fb.lid_mesh.nb_faces) if fb.lid_mesh is not None else 0
+                       for k, fb in everything.items()},
+        "obstacles": obstacles, "contact_faces_removed": removed,
         "omega_max_mesh": float(np.sqrt(2 * np.pi * g / lam_min)),  # deep-water ω at that wavelength, rad/s
         "cache_key": key, "solve_seconds": seconds,
         "created": datetime.datetime.now().isoformat(timespec="seconds"),

@@ -41,7 +41,9 @@ class BemBody:
     cog : centre of gravity in the n-frame (NED), m.
     mass : kg; enters the hydrostatic stiffness (gravity term about the CoG).
     panel_size : target panel edge length, m.
-    dofs : rigid DOFs to solve for, a subset of Surge, Sway, Heave, Roll, Pitch, Yaw.
+    dofs : rigid DOFs to solve for, a subset of Surge, Sway, Heave, Roll, Pitch, Yaw. Empty: an
+        obstacle (a structure fixed to ground), in the BEM without DOFs of its own; its mass is
+        not used (0 allowed) and its panels are bisected to ``panel_size`` (:mod:`.obstacles`).
     """
 
     name: str
@@ -78,11 +80,13 @@ def validate_body(body: BemBody) -> None:
     if not isinstance(name, str) or not name or "__" in name or "." in name or name.strip() != name:
         raise HydroError(f"body name {name!r}: expected a non-empty string without '__', '.' or spaces at the ends")
     _vec3(name, "cog", body.cog)
-    _positive(name, "mass", body.mass)
-    _positive(name, "panel_size", body.panel_size)
     dofs = tuple(body.dofs)
-    if not dofs or len(set(dofs)) != len(dofs) or not set(dofs) <= set(RIGID_DOFS):
-        raise HydroError(f"body '{name}': dofs = {dofs!r}; expected distinct names among {RIGID_DOFS}")
+    if dofs:                     # an obstacle (no DOFs) has no dynamics: its mass is not used
+        _positive(name, "mass", body.mass)
+    _positive(name, "panel_size", body.panel_size)
+    if len(set(dofs)) != len(dofs) or not set(dofs) <= set(RIGID_DOFS):
+        raise HydroError(f"body '{name}': dofs = {dofs!r}; expected distinct names among {RIGID_DOFS} "
+                         "(none for an obstacle)")
     g = body.geometry
     if not isinstance(g, dict) or g.get("type") not in GEOMETRY_TYPES:
         got = g.get("type") if isinstance(g, dict) else g

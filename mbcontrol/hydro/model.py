@@ -180,12 +180,21 @@ def _run_bem(scene: Scene, dofs):
             bodies.append(BemBody(name=body.name, geometry=geometry_dict(body.geometry),
                                       cog=body.cog, mass=body.mass,
                                       panel_size=scene.hydro.panel_size, dofs=body_dofs))
+    bodies += obstacle_bodies(scene)
     solve = compute if scene.hydro.interaction else compute_isolated
     data = solve(bodies, rho=scene.water.rho, g=scene.water.g, depth=scene.water.depth,
                        omegas=np.array(scene.hydro.omega), headings=scene.hydro.headings,
                        lid=scene.hydro.lid, cache_dir=cache_dir())
     what = "BEM" if scene.hydro.interaction else "BEM, bodies solved alone,"
     return f"{what} of {scene.path}", data
+
+
+def obstacle_bodies(scene: Scene, panel_size: float | None = None) -> list[BemBody]:
+    """The scene's obstacles as BemBodies without DOFs (mass unused), panels of `panel_size`
+    (m; default the scene's)."""
+    return [BemBody(name=o.name, geometry=geometry_dict(o.geometry), cog=o.geometry.center,
+                    mass=0.0, panel_size=panel_size or scene.hydro.panel_size, dofs=())
+            for o in scene.obstacles]
 
 
 def geometry_dict(geometry) -> dict:

@@ -1,8 +1,9 @@
 """Scene files: what a device is made of, read from TOML and validated once.
 
 A scene names its water, rigid bodies (mass, inertia about the CoG, CoG, BEM geometry), the
-joints of a tree (or forest) rooted at "ground", PTOs on joints and extra loads (hinge friction,
-linear moorings, quadratic drag). Every later stage trusts a loaded `Scene`.
+joints of a tree (or forest) rooted at "ground", PTOs on joints, extra loads (hinge friction,
+linear moorings, quadratic drag) and obstacles (fixed structures only the BEM sees). Every
+later stage trusts a loaded `Scene`.
 
 Coordinates are in the n-frame (north-east-down: x forward, y starboard, z down, origin on the
 undisturbed free surface) at the reference configuration q = 0, where every body frame is
@@ -48,6 +49,14 @@ class Body:
     cog: tuple[float, float, float]                        # m, n-frame at rest
     geometry: Geometry | None = None
     hydro: bool = True                                     # False: no hydrodynamic loads
+
+
+@dataclass(frozen=True)
+class Obstacle:
+    """A structure fixed to ground (a flap's base, a wall): in the BEM as a scatterer without
+    DOFs of its own, never in the multibody plant (no mass, no states)."""
+    name: str
+    geometry: Geometry                                     # required: what the waves meet
 
 
 @dataclass(frozen=True)
@@ -185,6 +194,7 @@ class Scene:
     hydro: HydroSettings = HydroSettings()
     parameters: dict = field(default_factory=dict)  # [parameters] as used (overrides applied)
     identify: dict = field(default_factory=dict)    # [identify]: parameter -> (lo, hi) to fit
+    obstacles: tuple[Obstacle, ...] = ()            # [[obstacle]]: fixed structures the BEM sees
 
     def body(self, name: str) -> Body:
         return next(b for b in self.bodies if b.name == name)
@@ -202,7 +212,9 @@ class Scene:
         data.pop("path")
         data["hydro"]["file"] = _file_digest(self.hydro.file)
         data["hydro"]["source"] = Path(self.hydro.source).name if self.hydro.source else None
-        for body in data["bodies"]:
+        if not data["obstacles"]:       # digests of scenes without obstacles stay as they were
+            data.pop("obstacles")
+        for body in list(data["bodies"]) + list(data.get("obstacles", ())):
             if body["geometry"] and body["geometry"]["file"]:
                 body["geometry"]["file"] = _file_digest(body["geometry"]["file"])
         text = json.dumps(data, sort_keys=True, default=str)

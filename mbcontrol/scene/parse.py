@@ -8,7 +8,7 @@ import numpy as np
 
 from .checks import Reader, catenary_geometry, check_topology
 from .model import (DOF_NAMES, JOINT_TYPES, Body, Drag, EndStop, Friction, Geometry, HydroSettings,
-                    Joint, Mooring, Pto, Scene, Water)
+                    Joint, Mooring, Obstacle, Pto, Scene, Water)
 from .template import expand
 
 
@@ -20,10 +20,12 @@ def parse_scene(data: dict, path: Path, parameters: dict | None = None) -> Scene
     data, used = expand(data, str(path), parameters)
     top = Reader(data, str(path), "")
     top.allow("name", "description", "water", "body", "joint", "pto", "friction", "mooring",
-              "drag", "end_stop", "hydro", "identify")
+              "drag", "end_stop", "hydro", "identify", "obstacle")
     water = _water(top.table("water", required=False))
     bodies = tuple(_body(r, path) for r in top.tables("body", required=True))
     joints = tuple(_joint(r) for r in top.tables("joint", required=True))
+    hydro = _hydro(top.table("hydro", required=False), path)
+    obstacles = _obstacles(top, path, bodies, hydro)
     scene = Scene(
         name=top.string("name", default=path.stem),
         path=str(path),
@@ -34,9 +36,10 @@ def parse_scene(data: dict, path: Path, parameters: dict | None = None) -> Scene
         moorings=tuple(_mooring(r) for r in top.tables("mooring")),
         drags=tuple(_drag(r) for r in top.tables("drag")),
         end_stops=tuple(_end_stop(r) for r in top.tables("end_stop")),
-        hydro=_hydro(top.table("hydro", required=False), path),
+        hydro=hydro,
         parameters=used,
         identify=_identify(top.table("identify", required=False)),
+        obstacles=obstacles,
     )
     return check_topology(scene, top)
 
@@ -77,6 +80,25 @@ def _geometry(r: Reader, path: Path) -> Geometry | None:
     if not mesh.exists():
         r.fail("file", f"expected an existing mesh file, {mesh} does not exist")
     return Geometry(kind, center, file=str(mesh))
+
+
+def _obstacles(top: Reader, path: Path, bodies, hydro) -> tuple[Obstacle, ...]:
+    """[[obstacle]] tables: name and geometry (both required), names unique among bodies too."""
+    out, taken = [], {b.name for b in bodies}
+    for r in top.tables("obstacle"):
+        r.allow("name", "geometry")
+        name = r.name()
+        if name in taken:
+            r.fail("name", f"expected a name no body or other obstacle has, got {name!r}")
+        taken.add(name)
+        if r.table("geometry", required=False).empty:
+            r.fail("geometry", "expected a geometry table (box, cylinder, sphere or mesh): an "
+                               "obstacle is a fixed structure only the BEM sees")
+        if not hydro.interaction:
+            r.fail("name", "expected [hydro] interaction = true: an obstacle acts on the bodies "
+                           "through the waves it scatters, which a solve of each body alone leaves out")
+        out.append(Obstacle(name=name, geometry=_geometry(r.table("geometry"), path)))
+    return tuple(out)
 
 
 def _joint(r: Reader) -> Joint:
