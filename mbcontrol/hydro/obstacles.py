@@ -50,8 +50,6 @@ def refine(mesh, panel_size: float, name=None):
     Bisection keeps each child's normal and leaves hanging nodes, which a constant-panel BEM
     does not need to avoid; unlike a uniform split it does not keep a CAD sliver's aspect ratio.
     """
-    import capytaine as cpt
-
     panel_size = np.sqrt(2.0) * panel_size
     fv = mesh.vertices[mesh.faces]                          # (n, 4, 3)
     size = np.linalg.norm(np.roll(fv, -1, axis=1) - fv, axis=2).max(axis=1)
