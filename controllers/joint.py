@@ -49,10 +49,9 @@ class PortModel:
     """The device seen from all its PTOs in `wave`: FD responses and the joint linear loop."""
 
     def __init__(self, plant, wave, params=None):
-        import control
-
-        from mbcontrol.analysis import linearize
         from mbcontrol.analysis.ports import linear_params, port_responses
+
+        from .sampled import joint_plant
         self.plant, self.wave = plant, wave
         self.ptos = [p.name for p in plant.scene.ptos]
         self.omega = np.asarray(wave.omega, float)
@@ -60,16 +59,12 @@ class PortModel:
         A = np.asarray(wave.amplitude, float) * np.exp(-1j * np.asarray(wave.phase, float))
         self.h = self.H * A[:, None]                         # (n_omega, n_pto)
         n = len(self.ptos)
-        sys = linearize(plant, params=linear_params(plant, self.ptos, params),
-                        inputs=[f"u__{p}" for p in self.ptos],
-                        outputs=[f"{p}__position" for p in self.ptos]
-                        + [f"{p}__velocity" for p in self.ptos])
+        sys = joint_plant(plant, params=linear_params(plant, self.ptos, params))
         if np.any(np.asarray(sys.D) != 0):
             raise ValueError(f"{plant.name}: a PTO's position or velocity depends directly "
                              f"on a PTO force")
         self._A, self._B, self._C = (np.asarray(m) for m in (sys.A, sys.B, sys.C))
         self._n = n
-        self.control = control
 
     def phasors(self, c, k):
         """(V, X, U): (n_pto, n_omega) PTO velocity, position, force phasors of the laws."""
@@ -90,7 +85,8 @@ class PortModel:
 
     def margin(self, c, k) -> float:
         """Minus the largest real part of the joint linear closed loop's poles (1/s)."""
-        K = np.hstack([np.diag(np.asarray(k, float)), np.diag(np.asarray(c, float))])
+        from .sampled import gain_matrix
+        K = gain_matrix(dict(zip(self.ptos, zip(c, k))), self.ptos)     # u = -K y
         return -float(np.max(np.linalg.eigvals(self._A - self._B @ K @ self._C).real))
 
 

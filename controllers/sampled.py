@@ -85,7 +85,7 @@ def _complete(plant, gains: dict) -> dict:
     return {n: tuple(map(float, gains.get(n, (0.0, 0.0)))) for n in names}
 
 
-def _gain_matrix(gains: dict, names) -> np.ndarray:
+def gain_matrix(gains: dict, names) -> np.ndarray:
     """G with u = -G y, y = [x_1, v_1, x_2, v_2, ...]: block-diagonal [stiffness, damping]."""
     G = np.zeros((len(names), 2 * len(names)))
     for i, n in enumerate(names):
@@ -105,7 +105,7 @@ def sampled_closed_loop(plant, gains, period: float | None, *, params=None) -> S
     gains = _complete(plant, gains)
     sys = joint_plant(plant, params=params)
     names = [p.name for p in plant.scene.ptos]
-    G = _gain_matrix(gains, names)
+    G = gain_matrix(gains, names)
     A, B, C, D = (np.asarray(M) for M in (sys.A, sys.B, sys.C, sys.D))
     if period is None:
         poles = np.linalg.eigvals(A - B @ np.linalg.solve(np.eye(len(names)) + G @ D, G @ C))
@@ -135,7 +135,7 @@ def discrete_loop(plant, gains: dict, period: float, pto: str, *, params=None):
         raise ValueError(f"{plant.name}: PTO positions and velocities should not depend on the "
                          f"force directly (D != 0)")
     Phi, Gamma = zoh_loop.zoh(sys.A, sys.B, float(period))
-    G, C = _gain_matrix(gains, names), np.asarray(sys.C)
+    G, C = gain_matrix(gains, names), np.asarray(sys.C)
     i = names.index(pto)
     rest = [j for j in range(len(names)) if j != i]
     Phi_o = Phi - Gamma[:, rest] @ G[rest] @ C
