@@ -8,7 +8,12 @@ def modal_form(A, B, C, tol: float = 1e-9):
     """Real modal (block-diagonal) realisation (A_m, B_m, C_m) of (A, B, C).
 
     Complex pole pairs sigma +- i w become 2x2 blocks [[sigma, w], [-w, sigma]], real poles 1x1,
-    so A_m has at most two non-zeros per row and a symbolic product A_m x costs O(n).
+    so A_m has at most two non-zeros per row and a symbolic product A_m x costs O(n). A pair's
+    eigenvector phase is chosen so its real and imaginary parts are orthogonal, a double real
+    eigenvalue returned as a conjugate pair is kept as a pair (its two real parts are one column),
+    and each block's states are scaled so its rows of B_m and columns of C_m have equal norms.
+    Without these, a 53-state fit of wavestar's data gave a near-singular T, B_m of 7.5e15 and a run that
+    "diverged" within 0.03 s (issue 20's branch wip/issue20-band).
     Raises ValueError when A is defective (not diagonalisable to working precision).
     """
     A, B, C = (np.asarray(M, dtype=float) for M in (A, B, C))
@@ -23,7 +28,10 @@ def modal_form(A, B, C, tol: float = 1e-9):
             continue
         lam, v = eigvals[i], vecs[:, i]
         used[i] = True
-        if abs(lam.imag) <= tol * max(1.0, abs(lam)):
+        # real: a real eigenvalue with a real eigenvector. A double real eigenvalue can come back
+        # as a conjugate pair with a complex eigenvector: the real parts of the two are then the
+        # same column; [Re v, Im v] below spans the pair (wavestar's fit, T singular before)
+        if abs(lam.imag) <= tol * max(1.0, abs(lam)) and np.linalg.norm(v.imag) <= tol * np.linalg.norm(v):
             columns.append(v.real / np.linalg.norm(v.real))
             blocks.append(np.array([[lam.real]]))
             continue
@@ -32,12 +40,23 @@ def modal_form(A, B, C, tol: float = 1e-9):
         used[partner] = True
         if lam.imag < 0:
             lam, v = lam.conjugate(), v.conjugate()
+        # any phase e^{iθ} v is an eigenvector: take the one with Re v ⟂ Im v and equal norms
+        # where possible, else [Re v, Im v] can be nearly parallel and T near-singular
+        a, b = v.real, v.imag
+        v = v * np.exp(-0.5j * np.arctan2(2 * a @ b, a @ a - b @ b))
         columns += [v.real, v.imag]
         blocks.append(np.array([[lam.real, lam.imag], [-lam.imag, lam.real]]))
     T = np.column_stack(columns)
     A_m = _block_diag(blocks)
     B_m = np.linalg.solve(T, B)
     C_m = C @ T
+    i = 0
+    for b in blocks:
+        k = slice(i, i + b.shape[0])
+        nb, nc = np.linalg.norm(B_m[k]), np.linalg.norm(C_m[:, k])
+        if nb > 0 and nc > 0:
+            B_m[k], C_m[:, k] = B_m[k] * np.sqrt(nc / nb), C_m[:, k] * np.sqrt(nb / nc)
+        i += b.shape[0]
     return A_m, B_m, C_m
 
 
