@@ -12,8 +12,8 @@ def modal_form(A, B, C, tol: float = 1e-9):
     eigenvector phase is chosen so its real and imaginary parts are orthogonal, a double real
     eigenvalue returned as a conjugate pair is kept as a pair (its two real parts are one column),
     and each block's states are scaled so its rows of B_m and columns of C_m have equal norms.
-    Without these, a 53-state fit of wavestar's data gave a near-singular T, B_m of 7.5e15 and a run that
-    "diverged" within 0.03 s (issue 20's branch wip/issue20-band).
+    Without these, a 53-state fit of wavestar's data (issue 20's branch wip/issue20-band) gave a
+    near-singular T, B_m of 7.5e15 and a run that "diverged" within 0.03 s.
     Raises ValueError when A is defective (not diagonalisable to working precision).
     """
     A, B, C = (np.asarray(M, dtype=float) for M in (A, B, C))
@@ -30,7 +30,7 @@ def modal_form(A, B, C, tol: float = 1e-9):
         used[i] = True
         # real: a real eigenvalue with a real eigenvector. A double real eigenvalue can come back
         # as a conjugate pair with a complex eigenvector: the real parts of the two are then the
-        # same column; [Re v, Im v] below spans the pair (wavestar's fit, T singular before)
+        # same column; [Re v, Im v] below spans the pair
         if abs(lam.imag) <= tol * max(1.0, abs(lam)) and np.linalg.norm(v.imag) <= tol * np.linalg.norm(v):
             columns.append(v.real / np.linalg.norm(v.real))
             blocks.append(np.array([[lam.real]]))
@@ -40,8 +40,8 @@ def modal_form(A, B, C, tol: float = 1e-9):
         used[partner] = True
         if lam.imag < 0:
             lam, v = lam.conjugate(), v.conjugate()
-        # any phase e^{iθ} v is an eigenvector: take the one with Re v ⟂ Im v and equal norms
-        # where possible, else [Re v, Im v] can be nearly parallel and T near-singular
+        # any phase e^{iθ} v is an eigenvector: take the one with Re v ⟂ Im v, else
+        # [Re v, Im v] can be nearly parallel and T near-singular
         a, b = v.real, v.imag
         v = v * np.exp(-0.5j * np.arctan2(2 * a @ b, a @ a - b @ b))
         columns += [v.real, v.imag]
