@@ -45,14 +45,15 @@ def model_gap(sphere):
     fitted radiation model (1 % fit tolerance) against the BEM data the bounds use. The
     matched damper and spring (c = Re Z_i, k = omega^2 (m + A) - K, from the bound's own
     Thevenin impedance, exp(-i omega t)) are the scene PTO's law, so no controller is
-    involved. Measured 1.0013: the plant absorbs 0.13 % more than linear theory predicts."""
+    involved. The fit's error shows as a gap either way: measured 0.9983 (the fit judged per
+    frequency in 0.3-2.5 rad/s, issue 20; 1.0013 with the global-norm fit before)."""
     cc = complex_conjugate_bound(sphere, WAVE)
     Z, omega = cc.thevenin.impedance[0], float(WAVE.omega[0])
     params = {"pto__damping": Z.real, "pto__stiffness": -omega * Z.imag}
     ds = simulate(sphere, WAVE, duration=12 * T, dt=DT, params=params)
     power = pto_metrics(ds, "pto", start=9 * T, end=12 * T)["mean_power_W"]
     gap = power / cc.power
-    assert 1.0 <= gap < 1.005
+    assert abs(gap - 1.0) < 0.005
     return gap
 
 
