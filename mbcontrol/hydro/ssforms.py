@@ -35,6 +35,10 @@ def modal_form(A, B, C, tol: float = 1e-9):
         used[partner] = True
         if lam.imag < 0:
             lam, v = lam.conjugate(), v.conjugate()
+        # any phase e^{iθ} v is an eigenvector: take the one with Re v ⟂ Im v and equal norms
+        # where possible, else [Re v, Im v] can be nearly parallel and T near-singular
+        a, b = v.real, v.imag
+        v = v * np.exp(-0.5j * np.arctan2(2 * a @ b, a @ a - b @ b))
         columns += [v.real, v.imag]
         blocks.append(np.array([[lam.real, lam.imag], [-lam.imag, lam.real]]))
     T = np.column_stack(columns)
