@@ -8,10 +8,12 @@ def modal_form(A, B, C, tol: float = 1e-9):
     """Real modal (block-diagonal) realisation (A_m, B_m, C_m) of (A, B, C).
 
     Complex pole pairs sigma +- i w become 2x2 blocks [[sigma, w], [-w, sigma]], real poles 1x1,
-    so A_m has at most two non-zeros per row and a symbolic product A_m x costs O(n). Each block's
-    states are scaled so that its rows of B_m and columns of C_m have equal norms: eigenvectors
-    fix no scale, and an unlucky one made B_m 7.5e15 (wavestar's fit), its states past a
-    divergence check within 0.03 s.
+    so A_m has at most two non-zeros per row and a symbolic product A_m x costs O(n). A pair's
+    eigenvector phase is chosen so its real and imaginary parts are orthogonal, a double real
+    eigenvalue returned as a conjugate pair is kept as a pair (its two real parts are one column),
+    and each block's states are scaled so its rows of B_m and columns of C_m have equal norms.
+    Without these, wavestar's fit gave a near-singular T, B_m of 7.5e15 and a simulation that
+    "diverged" within 0.03 s.
     Raises ValueError when A is defective (not diagonalisable to working precision).
     """
     A, B, C = (np.asarray(M, dtype=float) for M in (A, B, C))
@@ -26,7 +28,10 @@ def modal_form(A, B, C, tol: float = 1e-9):
             continue
         lam, v = eigvals[i], vecs[:, i]
         used[i] = True
-        if abs(lam.imag) <= tol * max(1.0, abs(lam)):
+        # real: a real eigenvalue with a real eigenvector. A double real eigenvalue can come back
+        # as a conjugate pair with a complex eigenvector: the real parts of the two are then the
+        # same column; [Re v, Im v] below spans the pair (wavestar's fit, T singular before)
+        if abs(lam.imag) <= tol * max(1.0, abs(lam)) and np.linalg.norm(v.imag) <= tol * np.linalg.norm(v):
             columns.append(v.real / np.linalg.norm(v.real))
             blocks.append(np.array([[lam.real]]))
             continue
