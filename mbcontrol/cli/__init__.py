@@ -122,7 +122,8 @@ def _parser() -> argparse.ArgumentParser:
     p = sub.add_parser("hydro", help="load or compute a model's BEM data and fit its radiation "
                                      "model; print the fit report")
     _model_options(p)
-    p.add_argument("--tol", type=float, help="radiation fit tolerance (normalised RMS error)")
+    p.add_argument("--tol", type=float, help="radiation fit tolerance (e.g. 0.01): the larger of the worst relative "
+                   "error per frequency in the scene's response_band and the global RMS error")
     p.add_argument("--json", action="store_true", help="print the report as JSON")
     p.set_defaults(run=run_hydro)
 

@@ -37,22 +37,25 @@ def run_hydro(args) -> int:
     if plant.hydro is None:
         print(f"{plant.name}: no hydrodynamic bodies")
         return 0
-    rad = plant.hydro.radiation
+    rad, rep = plant.hydro.radiation, plant.hydro.radiation.report
     report = {"model": plant.name, "source": plant.hydro.source, "dofs": list(plant.hydro.dofs),
               "omega_rad_s": [float(plant.hydro.omega[0]), float(plant.hydro.omega[-1])],
               "n_omega": int(plant.hydro.omega.size), "radiation_states": int(rad.order),
-              "fit_error": float(rad.fit_error),
-              "max_pole_real_part": float(np.max(np.linalg.eigvals(rad.A).real)),
-              "report": jsonable(rad.report)}
+              "fit_error": float(rad.fit_error), **{k: rep.get(k) for k in (
+                  "tol", "tol_met", "response_band", "band_error", "worst", "rms_error")},
+              "max_pole_real_part": float(np.max(np.linalg.eigvals(rad.A).real)), "report": jsonable(rep)}
     if args.json:
         print(json.dumps(report, indent=2))
     else:
-        print(f"{plant.name}: hydro data {report['source']}")
-        print(f"  DOFs ({len(report['dofs'])}): {', '.join(report['dofs'])}")
-        print(f"  {report['n_omega']} frequencies, {report['omega_rad_s'][0]:.3g}.."
-              f"{report['omega_rad_s'][1]:.3g} rad/s")
-        print(f"  radiation model: {rad.order} states, normalised RMS error "
-              f"{rad.fit_error:.2%}, slowest pole real part {report['max_pole_real_part']:.3g}")
+        print(f"{plant.name}: hydro data {report['source']}\n  DOFs ({len(report['dofs'])}): "
+              f"{', '.join(report['dofs'])}\n  {report['n_omega']} frequencies, "
+              f"{report['omega_rad_s'][0]:.3g}..{report['omega_rad_s'][1]:.3g} rad/s")
+        print(f"  radiation model: {rad.order} states, slowest pole real part {report['max_pole_real_part']:.3g} 1/s")
+        if rep.get("worst"):   # a fit loaded that missed its tolerance has warned already
+            wst, (lo, hi) = rep["worst"], rep["response_band"]
+            print(f"  fit error {rad.fit_error:.2%} (tol {rep['tol']:.2%}{'' if rep['tol_met'] else ', MISSED'}): "
+                  f"in {lo:.3g}-{hi:.3g} rad/s at worst {wst['error']:.2%}, {wst['part']} of "
+                  f"K[{wst['entry'][0]}, {wst['entry'][1]}] at {wst['omega']:.4g} rad/s; global RMS {rep['rms_error']:.2%}")
     return 0
 
 

@@ -12,6 +12,7 @@ import json
 import os
 import tempfile
 import time
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -22,7 +23,7 @@ from ..cache import cache_dir, status
 from ..errors import HydroError
 from ..scene import DOF_NAMES, Scene
 from ..waves import Wave, excitation_series, interpolate_complex
-from . import passivity, radiation, sdp, vector_fit
+from . import fit_error, passive_order, passivity, radiation, sdp, vector_fit
 from ._io import read_netcdf
 from .bem import compute
 from .geometry import BemBody
@@ -38,6 +39,7 @@ class HydroModel:
     radiation: RadiationModel
     source: str
     fit_omega_max: float = np.inf      # rad/s, the scene's radiation fit band limit
+    response_band: tuple | None = None  # rad/s, where the fit is judged per frequency (scene)
 
     def _matrix(self, name: str) -> np.ndarray:
         """(..., influenced, radiating) array: rows are the DOFs the force acts on."""
@@ -125,8 +127,8 @@ class HydroModel:
             raise HydroError(f"{self.source}: the plant moves {missing} but the hydro model "
                              f"only has {list(self.dofs)}")
         return HydroModel(dofs, self.data, _fit_cached(self.data, dofs, None, self.source,
-                                                       self.fit_omega_max),
-                          self.source, self.fit_omega_max)
+                                                       self.fit_omega_max, self.response_band),
+                          self.source, self.fit_omega_max, self.response_band)
 
     def frequency_domain_matrices(self, omega):
         """A(omega), B(omega) interpolated to omega (n, n_dof, n_dof), for FD solutions."""
@@ -139,7 +141,7 @@ def load_hydro_model(scene: Scene, dofs, tol: float | None = None) -> HydroModel
     """Body-frame data for `dofs` (from scene.hydro.file, or a cached BEM run) and its fit."""
     tol = scene.hydro.radiation_tol if tol is None else tol
     source, data = load_hydro_data(scene, dofs)
-    return fit_hydro_model(data, dofs, tol, source, scene.hydro.fit_omega_max)
+    return fit_hydro_model(data, dofs, tol, source, scene.hydro.fit_omega_max, scene.hydro.response_band)
 
 
 def load_hydro_data(scene: Scene, dofs) -> tuple[str, xr.Dataset]:
@@ -156,15 +158,15 @@ def load_hydro_data(scene: Scene, dofs) -> tuple[str, xr.Dataset]:
 
 
 def fit_hydro_model(data: xr.Dataset, dofs, tol: float | None, source: str,
-                    fit_omega_max: float = np.inf) -> HydroModel:
+                    fit_omega_max: float = np.inf, response_band=None) -> HydroModel:
     """A HydroModel of `data` on `dofs`, its radiation fitted to `tol` (cached on disk).
 
     For callers that change the data first (e.g. mbcontrol.plant.fidelity drops the coupling between
     bodies): the cache key is the data itself, so a changed dataset never serves an old fit.
     """
     _check_dofs(data, dofs, source)
-    fit = _fit_cached(data, tuple(dofs), tol, source, fit_omega_max)
-    return HydroModel(tuple(dofs), data, fit, source, fit_omega_max)
+    fit = _fit_cached(data, tuple(dofs), tol, source, fit_omega_max, response_band)
+    return HydroModel(tuple(dofs), data, fit, source, fit_omega_max, response_band)
 
 
 def _run_bem(scene: Scene, dofs):
@@ -235,17 +237,18 @@ def fit_band_limit(data: xr.Dataset, scene_limit: float = np.inf) -> float | Non
 FITS_SERVED: list = []      # the fit files asked for, in order (models/generate_hydro.py --ship-fits)
 
 
-def _fit_cached(data: xr.Dataset, dofs, tol, source: str, omega_max: float = np.inf):
-    """fit_radiation with an on-disk cache keyed by the data, the DOFs and the tolerance."""
+def _fit_cached(data: xr.Dataset, dofs, tol, source: str, omega_max: float = np.inf, response_band=None):
+    """fit_radiation with an on-disk cache keyed by the data, the DOFs, the tolerance and the bands."""
     tol = 0.01 if tol is None else tol
     digest = hashlib.sha256()
     for var in ("added_mass", "radiation_damping", "added_mass_inf"):
         digest.update(np.ascontiguousarray(data[var].values).tobytes())
     # the fitting code is part of the key: a changed algorithm never serves an old fit
-    for module in (radiation, vector_fit, passivity, sdp):
+    for module in (radiation, fit_error, vector_fit, passive_order, passivity, sdp):
         digest.update(Path(module.__file__).read_bytes())
     band = fit_band_limit(data, omega_max)
-    digest.update(json.dumps([list(dofs), tol, band]).encode())
+    response_band = None if response_band is None else [float(x) for x in response_band]
+    digest.update(json.dumps([list(dofs), tol, band] + ([response_band] if response_band else [])).encode())
     name = f"radiation_{digest.hexdigest()[:20]}.npz"
     FITS_SERVED.append(name)
     shipped = shipped_fits_dir() / name
@@ -262,7 +265,7 @@ def _fit_cached(data: xr.Dataset, dofs, tol, source: str, omega_max: float = np.
     started = time.perf_counter()
     status(f"fitting the radiation model of {Path(source).name} ({len(dofs)} DOFs, tolerance "
            f"{tol:g}): typically 5-90 s, once; cached afterwards")
-    model = fit_radiation(data, dofs=list(dofs), tol=tol, omega_max=band)
+    model = fit_radiation(data, dofs=list(dofs), tol=tol, omega_max=band, response_band=response_band)
     status(f"radiation model fitted in {time.perf_counter() - started:.1f} s: "
            f"{model.order} states, error {model.fit_error:.2%}")
     fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".npz.tmp")
@@ -287,10 +290,13 @@ def shipped_fits_dir() -> Path:
 
 
 def _model_from_arrays(z) -> RadiationModel:
-    return RadiationModel(A=z["A"], B=z["B"], C=z["C"], D=z["D"],
-                          dofs=tuple(str(d) for d in z["dofs"]), order=int(z["order"]),
-                          fit_error=float(z["fit_error"]), entry_errors=z["entry_errors"],
-                          report=json.loads(str(z["report"])))
+    model = RadiationModel(A=z["A"], B=z["B"], C=z["C"], D=z["D"],
+                           dofs=tuple(str(d) for d in z["dofs"]), order=int(z["order"]),
+                           fit_error=float(z["fit_error"]), entry_errors=z["entry_errors"],
+                           report=json.loads(str(z["report"])))
+    if model.report.get("tol_met") is False and "limited_by" in model.report:  # as loud as a fresh fit
+        warnings.warn(radiation.RadiationFitWarning(radiation.miss_message(model.report)), stacklevel=4)
+    return model
 
 
 def _jsonable(obj):

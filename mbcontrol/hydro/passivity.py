@@ -48,7 +48,7 @@ from scipy.optimize import brentq, minimize_scalar
 
 from .sdp import psd_least_squares, solve_sdp as _solve_sdp
 
-__all__ = ["PassivityReport", "hermitian_eigs", "passivity_test", "enforce_passivity", "make_passive",
+__all__ = ["PassivityReport", "hermitian_eigs", "passivity_test", "enforce_passivity",
            "psd_least_squares", "absorbed_energy"]
 
 
@@ -176,7 +176,10 @@ def passivity_test(A, B, C, D=None, *, omega=None, n_grid: int = 2000, rtol: flo
         a, b = grid[k], grid[k + 1]
         if np.any((cross >= a) & (cross <= b)):
             continue
-        edges.append(brentq(lambda x: lmin(np.exp(x))[0] - thr, np.log(a), np.log(b), xtol=1e-10))
+        f = lambda x: lmin(np.exp(x))[0] - thr  # noqa: E731
+        # a grid value at the threshold can flip sign when recomputed alone: then the midpoint
+        bracketed = np.sign(f(np.log(a))) != np.sign(f(np.log(b)))
+        edges.append(brentq(f, np.log(a), np.log(b), xtol=1e-10) if bracketed else np.sqrt(a * b))
         missed += 1
     edges = np.unique(edges)
     bands, wmin_all, emin_all = [], float(grid[np.argmin(gmin)]), float(gmin.min())
@@ -304,75 +307,6 @@ def enforce_passivity(A, B, C, omega, H, weights=None, *, dc_zero: bool = False,
     return Cn, {"status": str(status), "enforced": True, "constraints": kept, "solver": solver, **sinfo,
                 "seconds": float(time.perf_counter() - t0), "misfit_before": mis0, "misfit_after": mis1,
                 "q_rank": int(np.sum(ev > 1e-10 * max(ev.max(), 1e-300))), "q_size": int(r)}
-
-
-def make_passive(trial, error, abc, err, target, n_max, max_states, omega, H, weights, dc_zero, markov):
-    """Order selection around :func:`enforce_passivity`, used by ``fit_radiation`` per DOF group.
-
-    abc = (A, B, C) is the selected model and err its error; trial(r) -> (error, (A, B, C)) refits
-    at order r; error(A, B, C) is the fit's error gate. A model that is not passive gets C
-    enforced; while the enforced error exceeds ``target`` the order grows ~1.4× (a larger basis
-    leaves more freedom to the passive fit) up to min(n_max, max_states), and once an order meets
-    it the smallest passing order is bisected for. C B = ``markov`` is kept if some order meets the
-    target with it; otherwise the search is repeated without it (a passive model obeys the sum rule
-    C B = (2/π)∫Re K dω, so data whose A∞ or tail disagree with their B cannot have both). If no
-    order meets the target, the lowest-error passive model is returned. Returns
-    (A, B, C, error, info); info is JSON-serialisable.
-    """
-    r0 = abc[0].shape[0]
-    cap = min(n_max, int(max_states))
-    info = {"order_before": int(r0), "error_before": float(err), "attempts": []}
-    done = {}
-
-    def attempt(r, mk):
-        if (r, mk) in done:
-            return done[r, mk]
-        e, m = (err, abc) if r == r0 else trial(r)
-        if m is None:
-            done[r, mk] = None
-            return None
-        test = passivity_test(*m)
-        if r == r0:
-            info.update(passive_before=bool(test.passive), margin_before=float(test.margin))
-        if test.passive:
-            done[r, mk] = (*m, e)
-            return done[r, mk]
-        Cp, enf = enforce_passivity(*m, omega, H, weights, dc_zero=dc_zero, markov=markov if mk else None)
-        ep = error(m[0], m[1], Cp)
-        info["attempts"].append({"order": int(r), "error": float(ep), **enf})
-        res = (m[0], m[1], Cp, ep) if enf["enforced"] else None
-        if mk and enf["enforced"] and "markov" not in enf["constraints"]:  # infeasible with C B = K(0+)
-            done[r, True], done[r, False] = None, res
-        else:
-            done[r, mk] = res
-        return done[r, mk]
-
-    def ok(res):
-        return res is not None and res[3] <= target
-
-    def search(mk):
-        lo = hi = r0
-        while not ok(attempt(hi, mk)):
-            lo, hi = hi, min(cap, int(np.ceil(1.4 * hi)))
-            if hi <= lo:
-                return None
-        while hi - lo > 1:  # smallest passing order in (lo, hi]
-            mid = (lo + hi) // 2
-            lo, hi = (lo, mid) if ok(attempt(mid, mk)) else (mid, hi)
-        return done[hi, mk]
-
-    best = search(True) if markov is not None else None
-    info["markov_kept"] = None if markov is None else best is not None
-    if best is None:
-        best = search(False)
-    if best is None:
-        found = [v for v in done.values() if v is not None]  # the fewest states within 2 % of the best
-        emin = min((v[3] for v in found), default=np.inf)
-        best = min((v for v in found if v[3] <= 1.02 * emin), key=lambda v: v[0].shape[0], default=(*abc, err))
-    info.update(order_after=int(best[0].shape[0]), error_after=float(best[3]), target=float(target),
-                met=bool(best[3] <= target), enforced=bool(info["attempts"]),
-                seconds=float(sum(a["seconds"] for a in info["attempts"])))
-    return (*best, info)
 
 
 def absorbed_energy(A, B, C, D, dt, nu) -> np.ndarray:

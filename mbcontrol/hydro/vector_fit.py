@@ -4,16 +4,24 @@ The machinery behind :func:`mbcontrol.hydro.radiation.fit_radiation` for one gro
 DOFs: relaxed vector fitting with common stable poles (Gustavsen 2006; fast QR form of
 Deschrijver et al. 2008), a column realisation, square-root balanced truncation with the output
 matrix refitted, the congruence scaling that makes DOFs of different units comparable, and
-passivity enforcement around it (:mod:`mbcontrol.hydro.passivity`).
+passivity enforcement around it (:mod:`mbcontrol.hydro.passivity`). Every least-squares step
+weighs each frequency in the response band by the inverse size of its damping and added-mass parts
+(:func:`mbcontrol.hydro.fit_error.part_sizes`), the relative error by which the order is chosen
+(module radiation, "Error").
 """
 from __future__ import annotations
 
 import numpy as np
 import scipy.linalg as sla
 
-from .passivity import _response, make_passive
+from mbcontrol.errors import HydroError
+
+from .fit_error import INTERP_WEIGHT, _gate, _nerr, part_errors, part_sizes
+from .passive_order import make_passive
+from .passivity import _response
 
 TAIL_POINTS, TAIL_WEIGHT = 40, 0.3  # extrapolated K(jω) on 1.02-10 ω_max, weight per point
+SLOW_POLE = 0.1    # every pole decays at least at SLOW_POLE × the lowest data frequency (1/s)
 
 
 def _poles_real_form(poles):
@@ -32,28 +40,33 @@ def _basis(poles, s):
     return np.stack(cols, axis=1)
 
 
-def _ri(x):
-    return np.concatenate([x.real, x.imag], axis=0)
-
-
-def _clean_poles(ev, wmax=np.inf):
+def _clean_poles(ev, wmax=np.inf, wmin=0.0):
     """Flip unstable poles, cap |p| at 10 ω_max (a pole far above the band only mimics a
-    feedthrough, which K(∞) = 0 forbids), keep real poles and the upper member of each pair."""
+    feedthrough, which K(∞) = 0 forbids), make Re p <= -SLOW_POLE ω_min (the data resolve
+    neither a slower real pole nor a narrower resonance; either only makes simulations wait
+    for its transient), keep real poles and the upper member of each pair."""
     ev = np.where(ev.real > 0, -ev.real + 1j * ev.imag, ev)
     ev = np.where(np.abs(ev) > 10 * wmax, ev / np.abs(ev) * 10 * wmax, ev)
+    ev = np.minimum(ev.real, -SLOW_POLE * wmin) + 1j * ev.imag
     tol = 1e-9 * np.maximum(np.abs(ev), 1e-300)
     cplx = ev[ev.imag > tol]
     return np.concatenate([np.sort(ev[np.abs(ev.imag) <= tol].real) + 0j, cplx[np.argsort(cplx.imag)]])
 
 
-def _relocate(poles, s, H, wt):
-    """One relaxed-VF pole relocation. H: (nω, n_entries) scaled data, wt: row weights."""
+def _wri(x, wr, wi):
+    """Rows [w_re Re x; w_im Im x] (weights per row)."""
+    return np.concatenate([wr[:, None] * x.real, wi[:, None] * x.imag], axis=0)
+
+
+def _relocate(poles, s, H, Wr, Wi):
+    """One relaxed-VF pole relocation. H: (nω, n_entries) scaled data; Wr, Wi: weights of the
+    real and imaginary rows, same shape."""
     Phi = _basis(poles, s)
     N, ns = Phi.shape[1], s.size
     rows = []
     for e in range(H.shape[1]):
         h = H[:, e:e + 1]
-        M = _ri(wt[:, None] * np.hstack([Phi, -h * Phi, -h]))
+        M = _wri(np.hstack([Phi, -h * Phi, -h]), Wr[:, e], Wi[:, e])
         R = np.linalg.qr(M, mode="r")
         rows.append(R[N:2 * N + 1, N:])
     Rs = np.vstack(rows)
@@ -66,7 +79,8 @@ def _relocate(poles, s, H, wt):
         dt = np.copysign(1e-8, dt if dt != 0 else 1.0)
         ct = np.linalg.lstsq(Rs[:, :N], -Rs[:, N] * dt, rcond=None)[0]
     Lam, b = _poles_real_form(poles)
-    return _clean_poles(np.linalg.eigvals(Lam - np.outer(b, ct) / dt), float(np.abs(s).max()))
+    return _clean_poles(np.linalg.eigvals(Lam - np.outer(b, ct) / dt), float(np.abs(s).max()),
+                        float(np.abs(s).min()))
 
 
 def _constrained_lstsq(M, Y, Gc, Hc):
@@ -78,9 +92,9 @@ def _constrained_lstsq(M, Y, Gc, Hc):
     return Xp + Z @ np.linalg.lstsq(M @ Z, Y - M @ Xp, rcond=None)[0]
 
 
-def _residues(poles, s, H, wt, dc_zero=True, markov=None):
-    """Real residue parameters C (N, n_entries) minimising |Φ C - H|, optionally with Φ(0) C = 0
-    (K(0) = 0) and Σ residues = ``markov`` (K(t=0+), one value per entry)."""
+def _residues(poles, s, H, Wr, Wi, dc_zero=True, markov=None):
+    """Real residue parameters C (N, n_entries) minimising the weighted |Φ C - H| per entry,
+    optionally with Φ(0) C = 0 (K(0) = 0) and Σ residues = ``markov`` (K(t=0+), one per entry)."""
     rows, vals = [], []
     if dc_zero:
         rows.append(_basis(poles, np.array([0.0 + 0.0j])).real[0])  # Φ(0) is real
@@ -91,13 +105,11 @@ def _residues(poles, s, H, wt, dc_zero=True, markov=None):
     if len(rows) >= len(rows[0] if rows else []):  # no freedom left: drop the constraints
         rows, vals = [], []
     Gc = np.array(rows) if rows else None
-    return _constrained_lstsq(_ri(wt[:, None] * _basis(poles, s)), _ri(wt[:, None] * H), Gc,
-                              np.array(vals) if rows else None)
-
-
-def _nerr(fit, data):
-    den = np.sum(np.abs(data) ** 2)
-    return float(np.sqrt(np.sum(np.abs(fit - data) ** 2) / den)) if den > 0 else 0.0
+    hc = np.array(vals) if rows else None
+    Phi = _basis(poles, s)
+    return np.stack([_constrained_lstsq(_wri(Phi, Wr[:, e], Wi[:, e]), _wri(H[:, e:e + 1], Wr[:, e], Wi[:, e]),
+                                        Gc, None if hc is None else hc[:, e:e + 1])[:, 0]
+                     for e in range(H.shape[1])], axis=1)
 
 
 def _psd_sqrt(W):
@@ -117,24 +129,24 @@ def _balanced(A, B, C):
     return Ti @ A @ T, Ti @ B, C @ T, hsv
 
 
-def _vector_fit(w, H, wt, nd, tol, max_order, n_iter, dc_zero, markov=None):
+def _vector_fit(w, H, Wr, Wi, nd, err_fn, tol, max_order, n_iter, dc_zero, markov=None):
     """Common poles for all columns of H (nω, n_entries), N = 2, 4, … poles until the error is met.
     Each order starts from pairs spread log-uniformly over the data band with damping ratio ~0.1
     (well-damped starts avoid spurious sharp resonances). Rows from nd on are the weighted
-    asymptotic tail; errors count the first nd (data) rows only."""
+    asymptotic tail; errors (``err_fn`` of the fitted first nd rows) count the data rows only."""
     s = 1j * w
     history, best = [], None
     for N in range(2, max_order + 1, 2):
         beta = np.geomspace(w[:nd].min(), w[:nd].max(), N // 2)
         poles = -beta / 10 + 1j * beta
         for _ in range(n_iter):
-            new = _relocate(poles, s, H, wt)
+            new = _relocate(poles, s, H, Wr, Wi)
             done = new.size == poles.size and np.allclose(new, poles, rtol=1e-8, atol=0)
             poles = new
             if done:
                 break
-        Cr = _residues(poles, s, H, wt, dc_zero, markov)
-        err = _nerr(_basis(poles, s[:nd]) @ Cr, H[:nd])
+        Cr = _residues(poles, s, H, Wr, Wi, dc_zero, markov)
+        err = err_fn(_basis(poles, s[:nd]) @ Cr)
         history.append({"poles": int(sum(1 if p.imag == 0 else 2 for p in poles)), "error_scaled": err})
         if best is None or err < best[2]:
             best = (poles, Cr, err)
@@ -146,16 +158,14 @@ def _vector_fit(w, H, wt, nd, tol, max_order, n_iter, dc_zero, markov=None):
     return best[0], best[1], history
 
 
-def _refit_output(A, B, s, G, wt, pattern, dc_zero, markov=None):
+def _refit_output(A, B, s, G, Wr, Wi, pattern, dc_zero, markov=None):
     """Least-squares output matrix C for fixed (A, B): truncation keeps the poles, this restores
     the accuracy (and K(0) = 0, C B = K(0+)) that dropping states costs. Zero-pattern entries are
-    fitted to 0."""
+    fitted to 0. Wr, Wi (nω, m, m): weights of the real and imaginary parts; one solve per row."""
     r, m = B.shape
-    X = wt[:, None, None] * _response(A, B, np.eye(r), None, s.imag, 1e10)  # (nω, r, m): (sI - A)⁻¹B, weighted
-    Xt = np.einsum("krm->kmr", X).reshape(-1, r)
-    M = np.concatenate([Xt.real, Xt.imag])  # same regressors for every output row
-    tgt = wt[:, None, None] * np.where(pattern[None], G, 0.0)  # (nω, m_out, m_in)
-    Y = np.concatenate([tgt.transpose(0, 2, 1).reshape(-1, m).real, tgt.transpose(0, 2, 1).reshape(-1, m).imag])
+    X = _response(A, B, np.eye(r), None, s.imag, 1e10)  # (nω, r, m): (sI - A)⁻¹B
+    Xt = np.einsum("krm->kmr", X).reshape(-1, r)           # rows (ω, input j)
+    tgt = np.where(pattern[None], G, 0.0)
     rows, vals = [], []
     if dc_zero:
         rows.append(np.linalg.solve(A, B).T)  # c A⁻¹B = 0  <=>  K(0) = 0
@@ -166,7 +176,13 @@ def _refit_output(A, B, s, G, wt, pattern, dc_zero, markov=None):
     while rows and sum(x.shape[0] for x in rows) >= r:  # keep some freedom for the fit
         rows.pop(), vals.pop()
     Gc = np.vstack(rows) if rows else None
-    return _constrained_lstsq(M, Y, Gc, np.vstack(vals) if rows else None).T
+    Hc = np.vstack(vals) if rows else None
+    C = np.empty((m, r))
+    for i in range(m):
+        wr, wi = Wr[:, i, :].ravel(), Wi[:, i, :].ravel()
+        C[i] = _constrained_lstsq(_wri(Xt, wr, wi), _wri(tgt[:, i, :].reshape(-1, 1), wr, wi), Gc,
+                                  None if Hc is None else Hc[:, i:i + 1])[:, 0]
+    return C
 
 
 def _congruence_scale(Kg, unit_class):
@@ -188,7 +204,7 @@ def _unit_class(dof: str) -> str:
     return {"Surge": "m", "Sway": "m", "Heave": "m", "Roll": "rad", "Pitch": "rad", "Yaw": "rad"}.get(kind, dof)
 
 
-def _fit_group(w, Kg, pattern, unit_class, tol, max_order, n_iter, dc_zero, refit, M1=None, p_tail=3.0,
+def _fit_group(w, Kg, pattern, bem, ainf, inband, unit_class, tol, max_order, n_iter, dc_zero, refit, M1=None, p_tail=3.0,
                passive_states=0, vf_frac=0.7):
     """VF of one coupled group (scaled) to vf_frac·tol, column realisation, balanced truncation to tol."""
     m = Kg.shape[1]
@@ -202,7 +218,7 @@ def _fit_group(w, Kg, pattern, unit_class, tol, max_order, n_iter, dc_zero, refi
     # Re K = B_N (ω_N/ω)^p, and Im K = ω(A - A∞) = -[M1 + (c_N - M1)(ω_N/ω)²]/ω, the two-term
     # asymptotic form (K(0+)/ω, then K''(0+)/ω³) that is continuous with the data (c_N = -ω_N Im K_N)
     # and tends to the first Markov parameter M1 = K(0+).
-    we, Ge, wt = w, G, np.ones(nd)
+    we, Ge, tw = w, G, np.ones(nd)
     if M1s is not None:
         wn = w.max()
         wx = np.geomspace(1.02 * wn, 10 * wn, TAIL_POINTS)[:, None, None]
@@ -211,11 +227,24 @@ def _fit_group(w, Kg, pattern, unit_class, tol, max_order, n_iter, dc_zero, refi
         wx = wx[:, 0, 0]
         we = np.concatenate([w, wx])
         Ge = np.concatenate([G, np.where(pattern[None], ext, 0.0)])
-        wt = np.concatenate([np.ones(nd), np.full(wx.size, TAIL_WEIGHT)])
+        tw = np.concatenate([np.ones(nd), np.full(wx.size, TAIL_WEIGHT)])
+    # relative least squares (the error measure's): each part at each ω weighted by 1/its size
+    ainf_s = ainf * sc**2  # A∞ scaled like G
+    re, im = part_sizes(np.where(pattern[None], Ge, 0.0), we, ainf_s,
+                        np.concatenate([inband, np.zeros(we.size - nd, bool)]))  # the tail: absolute
+    Wr = np.broadcast_to((tw / re)[:, None, None], Ge.shape)
+    Wi = np.broadcast_to((tw / im)[:, None, None], Ge.shape)
+    wt = tw / re   # passivity enforcement: one weight per ω, as the LS fit (relative in band)
     He = np.stack([Ge[:, i, j] for i, j in ent], axis=1)
+    pick = (slice(None), [i for i, _ in ent], [j for _, j in ent])
+
+    def err_fn(rows):  # entries of the fitted data rows -> the worst part error
+        fit = np.zeros_like(G)
+        fit[pick] = rows
+        return _gate(fit, np.where(pattern[None], G, 0.0), w, ainf_s, bem, inband, sc)
     # most of the error budget for the fit, the rest for the truncation (errors add ~ in quadrature)
-    poles, Cr, history = _vector_fit(we, He, wt, nd, vf_frac * tol, max_order, n_iter, dc_zero,
-                                     None if M1s is None else np.array([M1s[i, j] for i, j in ent]))
+    poles, Cr, history = _vector_fit(we, He, Wr[pick], Wi[pick], nd, err_fn, vf_frac * tol, max_order,
+                                     n_iter, dc_zero, None if M1s is None else np.array([M1s[i, j] for i, j in ent]))
     Lam, bvec = _poles_real_form(poles)
     N = Lam.shape[0]
     A = np.kron(np.eye(m), Lam)
@@ -228,13 +257,20 @@ def _fit_group(w, Kg, pattern, unit_class, tol, max_order, n_iter, dc_zero, refi
     def error(Ar, Br, Cr_):
         fit = _response(Ar, Br, Cr_, None, w, 1e10)
         fit[:, ~pattern] = 0.0
-        return max(_nerr(fit, G), _nerr(fit / (sc[None, :, None] * sc[None, None, :]), Kg))
+        return _gate(fit, np.where(pattern[None], G, 0.0), w, ainf_s, bem, inband, sc)
+
+    def profile(Ar, Br, Cr_):   # in-band error / target per enforcement frequency (the tail: 0)
+        fit = _response(Ar, Br, Cr_, None, w, 1e10)
+        fit[:, ~pattern] = 0.0
+        e = np.max(part_errors(fit, np.where(pattern[None], G, 0.0), w, ainf_s), axis=(1, 2))
+        return np.concatenate([e * np.where(bem, 1.0, INTERP_WEIGHT) * inband, np.zeros(we.size - nd)]) / target
 
     def trial(r):
         Ar, Br = Ab[:r, :r], Bb[:r]
-        if np.max(np.linalg.eigvals(Ar).real) >= 0:
+        ev = np.linalg.eigvals(Ar)
+        if np.max(ev.real) > -0.99 * SLOW_POLE * w.min():  # unstable, or slow (truncation can make them)
             return np.inf, None
-        Cr_ = _refit_output(Ar, Br, 1j * we, Ge, wt, pattern, dc_zero, M1s) if refit else Cb[:, :r]
+        Cr_ = _refit_output(Ar, Br, 1j * we, Ge, Wr, Wi, pattern, dc_zero, M1s) if refit else Cb[:, :r]
         return error(Ar, Br, Cr_), (Ar, Br, Cr_)
 
     # smallest r meeting tol (or, if the fit itself misses it, within 5 % of the full-order error);
@@ -247,14 +283,20 @@ def _fit_group(w, Kg, pattern, unit_class, tol, max_order, n_iter, dc_zero, refi
             hi = mid
         else:
             lo = mid + 1
-    err, (Ar, Br, Cr_) = trial(lo)
+    err, abc = trial(lo)
+    while abc is None and lo < hsv.size:  # every order rejected (slow poles) up to here
+        lo += 1
+        err, abc = trial(lo)
+    if abc is None:
+        raise HydroError("radiation fit: no truncation order free of slow or unstable poles")
+    Ar, Br, Cr_ = abc
     info = {"poles": [[float(p.real), float(p.imag)] for p in poles], "history": history, "hsv": hsv.tolist(),
             "order": int(lo), "error_gate": float(err)}
     before = (Ar, Br / sc[None, :], Cr_ / sc[:, None])
     if passive_states:
         Ar, Br, Cr_, err, info["passivity"] = make_passive(trial, error, (Ar, Br, Cr_), err, target, hsv.size,
                                                            passive_states, we, np.where(pattern[None], Ge, 0.0), wt,
-                                                           dc_zero, M1s)
+                                                           dc_zero, M1s, profile)
         info["order"] = int(Ar.shape[0])
     return Ar, Br / sc[None, :], Cr_ / sc[:, None], info, before
 
@@ -266,7 +308,7 @@ def _best_scaled_fit(common, rest, dofs, passive):
 
     Which weighting lets the fit reach the tolerance soonest depends on the data: per-DOF scaling
     helps a small, clean entry; per-class scaling keeps the fit off a small, noisy one."""
-    w, Kg, _ = common
+    w, Kg, _, bem, ainf, inband = common
     tol = rest[0]
     options = {"unit class": [_unit_class(d) for d in dofs], "per DOF": list(dofs)}
     if np.allclose(_congruence_scale(Kg, options["unit class"]), _congruence_scale(Kg, options["per DOF"])):
@@ -275,11 +317,13 @@ def _best_scaled_fit(common, rest, dofs, passive):
     for label, classes in options.items():
         args = (*common, classes, *rest)
         *abc, rep, before = _fit_group(*args)
-        if passive and not rep["passivity"]["met"]:  # passive fits may need more poles: fit deeper, retry
+        # passive fits may need more poles: fit deeper, retry; only if the unconstrained fit met
+        # the target (else more poles do not help, and the retry doubles a long fit's time)
+        if passive and not rep["passivity"]["met"] and rep["error_gate"] <= rest[0]:
             *abc2, rep2, _ = _fit_group(*args, vf_frac=0.15)
             if rep2["passivity"]["error_after"] < rep["passivity"]["error_after"]:
                 abc, rep = abc2, {**rep2, "deeper_vector_fit": True}
-        err = _nerr(_response(*abc, None, w, 1e10), Kg)
+        err = _gate(_response(*abc, None, w, 1e10), Kg, w, ainf, bem, inband)
         markov_dropped = rep.get("passivity", {}).get("markov_kept") is False
         tried.append({"scaling": label, "n_states": int(abc[0].shape[0]), "error": float(err),
                       "markov_dropped": markov_dropped})

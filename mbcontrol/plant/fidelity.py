@@ -38,7 +38,7 @@ AUDIT_OUTPUTS = ("energy", "excitation_power", "radiated_power")   # plus "<pto>
 class Fidelity:
     """Which simplifications a plant uses; the defaults are the full model.
 
-    radiation_tol : normalised RMS error of the radiation fit (None: the scene's).
+    radiation_tol : radiation fit tolerance (hydro.radiation, "Error"; None: the scene's).
     couplings : "keep" or "drop" the radiation coupling between different bodies.
     freeze : body DOFs "<body>__<Dof>" of free/composite joints to remove, names of revolute or
         prismatic joints to block (as a test rig does), or "auto" (free-joint DOFs the waves
@@ -155,7 +155,7 @@ def _hydro_model(scene, frozen, fidelity, hydro, waves, notes) -> HydroModel | N
         notes["couplings"] = coupling_size(data, dofs, band)
         data = drop_couplings(data)
         source = f"{source} (couplings between bodies dropped)"
-    return fit_hydro_model(data, dofs, tol, source, limit)
+    return fit_hydro_model(data, dofs, tol, source, limit, scene.hydro.response_band)
 
 
 # ----------------------------------------------------------------------------- couplings

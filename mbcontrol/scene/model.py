@@ -167,8 +167,10 @@ class HydroSettings:
     omega: tuple[float, ...] = ()              # rad/s, BEM frequencies
     headings: tuple[float, ...] = (0.0,)       # rad, NED wave directions
     lid: bool = True
-    radiation_tol: float = 0.01                # normalised RMS error of the radiation fit
+    radiation_tol: float = 0.01                # radiation fit error (hydro.radiation, "Error")
     fit_omega_max: float = math.inf            # rad/s: fit the radiation model below this
+    response_band: tuple[float, float] | None = None  # rad/s: where the device moves (its seas
+                                               # and modes); radiation fit judged per ω there
     dofs: tuple[str, ...] = DOF_NAMES          # rigid DOFs the BEM solves for, per body
     source: str | None = None                  # third-party data (WAMIT .out, BEMIO .h5,
                                                # Capytaine .nc) that `file` is converted from

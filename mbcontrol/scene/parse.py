@@ -219,7 +219,11 @@ def _hydro(r: Reader, path: Path) -> HydroSettings:
     if r.empty:
         return HydroSettings()
     r.allow("file", "panel_size", "omega", "headings", "lid", "radiation_tol", "dofs",
-            "source", "source_bodies", "source_options", "fit_omega_max", "interaction", "hydrostatics")
+            "source", "source_bodies", "source_options", "fit_omega_max", "response_band", "interaction",
+            "hydrostatics")
+    band = r.finite_list("response_band", "frequency", default=()) or None
+    if band is not None and not (len(band) == 2 and 0 <= band[0] < band[1]):
+        r.fail("response_band", f"expected [low, high] in rad/s with 0 <= low < high, got {band}")
     source = r.string("source", default=None)
     file = r.string("file", default=None)
     omega = r.frequency_grid("omega")
@@ -232,6 +236,7 @@ def _hydro(r: Reader, path: Path) -> HydroSettings:
         radiation_tol=r.positive("radiation_tol", None, default=0.01),
         dofs=r.dof_list("dofs", default=DOF_NAMES),
         fit_omega_max=r.positive("fit_omega_max", "frequency", default=math.inf, finite=False),
+        response_band=tuple(band) if band is not None else None,
         source=str((path.parent / source).resolve()) if source else None,
         source_bodies=tuple(r.string_list("source_bodies", default=())),
         source_options=_source_options(r.table("source_options", required=False)),
