@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from mbcontrol.hydro import read_netcdf
+from mbcontrol.hydro.model import fit_band_limit
 from mbcontrol.scene import load_scene
 from mbcontrol.studies.identify import IdentifiabilityWarning, fit
 from mbcontrol.studies.identify import report as rep
@@ -71,24 +72,31 @@ def runs():
         return load_runs(sorted((TANK / "scenario_c").glob("[456]*.csv.xz")), drop_bad=True)
 
 
-def _errors(problem, values):
-    return {c: e["rms_relative_error"]
-            for c, e in rep.channel_errors(rep.amplitude_rows(problem, values)).items()}
+def _errors(problem, values, omega_max=np.inf):
+    rows = [r for r in rep.amplitude_rows(problem, values) if r["omega"] <= omega_max]
+    return {c: e["rms_relative_error"] for c, e in rep.channel_errors(rows).items()}
 
 
 def test_identified_model_reproduces_every_run(runs):
     """All 31 usable runs, the scene's default parameters, Gauss-Newton on the harmonic cost:
-    each free DOF within 10 % RMS relative amplitude error; roll and sway at least twice as
-    close as the model with the scene's values (potential flow, rig data); heave closer."""
+    each free DOF within 10 % RMS relative amplitude error. Where the radiation model was fitted
+    (the runs at or below the data's mesh limit, 6.99 rad/s; 18 of the 31) roll and sway at
+    least twice as close as the model with the scene's values (potential flow, rig data), heave
+    closer. Above it the model extrapolates the fit (runs at 7-9.3 rad/s): there two passive fits
+    of equal error in the band (1 % in sway and roll) put the identified sway 6.6 % or 7.8 % off
+    over all runs, so no improvement ratio is claimed there (issue 21: extrapolation said aloud)."""
     assert len(runs) == 31
     problem = flume_identification("flume_section", None, runs=runs)
-    before = _errors(problem, {})
+    scene = load_scene("flume_section")
+    fitted = fit_band_limit(read_netcdf(scene.hydro.file), scene.hydro.fit_omega_max)
+    assert fitted == pytest.approx(6.99, abs=0.01)
     # one wave height: linear and quadratic roll damping act alike, and the fit says so
     with pytest.warns(IdentifiabilityWarning, match="viscous__Roll and viscous__Roll_linear"):
         result = fit(problem, "gauss-newton")
     after = _errors(problem, result.values)
     assert set(after) == {"Sway", "Heave", "Roll"}
     assert max(after.values()) <= 0.10, after
+    before, after = _errors(problem, {}, fitted), _errors(problem, result.values, fitted)
     assert before["Roll"] >= 2 * after["Roll"] and before["Sway"] >= 2 * after["Sway"], \
         (before, after)
     assert after["Heave"] < before["Heave"]
