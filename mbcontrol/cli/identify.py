@@ -12,8 +12,11 @@ Data files follow the flume dataset's naming SPPH[_R] (../shared/data/tank, its 
 3-6 free different DOFs, which the model's joints of the same names follow (the blocked one is
 frozen). The incident wave at the model comes from the calibration runs (default: the
 'calibration' folder beside the data files' folder). Each run is simulated from rest into its
-steady window, driven by its own measured incident wave; all runs of a series are stepped in
-one compiled batch, with exact sensitivities for Gauss-Newton.
+steady window, driven by its own measured incident wave; each run is one call of the plant's
+compiled integrator (compiled once per series), with exact sensitivities for Gauss-Newton.
+Record units are read from the headers ("Sway [mm]") and converted to SI; an unknown unit, a
+channel of the wrong kind, a record cut before its steady window closes or a window of fewer
+than 3 whole periods is refused naming the file (--drop-bad: skipped and listed).
 
 --fit NAME[=LO:HI] names a plant parameter (PTO, friction, springs, drag) or a hydrodynamic
 correction <body>__<Dof>__{added_mass,radiation,excitation}_scale; without bounds they come
@@ -61,7 +64,7 @@ def add_parser(sub) -> None:
 
 
 def run_identify(args) -> int:
-    from ..studies.identify import fit
+    from ..studies.identify import ExtrapolationWarning, fit
     from ..studies.identify import report as rep
     from ..studies.identify.flume import load_runs
     from ..studies.identify.setup import flume_identification, prediction
@@ -76,8 +79,10 @@ def run_identify(args) -> int:
         validation = load_runs(args.validate, args.calibration, drop_bad=args.drop_bad) \
             if args.validate else []
         problem = flume_identification(args.model, None, runs=runs, fit=args.fit, **common)
+        vproblem = prediction(problem, validation) if validation else None
     for w in caught:
         print(f"mbcontrol: warning: {w.message}", file=sys.stderr)
+    said = [str(w.message) for w in caught if issubclass(w.category, ExtrapolationWarning)]
     before = rep.amplitude_rows(problem, {})      # the scene's own values: the model as built
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
@@ -86,10 +91,10 @@ def run_identify(args) -> int:
     v_before = v_after = None
     if validation:
         # fixed at the fitted values (those its plants have: a DOF may be blocked there)
-        vproblem = prediction(problem, validation)
         v_before = rep.amplitude_rows(vproblem, {})
         v_after = rep.amplitude_rows(vproblem, result.values)
     summary = rep.summary(problem.scene_name, problem, result, after, v_after)
+    summary["warnings"] = said + summary["warnings"]
     summary["fit_before"] = rep.errors_block(before)
     summary["validation_before"] = rep.errors_block(v_before) if v_before else None
     if args.out:

@@ -35,13 +35,19 @@ def test_identify_json_contract(capsys, tmp_path):
     assert s["valid"] is True and s["invalid_reasons"] == []
     assert list(s["parameters"]) == ["viscous__Roll_linear", "heave_rig__viscous"]
     for name, p in s["parameters"].items():
-        assert set(p) == {"initial", "value", "std", "lo", "hi"}
-        assert p["lo"] <= p["value"] <= p["hi"] and p["std"] > 0
+        assert set(p) == {"initial", "value", "std", "at_bound", "lo", "hi"}
+        assert p["lo"] <= p["value"] <= p["hi"]
+    # two runs of 0.8-1.4 % roll error: the linear roll damping goes to its lower bound, where
+    # it is reported without a sigma (a blocked Jacobian column gave one before issue 21)
+    roll, heave = s["parameters"]["viscous__Roll_linear"], s["parameters"]["heave_rig__viscous"]
+    assert roll["at_bound"] == "lower" and roll["std"] is None
+    assert roll["value"] == pytest.approx(roll["lo"], rel=1e-9)
+    assert heave["at_bound"] is None and heave["std"] > 0
     assert s["parameters"]["heave_rig__viscous"]["lo"] == 1.0          # bounds from --fit
     assert s["parameters"]["viscous__Roll_linear"]["hi"] == 5.0         # from [identify]
     corr = s["correlation"]
     assert len(corr) == 2 and all(len(row) == 2 for row in corr)
-    assert corr[0][0] == pytest.approx(1.0) and corr[0][1] == pytest.approx(corr[1][0])
+    assert corr[0][0] == pytest.approx(1.0) and corr[0][1] == corr[1][0] == 0.0   # one at a bound
     assert s["fit"]["runs"] == ["6081_1", "6101_2"] and s["validation"]["runs"] == ["6111_1"]
     for block in (s["fit"], s["validation"]):
         assert set(block["channels"]) == {"Heave", "Roll"}                 # free in series 6
@@ -50,6 +56,9 @@ def test_identify_json_contract(capsys, tmp_path):
         # the overall figure is the RMS of the per-channel relative errors (equal run counts)
         rel = [ch["rms_relative_error"] for ch in block["channels"].values()]
         assert block["rms_error"] == pytest.approx(math.sqrt(sum(r * r for r in rel) / 2))
+    # 6101_2 (7.0 rad/s) and 6111_1 (7.83) lie above the radiation fit (6.67 rad/s): said
+    assert any("fit runs 6101_2 (7) rad/s: above the radiation fit" in w for w in s["warnings"])
+    assert any("validation runs 6111_1 (7.83) rad/s" in w for w in s["warnings"])
     assert s["simulations"] > 0 and s["wall_time_s"] > 0
     assert s["cost_final"] <= s["cost_initial"]
     assert json.loads((tmp_path / "summary.json").read_text()) == s
@@ -79,7 +88,9 @@ def test_identified_values_go_back_into_simulate(capsys):
     (["--fit", "no_such_parameter=1:2"], "not a parameter of flume_section"),
     (["--fit", "viscous__Heave"], "write --fit viscous__Heave=LO:HI"),
     (["--fit", "viscous__Roll=2"], "expected NAME=LO:HI with two numbers"),
-    (["--fit", "viscous__Roll=2:1"], "viscous__Roll: expected lo < hi"),
+    (["--fit", "viscous__Roll=2:1"], "--fit viscous__Roll: bounds 2:1; expected LO < HI"),
+    # an unknown name is said before any question about its bounds
+    (["--fit", "no_such_parameter"], "not a parameter of flume_section"),
 ])
 def test_bad_fit_specs_are_named(capsys, argv, message):
     code, _, err = run(capsys, "identify", "flume_section", "--data", FEW[0], *argv)

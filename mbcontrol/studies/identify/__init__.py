@@ -5,11 +5,14 @@ runs the fit did not see.
 Modules: `records` (measured records: CSV and netCDF readers, channel checks), `flume` (the
 tank dataset of ../shared/data/tank as runs), `costs` (first harmonic, the seed's Eq. 67 peaks
 and lows), `problem` (runs + plant + parameters -> residuals and their exact Jacobian), `fit`
-(Nelder-Mead and Gauss-Newton, uncertainty), `report` (tables, JSON, figures).
+(Nelder-Mead and Gauss-Newton, uncertainty), `extrapolation` (runs where the model was not
+fitted), `report` (tables, JSON, figures).
 """
+from .extrapolation import ExtrapolationWarning
 from .fit import FitResult, IdentifiabilityWarning, fit
 from .problem import FitParameter, Identification, Run
 from .records import Record, RecordError, read_csv, read_netcdf
 
 __all__ = ["Identification", "FitParameter", "Run", "fit", "FitResult", "IdentifiabilityWarning",
+           "ExtrapolationWarning",
            "Record", "RecordError", "read_csv", "read_netcdf"]

@@ -4,12 +4,17 @@ exact sensitivities (a bounded trust-region Levenberg-Marquardt, scipy's least_s
 
 Uncertainty (at the optimum, from the Gauss-Newton Hessian J^T J of the residuals in the
 physical parameters, scaled by the residual variance s^2 = |r|^2 / (m - n)): covariance
-s^2 (J^T J)^-1, standard errors, correlations. Parameters the data cannot separate are named
+s^2 (J^T J)^-1, standard errors, correlations. A parameter the optimum leaves at one of its
+bounds (within AT_BOUND of the span, in the fitted variable) is reported there, with no sigma:
+its Jacobian column describes a move the bound blocks, and the interval would be one-sided.
+The others' covariance is that of the reduced problem (the bounded ones held), with m - n_free
+degrees of freedom. Parameters the data cannot separate are named
 in a warning: a pair with |correlation| > CORRELATION_LIMIT, or the direction of the smallest
 singular value of the column-scaled Jacobian when its condition number passes CONDITION_LIMIT.
 """
 from __future__ import annotations
 
+import math
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -19,6 +24,7 @@ import numpy as np
 METHODS = ("gauss-newton", "nelder-mead")
 CORRELATION_LIMIT = 0.95
 CONDITION_LIMIT = 1e6
+AT_BOUND = 1e-6          # share of a parameter's span (in theta) that counts as on the bound
 
 
 class IdentifiabilityWarning(UserWarning):
@@ -45,6 +51,7 @@ class FitResult:
     starts: int = 1
     warnings: list = field(default_factory=list)
     condition_number: float = float("nan")
+    at_bound: dict = field(default_factory=dict)     # name -> "lower" or "upper"
 
 
 def fit(problem, method: str = "gauss-newton", *, starts: int = 1, seed: int = 0,
@@ -99,11 +106,14 @@ def fit(problem, method: str = "gauss-newton", *, starts: int = 1, seed: int = 0
         bar.close()
     theta, value = best
     r, J = problem.residuals(theta, jacobian=True)
+    span = np.where(hi > lo, hi - lo, 1.0)
+    bound = {p.name: side for p, t, l, h, w in zip(problem.fit, theta, lo, hi, span)
+             for side, gap in (("lower", t - l), ("upper", h - t)) if gap <= AT_BOUND * w}
     result = FitResult(method=method, names=[p.name for p in problem.fit],
                        initial={p.name: p.initial for p in problem.fit},
                        values=problem.values(theta), std={}, correlation=np.eye(len(theta)),
                        cost_initial=cost_initial, cost=0.5 * float(r @ r), residuals=r,
-                       evaluations=evaluations, starts=len(points))
+                       evaluations=evaluations, starts=len(points), at_bound=bound)
     uncertainty(problem, theta, r, J, result)
     result.simulations = problem.simulations - sims0
     result.wall_time_s = time.perf_counter() - t0
@@ -111,9 +121,30 @@ def fit(problem, method: str = "gauss-newton", *, starts: int = 1, seed: int = 0
 
 
 def uncertainty(problem, theta, r, J, result: FitResult) -> None:
-    """Standard errors and correlations from s^2 (J_p^T J_p)^-1, J_p = dr/dp (physical)."""
+    """Standard errors and correlations from s^2 (J_p^T J_p)^-1, J_p = dr/dp (physical), over
+    the parameters not at a bound (result.at_bound: those get NaN and a warning)."""
     names = result.names
-    dp = np.array([p.from_theta(t) if p.log else 1.0 for p, t in zip(problem.fit, theta)])
+    free = np.array([name not in result.at_bound for name in names], bool)
+    std, corr = np.full(len(names), math.nan), np.eye(len(names))
+    messages = []
+    if free.any():
+        params = [p for p, f in zip(problem.fit, free) if f]
+        std[free], corr[np.ix_(free, free)], result.condition_number, messages = _covariance(
+            params, theta[free], r, J[:, free])
+    messages += [f"{name} is at its {result.at_bound[name]} bound: reported there, without "
+                 f"sigma (the data push it past the bound; widen it if the physics allows)"
+                 for name in names if name in result.at_bound]
+    result.std = dict(zip(names, map(float, std)))
+    result.correlation = corr
+    for text in messages:
+        warnings.warn(text, IdentifiabilityWarning, stacklevel=3)
+    result.warnings = messages
+
+
+def _covariance(params, theta, r, J):
+    """(std, correlation, condition number, warnings) of `params` at theta."""
+    names = [p.name for p in params]
+    dp = np.array([p.from_theta(t) if p.log else 1.0 for p, t in zip(params, theta)])
     Jp = J / dp[None, :]
     m, n = Jp.shape
     dof = max(m - n, 1)
@@ -121,35 +152,31 @@ def uncertainty(problem, theta, r, J, result: FitResult) -> None:
     scale = np.where(np.linalg.norm(Jp, axis=0) > 0, np.linalg.norm(Jp, axis=0), 1.0)
     Js = Jp / scale
     sv = np.linalg.svd(Js, compute_uv=False)
-    result.condition_number = float(sv[0] / sv[-1]) if sv[-1] > 0 else float("inf")
+    condition = float(sv[0] / sv[-1]) if sv[-1] > 0 else float("inf")
     cov = s2 * np.linalg.pinv(Js.T @ Js) / np.outer(scale, scale)
     std = np.sqrt(np.clip(np.diag(cov), 0.0, None))
     unseen = np.linalg.norm(Jp, axis=0) == 0
     std[unseen] = np.nan
-    result.std = dict(zip(names, map(float, std)))
     with np.errstate(invalid="ignore", divide="ignore"):
-        corr = cov / np.outer(std, std)
-    result.correlation = np.nan_to_num(corr)
+        corr = np.nan_to_num(cov / np.outer(std, std))
     messages = [f"{names[k]} has no effect on the data (e.g. its joint is blocked in every "
                 f"run): its value is the initial one and its sigma undefined"
                 for k in np.flatnonzero(unseen)]
     for i in range(n):
         for j in range(i + 1, n):
-            if abs(result.correlation[i, j]) > CORRELATION_LIMIT:
+            if abs(corr[i, j]) > CORRELATION_LIMIT:
                 messages.append(f"{names[i]} and {names[j]} are correlated "
-                                f"{result.correlation[i, j]:+.3f}: the data cannot separate them")
-    if result.condition_number > CONDITION_LIMIT and not unseen.any():
+                                f"{corr[i, j]:+.3f}: the data cannot separate them")
+    if condition > CONDITION_LIMIT and not unseen.any():
         _, _, Vt = np.linalg.svd(Js)
         weak = Vt[-1]
         lead = [names[k] for k in np.argsort(-np.abs(weak)) if abs(weak[k]) > 0.3]
-        messages.append(f"ill-conditioned (condition number {result.condition_number:.3g}): "
+        messages.append(f"ill-conditioned (condition number {condition:.3g}): "
                         f"the combination of {', '.join(lead)} is barely seen by the data")
     if m <= n:
         messages.append(f"{m} residuals for {n} parameters: no degrees of freedom left for "
                         f"the residual variance")
-    for text in messages:
-        warnings.warn(text, IdentifiabilityWarning, stacklevel=3)
-    result.warnings = messages
+    return std, corr, condition, messages
 
 
 def _bar(progress: bool, method: str):

@@ -9,7 +9,14 @@ runs into `Run`s for `mbcontrol.studies.identify`:
   WM_Position): it opens when the ramp's end (RAMP_PERIODS after the paddle starts, at the
   group velocity c_g of finite depth) has passed the model plus SETTLE_PERIODS for the model's
   transient, and closes when waves reflected by the model have come back from the paddle,
-  3 x / c_g after the paddle started (x = 7 m); whole periods only; a run with none is refused;
+  3 x / c_g after the paddle started (x = 7 m); whole periods only; a run with fewer than
+  MIN_PERIODS, or whose record ends inside the window, is refused with the numbers. The beach's
+  echo arrives earlier, (2 x_beach - x) / c_g, and the calibration windows stop before it (a probe
+  sees nothing else to reflect); the model windows need not: in the calibration runs at
+  4.95-7.0 rad/s the harmonic at WP_4 and WP_6 changes by 0.1-1.5 % when the echo arrives (one
+  run, 1101_1 at WP_4, by 15 %), while the model reflects a large share of the wave, whose
+  return from the paddle is what ends the window. Stopping at the echo would leave under two
+  periods at 4.95-5.43 rad/s, the roll and heave resonances;
 - the incident wave at the model from the calibration runs of the same PP and H: the first
   harmonic at each probe (in its own steady window), carried to x = 7 m as a progressive wave
   e^{i(k x - omega t)} and averaged over probes and repetitions (their spread is reported),
@@ -31,7 +38,7 @@ import numpy as np
 from ... import waves
 from .costs import harmonic, whole_periods
 from .problem import Run
-from .records import RecordError, channel_problem, read_csv
+from .records import RecordError, channel_problem, read_csv, require_quantity
 
 DEPTH, G = 1.0, 9.81                    # m, m/s^2
 MODEL_X = 7.0                           # m from the wavemaker
@@ -39,11 +46,13 @@ BEACH_X = 11.5                          # m, the middle of the parabolic beach (
 PROBES = {"WP_1": 3.00, "WP_2": 4.95, "WP_3": 5.20, "WP_4": 5.50, "WP_6": 8.50}   # m
 RAMP_PERIODS = 5                        # the wavemaker's ramp (README)
 SETTLE_PERIODS = 2                      # for the model's own transient after the ramp
+MIN_PERIODS = 3                         # whole periods a steady window must hold
 OMEGA = {1: 4.143, 2: 4.952, 3: 5.075, 4: 5.194, 5: 5.311, 6: 5.425, 7: 5.646, 8: 5.860,
          9: 6.065, 10: 7.004, 11: 7.830, 12: 8.578, 13: 9.265, 14: 9.905}           # rad/s
 HEIGHT = {1: 0.024, 2: 0.040}           # m, nominal
 SERIES = {3: ("Sway", "Heave", "Roll"), 4: ("Sway", "Heave"), 5: ("Sway", "Roll"),
           6: ("Heave", "Roll")}
+QUANTITY = {"Sway": "length", "Heave": "length", "Roll": "angle", "WM_Position": "length"}
 FREEZE = {3: (), 4: ("roll",), 5: ("heave",), 6: ("sway",)}     # joints of flume_section.toml
 SCENE_PARAMETERS = {5: {"sway_extra_mass": 0.3}}                 # kg: the heave block rides in sway
 _NAME = re.compile(r"^(?P<series>\d)(?P<pp>\d\d)(?P<h>\d)(?:_(?P<rep>\d+))?$")
@@ -65,6 +74,7 @@ def parse_name(path) -> dict:
 def wavemaker_start(record, share: float = 0.05) -> float:
     """Time (s) the paddle starts: WM_Position first leaves its still level by `share` of its
     largest excursion."""
+    require_quantity(record, "WM_Position", "length")
     t, wm = record.time, record.channel("WM_Position")
     still = np.median(wm[: max(10, int(0.5 / np.median(np.diff(t))))])
     excursion = np.abs(wm - still)
@@ -100,6 +110,7 @@ def incident_transfer(paths, omega: float) -> tuple[complex, float]:
         for probe, x in PROBES.items():
             if probe not in record.channels or channel_problem(record, probe):
                 continue
+            require_quantity(record, probe, "length")
             t0 = start + x / waves.group_velocity(omega, DEPTH, G) + (RAMP_PERIODS + 1) * period
             t1 = start + (2 * BEACH_X - x) / waves.group_velocity(omega, DEPTH, G)   # before the beach's echo
             try:
@@ -119,6 +130,10 @@ def incident_transfer(paths, omega: float) -> tuple[complex, float]:
 def calibration_files(folder, pp: int, height_code: int) -> list[Path]:
     """The calibration runs 1PPH and 1PPH_R in `folder`."""
     folder = Path(folder)
+    if not folder.is_dir():
+        raise RecordError(f"{folder}: no calibration folder (the 1PPH[_R] runs of waves alone, "
+                          f"by default `calibration` beside the data files' folder); give it "
+                          f"with --calibration DIR (calibration= in Python)")
     found = sorted(p for p in folder.glob(f"1{pp:02d}{height_code}*.csv*")
                    if _NAME.match(p.name.split(".")[0]))
     if not found:
@@ -138,15 +153,22 @@ def load_run(path, calibration, *, channels: dict | None = None) -> Run:
     omega, free = info["omega"], SERIES[info["series"]]
     start = wavemaker_start(record)
     open_, close = steady_window(start, omega)
-    close = min(close, float(record.time[-1]))
+    if record.time[-1] < close:
+        raise RecordError(f"{path}: the record ends at {record.time[-1]:.2f} s, before its steady "
+                          f"window closes ({open_:.2f}-{close:.2f} s: the ramp's passage to the "
+                          f"reflections' return); a cut record is not used")
     try:
         open_, close, n = whole_periods(record.time, omega, open_, close)
     except ValueError:
-        raise RecordError(f"{path}: no whole wave period ({2 * math.pi / omega:.3f} s) between "
+        n = 0
+    if n < MIN_PERIODS:
+        raise RecordError(f"{path}: {n} whole wave period(s) ({2 * math.pi / omega:.3f} s) between "
                           f"the ramp's passage ({open_:.2f} s) and the reflections' return "
-                          f"({close:.2f} s); the run is too short for a steady window") from None
+                          f"({close:.2f} s); expected at least {MIN_PERIODS} for a steady "
+                          f"harmonic")
     names = channels or {c: c for c in free}
     for channel in free:
+        require_quantity(record, channel, QUANTITY[channel])
         problem = channel_problem(record, channel, (open_, close))
         if problem:
             raise RecordError(f"{path}: {problem}")
@@ -177,8 +199,9 @@ def load_runs(paths, calibration=None, *, drop_bad: bool = False) -> list[Run]:
             if not drop_bad:
                 raise
             dropped.append(str(exc))
+    if not runs:
+        raise RecordError(f"no usable run among the {len(paths)} file(s) given" + (
+            ":\n  " + "\n  ".join(dropped) if dropped else ""))
     if dropped:
         warnings.warn(f"dropped {len(dropped)} run(s):\n  " + "\n  ".join(dropped), stacklevel=2)
-    if not runs:
-        raise RecordError("no usable run among the files given")
     return runs

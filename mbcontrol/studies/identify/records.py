@@ -2,8 +2,13 @@
 
 A `Record` is what a file holds: time (s) and channels by name, each with its unit. Readers
 take a column map (file column -> channel name) so a lab's naming meets the plant's; a
-`[unit]` suffix in a CSV header ("Sway [m]") gives the unit. `check_channels` refuses a
-channel that is missing, NaN or flat (a tracking failure), naming the file and the channel.
+`[unit]` suffix in a CSV header ("Sway [m]") or a netCDF `units` attribute gives the unit, and
+every channel is converted to SI on reading (mm, cm -> m; deg -> rad; kN -> N; ms -> s; see
+UNITS): a unit not in UNITS is an error naming the file and the column, never a silent factor.
+A column without a unit is kept as it is (its unit ""), and `require_quantity` refuses it
+where the caller knows what the channel must be only if its unit says otherwise.
+`check_channels` refuses a channel that is missing, NaN or flat (a tracking failure), naming
+the file and the channel.
 CSV files may be compressed (.csv.xz, .csv.gz, .csv.bz2).
 """
 from __future__ import annotations
@@ -19,6 +24,21 @@ import numpy as np
 
 from ...errors import MbcontrolError
 
+# unit as written -> (quantity, SI unit, factor to SI); spellings are matched case-sensitively
+# (mm is not Mm) after stripping spaces
+UNITS = {
+    "s": ("time", "s", 1.0), "ms": ("time", "s", 1e-3),
+    "m": ("length", "m", 1.0), "cm": ("length", "m", 1e-2), "mm": ("length", "m", 1e-3),
+    "rad": ("angle", "rad", 1.0), "deg": ("angle", "rad", np.pi / 180),
+    "degree": ("angle", "rad", np.pi / 180), "degrees": ("angle", "rad", np.pi / 180),
+    "°": ("angle", "rad", np.pi / 180),
+    "N": ("force", "N", 1.0), "kN": ("force", "N", 1e3),
+    "Nm": ("moment", "N m", 1.0), "kNm": ("moment", "N m", 1e3),
+    "m/s": ("velocity", "m/s", 1.0), "mm/s": ("velocity", "m/s", 1e-3),
+    "m/s2": ("acceleration", "m/s2", 1.0), "m/s^2": ("acceleration", "m/s2", 1.0),
+    "rad/s": ("angular velocity", "rad/s", 1.0), "deg/s": ("angular velocity", "rad/s", np.pi / 180),
+    "kg": ("mass", "kg", 1.0), "V": ("voltage", "V", 1.0), "-": ("dimensionless", "-", 1.0),
+}
 FLAT_SHARE = 0.5          # a channel whose samples are exactly equal for over half the window
 FLAT_RANGE = 1e-12        # or whose range is below this (its unit) is flat: a tracking failure
 
@@ -90,22 +110,47 @@ def read_netcdf(path, columns: dict | None = None, *, time: str = "time") -> Rec
                    columns, time)
 
 
+def to_si(path, column: str, unit: str, values):
+    """(values in SI, SI unit) for a column written in `unit` ("" is kept as it is);
+    RecordError naming the file and the column for a unit not in UNITS."""
+    key = unit.replace(" ", "")
+    if not key:
+        return np.asarray(values, float), ""
+    if key not in UNITS:
+        raise RecordError(f"{path}: column {column!r} has unit {unit!r}, which mbcontrol does "
+                          f"not know; expected one of {', '.join(sorted(UNITS))} (converted to "
+                          f"SI on reading)")
+    _, si, factor = UNITS[key]
+    return np.asarray(values, float) * factor, si
+
+
+def require_quantity(record: "Record", name: str, quantity: str) -> None:
+    """RecordError unless channel `name`'s unit is one of `quantity` ("length", "angle",
+    ...) or not given (then SI is assumed, as the plant's outputs are)."""
+    unit = record.units.get(name, "")
+    if unit and UNITS[unit.replace(" ", "")][0] != quantity:
+        expected = sorted(u for u, (q, _, _) in UNITS.items() if q == quantity)
+        raise RecordError(f"{record.path}: channel {name!r} is in {unit!r}; expected {quantity} "
+                          f"units ({', '.join(expected)})")
+
+
 def _record(path, names, units, arrays, columns, time) -> Record:
     if time not in names:
         raise RecordError(f"{path}: no time column {time!r}; columns: {', '.join(names)}")
     values = dict(zip(names, arrays))
-    t = np.asarray(values.pop(time), float)
+    t, time_unit = to_si(path, time, units.get(time, ""), values.pop(time))
+    if time_unit not in ("", "s"):
+        raise RecordError(f"{path}: time column {time!r} is in {units[time]!r}; expected s or ms")
     if t.size < 2 or not np.all(np.diff(t) > 0):
         raise RecordError(f"{path}: time column {time!r} is not increasing")
-    if columns is not None:
-        missing = [c for c in columns if c not in values]
-        if missing:
-            raise RecordError(f"{path}: no column(s) {missing}; the file has "
-                              f"{', '.join(values)}")
-        values = {columns[c]: values[c] for c in columns}
-        units = {columns[c]: units.get(c, "") for c in columns}
-    return Record(str(path), t, {k: np.asarray(v, float) for k, v in values.items()},
-                  {k: units.get(k, "") for k in values})
+    kept = {c: c for c in values} if columns is None else columns
+    missing = [c for c in kept if c not in values]
+    if missing:
+        raise RecordError(f"{path}: no column(s) {missing}; the file has {', '.join(values)}")
+    channels, si_units = {}, {}
+    for column, name in kept.items():       # only the columns kept: others may be anything
+        channels[name], si_units[name] = to_si(path, column, units.get(column, ""), values[column])
+    return Record(str(path), t, channels, si_units)
 
 
 def channel_problem(record: Record, name: str, window=None) -> str | None:

@@ -19,7 +19,9 @@ from .costs import harmonic, whole_periods
 
 def amplitude_rows(problem, values: dict) -> list[dict]:
     """Per run and free channel: {run, group, omega (rad/s), incident (m), channel, unit,
-    measured, model (first-harmonic amplitudes, channel unit), relative_error}."""
+    measured, model (first-harmonic amplitudes, channel unit), relative_error, extrapolated
+    (why the run lies where the model was not fitted, `extrapolation.reasons`; [] if not)}."""
+    from .extrapolation import reasons
     sims = problem.simulate(values)
     rows = []
     for run, sim in zip(problem.runs, sims):
@@ -31,7 +33,8 @@ def amplitude_rows(problem, values: dict) -> list[dict]:
                          "incident": run.amplitude, "channel": channel,
                          "unit": "rad" if channel.lower().startswith(("roll", "pitch", "yaw"))
                          else "m", "measured": measured, "model": model,
-                         "relative_error": (model - measured) / measured})
+                         "relative_error": (model - measured) / measured,
+                         "extrapolated": reasons(problem, run.omega)})
     return rows
 
 
@@ -48,13 +51,40 @@ def channel_errors(rows: list[dict]) -> dict:
     return out
 
 
+def repeatability(rows: list[dict]) -> dict:
+    """The data's own floor: runs of one group at the same frequency (repetitions), each
+    channel's amplitude per unit incident wave against their mean. {channel: {"sets": number
+    of repeated (group, omega) sets, "runs", "rms_relative_spread": RMS over those runs of
+    (a / mean - 1), "max_relative_spread"}}; a model that predicted each set's mean exactly
+    would show this RMS relative error, so no model is expected to beat it."""
+    sets = {}
+    for r in rows:
+        sets.setdefault((r["channel"], r["group"], round(r["omega"], 6)), []).append(
+            r["measured"] / r["incident"])
+    out = {}
+    for (channel, _, _), values in sorted(sets.items()):
+        if len(values) < 2:
+            continue
+        v = np.asarray(values)
+        entry = out.setdefault(channel, {"sets": 0, "runs": 0, "spread": []})
+        entry["sets"] += 1
+        entry["runs"] += v.size
+        entry["spread"] += list(v / v.mean() - 1)
+    for entry in out.values():
+        spread = np.asarray(entry.pop("spread"))
+        entry["rms_relative_spread"] = float(np.sqrt(np.mean(spread ** 2)))
+        entry["max_relative_spread"] = float(np.max(np.abs(spread)))
+    return out
+
+
 def errors_block(rows: list[dict], residuals=None) -> dict:
-    """{runs, rms_error, channels}: the "fit" / "validation" block of the JSON contract;
-    rms_error is the RMS of the relative amplitude errors over every run and channel."""
+    """{runs, rms_error, channels, repeatability}: the "fit" / "validation" block of the JSON
+    contract; rms_error is the RMS of the relative amplitude errors over every run and channel;
+    repeatability the spread between repeated runs (`repeatability`), the data's floor."""
     rel = np.array([r["relative_error"] for r in rows])
     return {"runs": sorted({r["run"] for r in rows}),
             "rms_error": float(np.sqrt(np.mean(rel ** 2))) if rel.size else None,
-            "channels": channel_errors(rows)}
+            "channels": channel_errors(rows), "repeatability": repeatability(rows)}
 
 
 def forward_validity(problem, values: dict, rows: list[dict]) -> dict:
@@ -95,8 +125,10 @@ def summary(model: str, problem, result, fit_rows, validation_rows=None) -> dict
     verdict = forward_validity(problem, result.values, fit_rows + (validation_rows or []))
     params = {}
     for p in problem.fit:
+        std = result.std.get(p.name)
         params[p.name] = {"initial": p.initial, "value": result.values[p.name],
-                          "std": result.std.get(p.name), "lo": p.lo, "hi": p.hi}
+                          "std": None if std is None or math.isnan(std) else std,
+                          "at_bound": result.at_bound.get(p.name), "lo": p.lo, "hi": p.hi}
     return jsonable({
         "model": model, "valid": verdict["valid"], "invalid_reasons": verdict["invalid_reasons"],
         "method": result.method, "cost": problem.cost,
@@ -114,7 +146,9 @@ def parameter_table(problem, result) -> str:
     lines = [f"{'parameter':36s} {'initial':>11s} {'identified':>11s} {'+- sigma':>10s}  bounds"]
     for p in problem.fit:
         v, s = result.values[p.name], result.std.get(p.name, math.nan)
-        lines.append(f"{p.name:36s} {p.initial:11.4g} {v:11.4g} {s:10.3g}  "
+        side = result.at_bound.get(p.name)
+        sigma = f"{'at ' + side:>10s}" if side else f"{s:10.3g}"
+        lines.append(f"{p.name:36s} {p.initial:11.4g} {v:11.4g} {sigma}  "
                      f"[{p.lo:.3g}, {p.hi:.3g}]{' log' if p.log else ''}")
     lines.append(f"cost (1/2 |r|^2, {problem.cost}): {result.cost_initial:.4g} -> {result.cost:.4g}"
                  f"; {result.simulations} simulations, {result.wall_time_s:.1f} s")
@@ -122,18 +156,25 @@ def parameter_table(problem, result) -> str:
 
 
 def error_table(rows: list[dict], label: str) -> str:
-    """Per channel: RMS error (unit) and RMS relative error over the runs."""
-    lines = [f"{label}: {'channel':8s} {'runs':>4s} {'rms error':>12s} {'rms relative':>13s}"]
+    """Per channel: RMS error (unit) and RMS relative error over the runs, and beside it the
+    repeated runs' own spread (`repeatability`; "-" where no run was repeated)."""
+    floor = repeatability(rows)
+    lines = [f"{label}: {'channel':8s} {'runs':>4s} {'rms error':>12s} {'rms relative':>13s}"
+             f" {'repeat spread':>14s}"]
     for channel, e in channel_errors(rows).items():
         unit = next(r["unit"] for r in rows if r["channel"] == channel)
+        f = floor.get(channel)
+        spread = f"{100 * f['rms_relative_spread']:5.1f}% ({f['sets']})" if f else "-"
         lines.append(f"{'':{len(label) + 2}s}{channel:8s} {e['runs']:4d} "
-                     f"{e['rms_error']:10.3g} {unit:1s} {100 * e['rms_relative_error']:12.1f}%")
+                     f"{e['rms_error']:10.3g} {unit:3s} {100 * e['rms_relative_error']:10.1f}%"
+                     f" {spread:>14s}")
     return "\n".join(lines)
 
 
 def plot_amplitudes(rows_by_label: dict, path=None, title: str | None = None):
     """Response amplitude per unit incident amplitude against frequency, one panel per channel,
-    measured (dots) and each labelled model (lines), runs grouped by `group` (markers).
+    measured (dots) and each labelled model (lines), runs grouped by `group` (markers); runs
+    where the model extrapolates (rows' "extrapolated") crossed in red.
     Returns the figure (written to path when given)."""
     import matplotlib.pyplot as plt
 
@@ -150,6 +191,10 @@ def plot_amplitudes(rows_by_label: dict, path=None, title: str | None = None):
                          if r["group"] == group)
             if pts:
                 ax.plot(*zip(*pts), marker, color="k", mfc="none", label=f"measured, {group}")
+        far = [(r["omega"], r["measured"] / r["incident"]) for r in mine if r.get("extrapolated")]
+        if far:
+            ax.plot(*zip(*far), "x", color="tab:red", ms=9,
+                    label="model extrapolated there (see warnings)")
         for k, (label, rows) in enumerate(rows_by_label.items()):
             for group, marker in markers.items():
                 pts = sorted((r["omega"], r["model"] / r["incident"]) for r in rows

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 
+from . import extrapolation
 from .problem import FitParameter, Identification
 
 
@@ -20,6 +21,7 @@ def fit_parameters(scene, plant_parameters: dict, specs=()) -> list[FitParameter
         chosen = dict(scene.identify)
     for spec in specs:
         name, _, bounds = spec.partition("=")
+        _known(scene, plant_parameters, name)
         if bounds:
             try:
                 lo, hi = (float(v) for v in bounds.split(":"))
@@ -33,15 +35,21 @@ def fit_parameters(scene, plant_parameters: dict, specs=()) -> list[FitParameter
         chosen[name] = (lo, hi)
     out = []
     for name, (lo, hi) in chosen.items():
-        if name not in plant_parameters:
-            raise ValueError(f"--fit {name}: not a parameter of {scene.name}; it has "
-                             f"{', '.join(sorted(plant_parameters))}")
+        _known(scene, plant_parameters, name)
+        if not lo < hi:
+            raise ValueError(f"--fit {name}: bounds {lo:g}:{hi:g}; expected LO < HI")
         log = lo > 0
         nominal = plant_parameters[name]
         initial = nominal if lo <= nominal <= hi and (nominal > 0 or not log) else (
             math.sqrt(lo * hi) if log else 0.5 * (lo + hi))
         out.append(FitParameter(name, float(initial), float(lo), float(hi), log=log))
     return out
+
+
+def _known(scene, plant_parameters, name) -> None:
+    if name not in plant_parameters:
+        raise ValueError(f"--fit {name}: not a parameter of {scene.name}; it has "
+                         f"{', '.join(sorted(plant_parameters))}")
 
 
 def channel_outputs(plant, runs) -> dict:
@@ -70,16 +78,24 @@ def flume_identification(model, files, *, calibration=None, fit=(), drop_bad: bo
         runs = load_runs(files, calibration, drop_bad=drop_bad)
     full = build_plant(scene, hydro_corrections=True)
     parameters = fit_parameters(scene, dict(zip(full.parameters, full.p0)), list(fit))
-    return Identification(scene.path, runs, parameters, outputs=channel_outputs(full, runs),
-                          drop_absent=not fit, **options)
+    problem = Identification(scene.path, runs, parameters, outputs=channel_outputs(full, runs),
+                             drop_absent=not fit, **options)
+    extrapolation.warn(problem, "fit")
+    return problem
 
 
 def prediction(problem: Identification, runs) -> Identification:
     """The same model and options on other runs, nothing to fit: evaluate it with
     `report.amplitude_rows(prediction, fitted_values)` to validate on runs the fit did not see
-    (values of parameters its plants lack, e.g. of a blocked DOF, are ignored)."""
+    (values of parameters its plants lack, e.g. of a blocked DOF, are ignored). Runs outside
+    the fitted runs' frequency band, or above the radiation fit, warn (ExtrapolationWarning)
+    and are flagged in the rows."""
     from ...plant import build_plant
     from ...scene import load_scene
     full = build_plant(load_scene(problem.scene), hydro_corrections=True)
-    return Identification(problem.scene, runs, [], outputs=channel_outputs(full, runs),
-                          **problem.options)
+    predicted = Identification(problem.scene, runs, [], outputs=channel_outputs(full, runs),
+                               **problem.options)
+    omegas = [r.omega for r in problem.runs]
+    predicted.fitted_band = (min(omegas), max(omegas))   # what the identified values have seen
+    extrapolation.warn(predicted, "validation")
+    return predicted

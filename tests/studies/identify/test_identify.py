@@ -131,3 +131,59 @@ def test_forward_runs_are_checked(clean_records):
     assert not bad["valid"]
     text = " ".join(bad["invalid_reasons"])
     assert "create energy" in text and "beyond the mean draft" in text
+
+
+def test_a_parameter_at_its_bound_gets_no_sigma(clean_records):
+    """The truth (3e5 N s/m) above the damping's upper bound: the fit stops on the bound and
+    says so; its sigma would come from a Jacobian column the bound blocks, so there is none,
+    and the added-mass scale's comes from the reduced problem (one parameter)."""
+    from mbcontrol.studies.identify import IdentifiabilityWarning
+    from mbcontrol.studies.identify.report import parameter_table, summary
+    prob = Identification("sphere", runs_with_noise(clean_records, 0),
+                          [FitParameter("pto__damping", 2.0e5, 5e4, 2.5e5),
+                           FitParameter("sphere__Heave__added_mass_scale", 1.0, 0.5, 2.0)],
+                          outputs={"Heave": "heave"}, dt=0.1, settle=80.0, direction=0.0)
+    with pytest.warns(IdentifiabilityWarning, match="pto__damping is at its upper bound"):
+        result = fit(prob, "gauss-newton")
+    assert result.at_bound == {"pto__damping": "upper"}
+    assert result.values["pto__damping"] == pytest.approx(2.5e5, rel=1e-5)
+    assert math.isnan(result.std["pto__damping"])
+    assert 0 < result.std["sphere__Heave__added_mass_scale"] < 0.05
+    assert result.correlation[0, 1] == 0.0
+    row = summary("sphere", prob, result, [])["parameters"]["pto__damping"]
+    assert row["std"] is None and row["at_bound"] == "upper"
+    assert "at upper" in parameter_table(prob, result).splitlines()[1]
+
+
+def test_prediction_outside_the_fitted_band_is_said_aloud(clean_records, tmp_path):
+    """Fitted on the 5.5-12 s runs, the 14 s and 16 s ones are predicted: an
+    ExtrapolationWarning names them and the band, their rows say why, and the amplitude
+    figure crosses them."""
+    from mbcontrol.studies.identify import ExtrapolationWarning
+    from mbcontrol.studies.identify.report import amplitude_rows, plot_amplitudes
+    from mbcontrol.studies.identify.setup import prediction
+    runs = runs_with_noise(clean_records, 0)
+    inside, outside = runs[:8], runs[8:]
+    assert [r.name for r in outside] == ["T14", "T16"]
+    prob = problem(inside)
+    assert all(not r["extrapolated"] for r in amplitude_rows(prob, TRUTH))
+    with pytest.warns(ExtrapolationWarning, match=r"validation runs T14 \(0.449\), T16 \(0.393\) "
+                                                  r"rad/s: outside the fitted runs' 0.524-1.14"):
+        predicted = prediction(prob, outside)
+    rows = amplitude_rows(predicted, TRUTH)
+    assert all(r["extrapolated"] == ["outside the fitted runs' 0.524-1.14 rad/s"] for r in rows)
+    fig = plot_amplitudes({"truth": rows}, tmp_path / "amplitudes.png")
+    labels = fig.axes[0].get_legend_handles_labels()[1]
+    assert "model extrapolated there (see warnings)" in labels
+
+
+def test_repeatability_is_the_spread_of_repeated_runs():
+    """Two repetitions (1.0 and 1.1 per unit wave) and one single run: each repetition is
+    1/21 from their mean; the single run and other groups do not count."""
+    from mbcontrol.studies.identify.report import repeatability
+    row = dict(channel="Heave", group="a", omega=1.0, incident=2.0, model=0.0)
+    rows = [{**row, "measured": 2.0}, {**row, "measured": 2.2},
+            {**row, "measured": 9.0, "omega": 2.0}, {**row, "measured": 2.2, "group": "b"}]
+    floor = repeatability(rows)
+    assert floor == {"Heave": {"sets": 1, "runs": 2, "rms_relative_spread": pytest.approx(1 / 21),
+                               "max_relative_spread": pytest.approx(1 / 21)}}

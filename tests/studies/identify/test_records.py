@@ -50,7 +50,8 @@ def test_netcdf_record(tmp_path):
                     coords={"t": ("t", t, {"units": "s"})})
     ds.to_netcdf(tmp_path / "run.nc")
     r = read_netcdf(tmp_path / "run.nc", {"roll_deg": "Roll"}, time="t")
-    assert r.units == {"Roll": "deg"} and r.channels["Roll"].shape == t.shape
+    assert r.units == {"Roll": "rad"}                                 # converted on reading
+    np.testing.assert_allclose(r.channels["Roll"], 0.1 * np.sin(t), rtol=1e-12)
     with pytest.raises(RecordError, match="no time coordinate 'time'"):
         read_netcdf(tmp_path / "run.nc")
 
@@ -113,9 +114,76 @@ def test_nan_channel_and_short_run_are_refused(tmp_path):
                 edit=("Roll [rad]", "nan"))
     with pytest.raises(RecordError, match=r"5081_1.csv: channel 'Roll' has \d+ NaN"):
         load_run(nan, CALIBRATION)
-    short = _copy(RUNS / "4021_1.csv.xz", tmp_path / "scenario_c" / "4021_1.csv", rows=5000)
-    with pytest.raises(RecordError, match=r"4021_1.csv: no whole wave period .* too short for a "
-                                          r"steady window"):
-        load_run(short, CALIBRATION)
+    # 4021_1's steady window is 31.6-36.2 s (200 Hz): cut at 25 s and at 34 s, inside it
+    for rows, end in ((5000, "25.00"), (6800, "34.00")):
+        short = _copy(RUNS / "4021_1.csv.xz", tmp_path / "scenario_c" / "4021_1.csv", rows=rows)
+        with pytest.raises(RecordError, match=rf"4021_1.csv: the record ends at {end} s, before "
+                                              r"its steady window closes \(31.6\d-36.2\d s"):
+            load_run(short, CALIBRATION)
+    # at 4.143 rad/s (PP 01) the reflections are back before the ramp has passed the model
+    early = _copy(RUNS / "4021_1.csv.xz", tmp_path / "scenario_c" / "4011_1.csv")
+    with pytest.raises(RecordError, match=r"4011_1.csv: 0 whole wave period\(s\) \(1.517 s\) .* "
+                                          r"expected at least 3"):
+        load_run(early, CALIBRATION)
     with pytest.raises(RecordError, match="no calibration run 1021"):
         load_run(RUNS / "4021_1.csv.xz", tmp_path)
+
+
+def _rewrite(src: Path, dst: Path, columns: dict) -> Path:
+    """A plain-CSV copy of a tank file with columns renamed and their values transformed:
+    columns = {old header: (new header, function of the value)}."""
+    with lzma.open(src, "rt") as fh:
+        lines = fh.read().splitlines()
+    header = lines[0].split(",")
+    edits = {header.index(old): (new, f) for old, (new, f) in columns.items()}
+    for k, (new, _) in edits.items():
+        header[k] = new
+    body = []
+    for line in lines[1:]:
+        values = line.split(",")
+        for k, (_, f) in edits.items():
+            values[k] = repr(f(float(values[k])))
+        body.append(",".join(values))
+    dst.parent.mkdir(parents=True, exist_ok=True)
+    dst.write_text("\n".join([",".join(header), *body]) + "\n")
+    return dst
+
+
+def test_units_in_headers_are_converted_and_checked(tmp_path):
+    """Sway stored in mm under "Sway [mm]" and roll in degrees under "Roll [deg]" load as the
+    run in m and rad, and fit to the same value (the issue: 50.6 instead of 32.6, silently); an
+    unknown unit or a channel of the wrong kind is refused naming the file and the column."""
+    from mbcontrol.studies.identify import fit
+    from mbcontrol.studies.identify.setup import flume_identification
+    src = RUNS / "5081_1.csv.xz"
+    mm = _rewrite(src, tmp_path / "scenario_c" / "5081_1.csv",
+                  {"Sway [m]": ("Sway [mm]", lambda v: 1e3 * v),
+                   "Roll [rad]": ("Roll [deg]", math.degrees)})
+    a, b = load_run(src, CALIBRATION), load_run(mm, CALIBRATION)
+    assert a.window == b.window and b.amplitude == pytest.approx(a.amplitude, rel=1e-12)
+    for channel in ("Sway", "Roll"):
+        np.testing.assert_allclose(b.channels[channel], a.channels[channel], rtol=1e-12)
+    values = [fit(flume_identification("flume_section", None, runs=[run],
+                                       fit=["sway_rig__viscous"]), "gauss-newton").values
+              for run in (a, b)]
+    assert values[1]["sway_rig__viscous"] == pytest.approx(values[0]["sway_rig__viscous"],
+                                                           rel=1e-9)
+    inches = _rewrite(src, tmp_path / "in" / "5081_1.csv", {"Sway [m]": ("Sway [in]", float)})
+    with pytest.raises(RecordError, match=r"5081_1.csv: column 'Sway' has unit 'in', which "
+                                          r"mbcontrol does not know; expected one of .*mm"):
+        load_run(inches, CALIBRATION)
+    metres = _rewrite(src, tmp_path / "m" / "5081_1.csv", {"Roll [rad]": ("Roll [m]", float)})
+    with pytest.raises(RecordError, match=r"5081_1.csv: channel 'Roll' is in 'm'; expected "
+                                          r"angle units \(.*deg.*rad"):
+        load_run(metres, CALIBRATION)
+
+
+def test_every_refusal_is_listed_and_a_missing_calibration_folder_named(tmp_path):
+    bad = [_copy(RUNS / name, tmp_path / "scenario_c" / name.replace(".xz", ""),
+                 edit=("Roll [rad]", "nan")) for name in ("5081_1.csv.xz", "5081_2.csv.xz")]
+    with pytest.raises(RecordError, match=r"(?s)no usable run among the 2 file\(s\) given:.*"
+                                          r"5081_1.csv: channel 'Roll' has \d+ NaN.*"
+                                          r"5081_2.csv: channel 'Roll' has \d+ NaN"):
+        load_runs(bad, CALIBRATION, drop_bad=True)
+    with pytest.raises(RecordError, match=r"no calibration folder .* --calibration DIR"):
+        load_runs([RUNS / "5081_1.csv.xz"], tmp_path / "nowhere")
