@@ -8,7 +8,16 @@ s^2 (J^T J)^-1, standard errors, correlations. A parameter the optimum leaves at
 bounds (within AT_BOUND of the span, in the fitted variable) is reported there, with no sigma:
 its Jacobian column describes a move the bound blocks, and the interval would be one-sided.
 The others' covariance is that of the reduced problem (the bounded ones held), with m - n_free
-degrees of freedom. Parameters the data cannot separate are named
+degrees of freedom.
+
+Residuals correlated in time (the peaks and timeseries costs: consecutive residuals of one run
+and channel, `Identification.time_blocks`) make (J^T J)^-1 s^2 far too narrow: the samples are
+not independent. There the covariance is the sandwich (J^T J)^-1 J^T Σ J (J^T J)^-1 with Σ the
+AR(1) covariance γ0 ρ^|i-j| within each block (ρ the pooled lag-1 autocorrelation of the
+residuals, floored at 0, γ0 = s^2), i.e. Newey-West with the AR(1) kernel; the result's
+`uncertainty_method` states it, with ρ and the effective sample count m (1-ρ)/(1+ρ). Checked on
+AR(1) measurement noise: 95 % intervals hold the truth in about 95 % of seeds (tests). Model
+error that repeats every period is not AR(1): its intervals stay optimistic. Parameters the data cannot separate are named
 in a warning: a pair with |correlation| > CORRELATION_LIMIT, or the direction of the smallest
 singular value of the column-scaled Jacobian when its condition number passes CONDITION_LIMIT.
 """
@@ -52,6 +61,7 @@ class FitResult:
     warnings: list = field(default_factory=list)
     condition_number: float = float("nan")
     at_bound: dict = field(default_factory=dict)     # name -> "lower" or "upper"
+    uncertainty_method: str = "independent residuals"
 
 
 def fit(problem, method: str = "gauss-newton", *, starts: int = 1, seed: int = 0,
@@ -129,8 +139,9 @@ def uncertainty(problem, theta, r, J, result: FitResult) -> None:
     messages = []
     if free.any():
         params = [p for p, f in zip(problem.fit, free) if f]
-        std[free], corr[np.ix_(free, free)], result.condition_number, messages = _covariance(
-            params, theta[free], r, J[:, free])
+        std[free], corr[np.ix_(free, free)], result.condition_number, messages, method = \
+            _covariance(params, theta[free], r, J[:, free], getattr(problem, "time_blocks", None))
+        result.uncertainty_method = method
     messages += [f"{name} is at its {result.at_bound[name]} bound: reported there, without "
                  f"sigma (the data push it past the bound; widen it if the physics allows)"
                  for name in names if name in result.at_bound]
@@ -141,8 +152,36 @@ def uncertainty(problem, theta, r, J, result: FitResult) -> None:
     result.warnings = messages
 
 
-def _covariance(params, theta, r, J):
-    """(std, correlation, condition number, warnings) of `params` at theta."""
+def _ar1(r, blocks):
+    """Pooled lag-1 autocorrelation of r within consecutive blocks (sizes), floored at 0."""
+    num = den = 0.0
+    i = 0
+    for n in blocks:
+        seg = r[i:i + n]
+        num += float(seg[1:] @ seg[:-1])
+        den += float(seg @ seg)
+        i += n
+    return max(0.0, num / den) if den > 0 else 0.0
+
+
+def _ar1_times(G, rho, blocks):
+    """T G with T_ij = rho^|i-j| within each block (0 across): a forward and a backward
+    first-order filter, T G = F + B - G, in O(m n)."""
+    from scipy.signal import lfilter
+    out = np.empty_like(G)
+    i = 0
+    for n in blocks:
+        seg = G[i:i + n]
+        forward = lfilter([1.0], [1.0, -rho], seg, axis=0)
+        backward = lfilter([1.0], [1.0, -rho], seg[::-1], axis=0)[::-1]
+        out[i:i + n] = forward + backward - seg
+        i += n
+    return out
+
+
+def _covariance(params, theta, r, J, blocks=None):
+    """(std, correlation, condition number, warnings, method) of `params` at theta; blocks:
+    sizes of the residuals' time-correlated runs (module notes), None or all 1: independent."""
     names = [p.name for p in params]
     dp = np.array([p.from_theta(t) if p.log else 1.0 for p, t in zip(params, theta)])
     Jp = J / dp[None, :]
@@ -153,7 +192,14 @@ def _covariance(params, theta, r, J):
     Js = Jp / scale
     sv = np.linalg.svd(Js, compute_uv=False)
     condition = float(sv[0] / sv[-1]) if sv[-1] > 0 else float("inf")
-    cov = s2 * np.linalg.pinv(Js.T @ Js) / np.outer(scale, scale)
+    bread = np.linalg.pinv(Js.T @ Js)
+    method = "independent residuals"
+    rho = _ar1(r, blocks) if blocks and max(blocks) > 2 else 0.0
+    if rho > 0:
+        bread = bread @ (Js.T @ _ar1_times(Js, rho, blocks)) @ bread
+        method = (f"AR(1) sandwich: residual lag-1 correlation {rho:.3f} within each run and "
+                  f"channel, about {m * (1 - rho) / (1 + rho):.0f} independent samples of {m}")
+    cov = s2 * bread / np.outer(scale, scale)
     std = np.sqrt(np.clip(np.diag(cov), 0.0, None))
     unseen = np.linalg.norm(Jp, axis=0) == 0
     std[unseen] = np.nan
@@ -176,7 +222,7 @@ def _covariance(params, theta, r, J):
     if m <= n:
         messages.append(f"{m} residuals for {n} parameters: no degrees of freedom left for "
                         f"the residual variance")
-    return std, corr, condition, messages
+    return std, corr, condition, messages, method
 
 
 def _bar(progress: bool, method: str):

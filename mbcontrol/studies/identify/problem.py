@@ -152,6 +152,7 @@ class Identification:
             self.groups.setdefault(key, []).append(i)
         self.duration = self.settle + max(r.window[1] - r.window[0] for r in self.runs)
         self.simulations = 0
+        self.time_blocks = None         # set by residuals(): see there
         self._plants, self._sensitivity = {}, {}
         self._measured = [self._measure(run) for run in self.runs]
         self.scales = self._channel_scales()
@@ -295,9 +296,10 @@ class Identification:
         values = self.values(theta)
         sims = self.simulate(values, jacobian)
         dp = np.array([p.from_theta(t) if p.log else 1.0 for p, t in zip(self.fit, theta)])
-        rows, jrows = [], []
+        rows, jrows, blocks = [], [], []
         for run, meas, sim in zip(self.runs, self._measured, sims):
             for channel, (t, y, dy) in sim.items():
+                blocks.append(len(rows))
                 m, w = meas[channel], self.weights[channel]
                 start, end, _ = whole_periods(run.time, run.omega, *run.window)
                 if self.cost == "harmonic":
@@ -331,6 +333,10 @@ class Identification:
                         jrows.extend(np.column_stack([np.interp(m["t"], t, dy[:, j])
                                                       for j in range(len(self.fit))]) / scale)
         r = np.array(rows, float)
+        # consecutive residuals of one run and channel in time (peaks, timeseries): their
+        # errors may be correlated, which fit.uncertainty allows for; harmonic ones stand alone
+        self.time_blocks = (list(np.diff(blocks + [r.size])) if self.cost != "harmonic"
+                            else [1] * r.size)
         if not jacobian:
             return r
         J = np.array(jrows, float).reshape(r.size, len(self.fit)) * dp[None, :]

@@ -132,6 +132,7 @@ def summary(model: str, problem, result, fit_rows, validation_rows=None) -> dict
     return jsonable({
         "model": model, "valid": verdict["valid"], "invalid_reasons": verdict["invalid_reasons"],
         "method": result.method, "cost": problem.cost,
+        "uncertainty_method": result.uncertainty_method,
         "parameters": params, "correlation": np.asarray(result.correlation).tolist(),
         "fit": errors_block(fit_rows),
         "validation": errors_block(validation_rows) if validation_rows else None,
@@ -150,6 +151,7 @@ def parameter_table(problem, result) -> str:
         sigma = f"{'at ' + side:>10s}" if side else f"{s:10.3g}"
         lines.append(f"{p.name:36s} {p.initial:11.4g} {v:11.4g} {sigma}  "
                      f"[{p.lo:.3g}, {p.hi:.3g}]{' log' if p.log else ''}")
+    lines.append(f"sigma: {result.uncertainty_method}")
     lines.append(f"cost (1/2 |r|^2, {problem.cost}): {result.cost_initial:.4g} -> {result.cost:.4g}"
                  f"; {result.simulations} simulations, {result.wall_time_s:.1f} s")
     return "\n".join(lines)

@@ -187,3 +187,49 @@ def test_repeatability_is_the_spread_of_repeated_runs():
     floor = repeatability(rows)
     assert floor == {"Heave": {"sets": 1, "runs": 2, "rms_relative_spread": pytest.approx(1 / 21),
                                "max_relative_spread": pytest.approx(1 / 21)}}
+
+
+def _runs_with_ar1_noise(records, seed, tau=0.1):
+    """Runs with AR(1) measurement noise: 1 % of each record's standard deviation, correlation
+    time tau wave periods (lag-1 correlation 0.78 at the timeseries cost's T/40 samples)."""
+    from scipy.signal import lfilter
+    rng = np.random.default_rng(seed)
+    runs = []
+    for T, phase, t, y in records:
+        rho, sigma = math.exp(-(T / 200) / (tau * T)), NOISE * np.std(y[t > 14 * T])
+        noise = lfilter([1.0], [1.0, -rho], sigma * math.sqrt(1 - rho ** 2)
+                        * rng.standard_normal(y.size))
+        runs.append(Run(name=f"T{T:g}", omega=2 * math.pi / T, amplitude=1.0, phase=phase,
+                        window=(14 * T, 20 * T), time=t, channels={"Heave": y + noise}))
+    return runs
+
+
+def test_intervals_hold_under_time_correlated_noise(clean_records):
+    """Timeseries cost, AR(1) noise, 50 seeds: the stated 95 % intervals (the AR(1) sandwich)
+    hold the truth in about 95 % of seeds (measured: 47 and 48 of 50; over 200 seeds 94.5 % and
+    96 %, z-scores' std 1.03 and 0.97); the independent-residual sigma, 2.8x narrower, holds it
+    in 30 and 34 of 50. dt = 0.05 s: at the other tests' 0.1 s the fit's own
+    discretisation biases the estimates by 0.4 sigma."""
+    from mbcontrol.studies.identify.fit import _covariance
+    truth = np.array(list(TRUTH.values()))
+    z, z_naive = [], []
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for seed in range(50):
+            prob = Identification("sphere", _runs_with_ar1_noise(clean_records, seed),
+                                  [FitParameter("pto__damping", 2.0e5, 5e4, 1e6),
+                                   FitParameter("sphere__Heave__added_mass_scale", 1.0, 0.5, 2.0)],
+                                  outputs={"Heave": "heave"}, cost="timeseries", dt=0.05,
+                                  settle=80.0, direction=0.0)
+            result = fit(prob)
+            estimate = np.array([result.values[n] for n in TRUTH])
+            sigma = np.array([result.std[n] for n in TRUTH])
+            assert result.uncertainty_method.startswith("AR(1) sandwich")
+            theta = np.array([p.to_theta(result.values[p.name]) for p in prob.fit])
+            r, J = prob.residuals(theta, jacobian=True)
+            naive = _covariance(prob.fit, theta, r, J, None)[0]
+            z.append((estimate - truth) / sigma)
+            z_naive.append((estimate - truth) / naive)
+    z, z_naive = np.abs(np.array(z)), np.abs(np.array(z_naive))
+    assert np.all((z < 1.96).sum(axis=0) >= 45), (z < 1.96).sum(axis=0)
+    assert np.all((z_naive < 1.96).sum(axis=0) <= 40), (z_naive < 1.96).sum(axis=0)
