@@ -19,18 +19,26 @@ channel of the wrong kind, a record cut before its steady window closes or a win
 than 3 whole periods is refused naming the file (--drop-bad: skipped and listed).
 
 --fit NAME[=LO:HI] names a plant parameter (PTO, friction, springs, drag) or a hydrodynamic
-correction <body>__<Dof>__{added_mass,radiation,excitation}_scale; without bounds they come
+correction <body>__<Dof>__{added_mass,radiation,excitation}_scale (dimensionless: A(inf);
+the radiation kernel B(w) + jw(A(w) - A(inf)); the excitation force); without bounds they come
 from the scene's [identify] table, which is also the default set. Positive bounds fit the
 logarithm. Costs: harmonic (relative error of first-harmonic amplitudes, dimensionless;
 --phase adds the phase error, rad), peaks (the seed's Eq. 67 on peaks and lows, per channel
 scale), timeseries (output error over the window). Prints the parameter table with standard
 errors (Gauss-Newton Hessian scaled by the residual variance), the amplitude errors per channel
-before and after, and --validate runs predicted with the fitted values.
+before and after (beside the spread of repeated runs, the data's floor), and --validate runs
+predicted with the fitted values, each with a 95 % prediction interval (parameter covariance
+and repeatability; "predictions" in --json); runs outside the fitted runs' frequencies or
+above the radiation fit are warned about and crossed on the figures.
 
 Example:
   mbcontrol identify flume_section --data ../shared/data/tank/scenario_c/5*.csv.xz \\
       --validate ../shared/data/tank/scenario_c/6*.csv.xz --out out/identify
 """
+
+
+PREDICTION_KEYS = ("run", "channel", "omega", "unit", "measured", "model", "sigma",
+                   "interval_95", "extrapolated")
 
 
 def add_parser(sub) -> None:
@@ -66,6 +74,7 @@ def add_parser(sub) -> None:
 def run_identify(args) -> int:
     from ..studies.identify import ExtrapolationWarning, fit
     from ..studies.identify import report as rep
+    from ..studies.identify.intervals import coverage, prediction_intervals
     from ..studies.identify.flume import load_runs
     from ..studies.identify.setup import flume_identification, prediction
     from .commands import _key_value
@@ -93,8 +102,13 @@ def run_identify(args) -> int:
         # fixed at the fitted values (those its plants have: a DOF may be blocked there)
         v_before = rep.amplitude_rows(vproblem, {})
         v_after = rep.amplitude_rows(vproblem, result.values)
+    if validation:      # parameter uncertainty and the fitted runs' repeatability
+        v_after = prediction_intervals(vproblem, result, v_after, rep.repeatability(after))
     summary = rep.summary(problem.scene_name, problem, result, after, v_after)
     summary["warnings"] = said + summary["warnings"]
+    if validation:
+        summary["predictions"] = [{k: r[k] for k in PREDICTION_KEYS} for r in v_after]
+        summary["prediction_coverage"] = coverage(v_after)
     summary["fit_before"] = rep.errors_block(before)
     summary["validation_before"] = rep.errors_block(v_before) if v_before else None
     if args.out:
@@ -110,6 +124,9 @@ def run_identify(args) -> int:
     if validation:
         print(rep.error_table(v_before, "validation, scene values"))
         print(rep.error_table(v_after, "validation, identified"))
+        c = summary["prediction_coverage"]
+        print(f"validation: {c['inside']} of {c['rows']} measured amplitudes inside their 95 % "
+              f"prediction intervals (parameter sigma and the runs' repeatability)")
     if args.out:
         print(f"wrote {args.out}/summary.json, parameters.txt, amplitudes.png, time_series.png")
     return 0

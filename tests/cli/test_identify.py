@@ -59,6 +59,13 @@ def test_identify_json_contract(capsys, tmp_path):
     # 6101_2 (7.0 rad/s) and 6111_1 (7.83) lie above the radiation fit (6.67 rad/s): said
     assert any("fit runs 6101_2 (7) rad/s: above the radiation fit" in w for w in s["warnings"])
     assert any("validation runs 6111_1 (7.83) rad/s" in w for w in s["warnings"])
+    # every predicted amplitude with its 95 % interval (parameter sigma, repeatability)
+    assert [(p["run"], p["channel"]) for p in s["predictions"]] == [("6111_1", "Heave"),
+                                                                    ("6111_1", "Roll")]
+    for p in s["predictions"]:
+        lo, hi = p["interval_95"]
+        assert 0 <= lo < p["model"] < hi and p["sigma"] > 0 and p["extrapolated"]
+    assert s["prediction_coverage"]["rows"] == 2
     assert s["simulations"] > 0 and s["wall_time_s"] > 0
     assert s["cost_final"] <= s["cost_initial"]
     assert json.loads((tmp_path / "summary.json").read_text()) == s

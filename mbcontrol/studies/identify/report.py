@@ -204,6 +204,14 @@ def plot_amplitudes(rows_by_label: dict, path=None, title: str | None = None):
                 if pts:
                     ax.plot(*zip(*pts), "-" + marker, color=f"C{k}", ms=3, lw=1,
                             label=f"{label}, {group}")
+            bars = [r for r in rows if r["channel"] == channel and "interval_95" in r]
+            if bars:
+                centre = np.array([r["model"] / r["incident"] for r in bars])
+                lo, hi = (np.array([r["interval_95"][i] / r["incident"] for r in bars])
+                          for i in (0, 1))
+                ax.errorbar([r["omega"] for r in bars], centre, yerr=[centre - lo, hi - centre],
+                            fmt="none", ecolor=f"C{k}", capsize=3, lw=0.8,
+                            label=f"{label}: 95 % prediction interval")
         ax.set_xlabel("wave frequency, rad/s")
         ax.set_ylabel(f"{channel} amplitude / wave amplitude, {unit}/m")
         ax.set_title(channel)

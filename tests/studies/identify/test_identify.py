@@ -233,3 +233,37 @@ def test_intervals_hold_under_time_correlated_noise(clean_records):
     z, z_naive = np.abs(np.array(z)), np.abs(np.array(z_naive))
     assert np.all((z < 1.96).sum(axis=0) >= 45), (z < 1.96).sum(axis=0)
     assert np.all((z_naive < 1.96).sum(axis=0) <= 40), (z_naive < 1.96).sum(axis=0)
+
+
+def test_prediction_intervals_match_the_scatter_of_predictions(clean_records):
+    """The parameter part of a prediction interval against its meaning: over 16 noise seeds,
+    the scatter of each predicted amplitude (the 14 s and 16 s runs, outside the 5.5-12 s fit)
+    and the mean predicted sigma agree within the sampling error of 16 draws (+-55 %); the
+    repeatability part is the floor times the amplitude; a perfect floor-free prediction of the
+    truth lies inside its interval."""
+    from mbcontrol.studies.identify.intervals import coverage, prediction_intervals
+    from mbcontrol.studies.identify.report import amplitude_rows
+    from mbcontrol.studies.identify.setup import prediction
+    predicted_runs = runs_with_noise(clean_records, 0)[8:]
+    amplitudes, sigmas = [], []
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for seed in range(100, 116):
+            prob = problem(runs_with_noise(clean_records, seed)[:8])
+            result = fit(prob)
+            target = prediction(prob, predicted_runs)
+            rows = prediction_intervals(target, result, amplitude_rows(target, result.values), {})
+            amplitudes.append([r["model"] for r in rows])
+            sigmas.append([r["sigma_parameters"] for r in rows])
+            assert all(r["sigma"] == r["sigma_parameters"] for r in rows)
+        floor = {"Heave": {"rms_relative_spread": 0.02}}
+        with_floor = prediction_intervals(target, result, amplitude_rows(target, result.values),
+                                          floor)
+        truth_rows = amplitude_rows(target, TRUTH)
+    ratio = np.std(amplitudes, axis=0, ddof=1) / np.mean(sigmas, axis=0)
+    assert np.all((ratio > 0.45) & (ratio < 1.55)), ratio
+    for r in with_floor:
+        assert r["sigma_repeatability"] == pytest.approx(0.02 * r["model"])
+        assert r["sigma"] == pytest.approx(np.hypot(r["sigma_parameters"], 0.02 * r["model"]))
+    exact = [{**r, "measured": t["model"]} for r, t in zip(with_floor, truth_rows)]
+    assert coverage(exact) == {"inside": 2, "rows": 2, "share": 1.0}
