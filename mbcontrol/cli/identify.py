@@ -31,6 +31,11 @@ predicted with the fitted values, each with a 95 % prediction interval (paramete
 and repeatability; "predictions" in --json); runs outside the fitted runs' frequencies or
 above the radiation fit are warned about and crossed on the figures.
 
+--cross-validate replaces the fit by leave-one-series-out cross-validation of candidate
+structures (--candidate NAME=SPEC,SPEC...): each series predicted by a fit on the others, the
+held-out RMS relative amplitude error per channel and pooled, the best (fewest parameters
+within 1 %) marked.
+
 Example:
   mbcontrol identify flume_section --data ../shared/data/tank/scenario_c/5*.csv.xz \\
       --validate ../shared/data/tank/scenario_c/6*.csv.xz --out out/identify
@@ -68,7 +73,36 @@ def add_parser(sub) -> None:
                    help="skip unusable runs with a warning instead of stopping")
     p.add_argument("--out", metavar="DIR", help="write summary.json, tables and figures here")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
+    p.add_argument("--cross-validate", action="store_true",
+                   help="instead of one fit: leave each series out in turn, fit on the others,\n"
+                        "predict it; per candidate structure (--candidate; default the --fit\n"
+                        "set or the scene's [identify] table), the held-out errors and the best")
+    p.add_argument("--candidate", action="append", default=[], metavar="NAME=SPEC[,SPEC...]",
+                   help="a candidate structure for --cross-validate: the parameters to fit,\n"
+                        "--fit specs joined by commas (repeatable), e.g.\n"
+                        "'coulomb=viscous__Roll_linear,sway_rig__coulomb=0.05:2'")
     p.set_defaults(run=run_identify)
+
+
+def _candidates(args) -> dict:
+    """name -> fit specs from --candidate (default: the --fit set, or the scene's table)."""
+    out = {}
+    for text in args.candidate:
+        name, _, specs = text.partition("=")
+        if not name or not specs:
+            raise ValueError(f"--candidate {text}: expected NAME=SPEC[,SPEC...]")
+        out[name] = [s for s in specs.split(",") if s]
+    return out or {"given" if args.fit else "scene [identify]": list(args.fit)}
+
+
+def _cross_validate(args, runs, common) -> int:
+    from ..studies.identify.crossval import cross_validate, table
+    cv = cross_validate(args.model, runs, _candidates(args), progress=not args.json, **common)
+    if args.json:
+        print(json.dumps({"model": args.model, "cross_validation": cv}, indent=2))
+    else:
+        print(table(cv))
+    return 0
 
 
 def run_identify(args) -> int:
@@ -87,10 +121,13 @@ def run_identify(args) -> int:
         runs = load_runs(args.data, args.calibration, drop_bad=args.drop_bad)
         validation = load_runs(args.validate, args.calibration, drop_bad=args.drop_bad) \
             if args.validate else []
-        problem = flume_identification(args.model, None, runs=runs, fit=args.fit, **common)
-        vproblem = prediction(problem, validation) if validation else None
+        if not args.cross_validate:
+            problem = flume_identification(args.model, None, runs=runs, fit=args.fit, **common)
+            vproblem = prediction(problem, validation) if validation else None
     for w in caught:
         print(f"mbcontrol: warning: {w.message}", file=sys.stderr)
+    if args.cross_validate:
+        return _cross_validate(args, runs + validation, common)
     said = [str(w.message) for w in caught if issubclass(w.category, ExtrapolationWarning)]
     before = rep.amplitude_rows(problem, {})      # the scene's own values: the model as built
     with warnings.catch_warnings(record=True) as caught:
