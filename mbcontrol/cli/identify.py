@@ -138,9 +138,9 @@ def run_identify(args) -> int:
     if validation:
         # fixed at the fitted values (those its plants have: a DOF may be blocked there)
         v_before = rep.amplitude_rows(vproblem, {})
-        v_after = rep.amplitude_rows(vproblem, result.values)
-    if validation:      # parameter uncertainty and the fitted runs' repeatability
-        v_after = prediction_intervals(vproblem, result, v_after, rep.repeatability(after))
+        # each with its interval: parameter uncertainty and the fitted runs' repeatability
+        v_after = prediction_intervals(vproblem, result, rep.amplitude_rows(vproblem, result.values),
+                                       rep.repeatability(after))
     summary = rep.summary(problem.scene_name, problem, result, after, v_after)
     summary["warnings"] = said + summary["warnings"]
     if validation:
