@@ -178,3 +178,45 @@ def test_the_toolboxs_warnings_read_as_sentences():
         "mbcontrol: warning: it diverges\n"
     theirs = os.path.join(os.sep, "x", "numpy", "lib.py")
     assert "RuntimeWarning" in _format_warning("overflow", RuntimeWarning, theirs, 1)
+
+
+def test_version_and_python_m(capsys):
+    import subprocess
+    import sys
+    with pytest.raises(SystemExit) as done:
+        main(["--version"])
+    assert done.value.code == 0 and capsys.readouterr().out.startswith("mbcontrol 0.")
+    out = subprocess.run([sys.executable, "-m", "mbcontrol", "models"], capture_output=True,
+                         text=True, check=True).stdout
+    assert "sphere" in out and "rm3" in out
+
+
+def test_models_name_describes_parameters_units_and_controllers(capsys):
+    """`models NAME` lists what can be set: plant parameters with defaults and units (checked
+    against the scene's own values), and every registered controller with its settings."""
+    import inspect
+
+    from mbcontrol.controllers import REGISTRY
+    assert main(["models", "flume_section", "--json"]) == 0
+    info = json.loads(capsys.readouterr().out)
+    p = info["parameters"]
+    assert p["sway_rig__viscous"] == {"default": 8.7, "unit": "N s/m"}
+    assert p["roll_rig__viscous"]["unit"] == "N m s/rad"
+    assert p["viscous__Roll"]["unit"] == "N m s^2/rad^2"
+    assert p["sway_springs__stiffness_y"] == {"default": 60.0, "unit": "N/m"}
+    assert all(v["unit"] for v in p.values()), p
+    assert set(info["controllers"]) == set(REGISTRY)
+    assert list(info["controllers"]["reactive"]) == list(inspect.signature(REGISTRY["reactive"]).parameters)
+    assert info["scene_parameters"] == {"sway_extra_mass": 0.0, "axle_mass": 0.05}
+    assert main(["models", "sphere"]) == 0
+    text = capsys.readouterr().out
+    assert "pto__damping" in text and "N s/m" in text and "force_max 2000000.0" in text
+
+
+@pytest.mark.parametrize("command", ["simulate", "design"])
+def test_help_names_every_registered_controller(capsys, command):
+    from mbcontrol.controllers import REGISTRY
+    with pytest.raises(SystemExit):
+        main([command, "--help"])
+    text = capsys.readouterr().out
+    assert all(name in text for name in REGISTRY), text

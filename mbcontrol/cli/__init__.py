@@ -2,6 +2,7 @@
 
 Examples:
   mbcontrol models
+  mbcontrol models sphere
   mbcontrol hydro hinged_barge
   mbcontrol simulate hinged_barge --wave regular --height 0.02 --period 1.0 --duration 30 --json
   mbcontrol simulate hinged_barge --wave jonswap --hs 0.03 --tp 1.0 --seed 3 --out run.nc
@@ -89,6 +90,14 @@ def _format_warning(message, category, filename, lineno, line=None) -> str:
 _python_format = warnings.formatwarning
 
 
+def _version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+    try:
+        return version("mbcontrol")
+    except PackageNotFoundError:        # run from a source tree that was never installed
+        return "unknown (not installed)"
+
+
 def main(argv=None) -> int:
     previous, warnings.formatwarning = warnings.formatwarning, _format_warning
     try:
@@ -112,11 +121,17 @@ def _main(argv) -> int:
 
 
 def _parser() -> argparse.ArgumentParser:
+    from mbcontrol.controllers import REGISTRY
+    controllers = ", ".join(REGISTRY)
     parser = argparse.ArgumentParser(
         prog="mbcontrol", description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
+    parser.add_argument("--version", action="version", version=f"mbcontrol {_version()}")
     sub = parser.add_subparsers(title="commands", metavar="COMMAND")
 
-    p = sub.add_parser("models", help="list the catalogue of models")
+    p = sub.add_parser("models", help="list the catalogue, or describe one model: its bodies, "
+                                      "joints, PTOs, parameters and the controllers' settings")
+    p.add_argument("name", nargs="?", help="a model (catalogue name or scene .toml) to describe")
+    p.add_argument("--json", action="store_true", help="print the description as JSON")
     p.set_defaults(run=run_models)
 
     p = sub.add_parser("hydro", help="load or compute a model's BEM data and fit its radiation "
@@ -138,7 +153,8 @@ def _parser() -> argparse.ArgumentParser:
                    help="\n".join(f"{m.name}: {m.description}" for m in METHODS.values()))
     p.add_argument("--rtol", type=float, default=1e-8,
                    help="relative tolerance of the adaptive methods (cvodes, adams)")
-    p.add_argument("--controller", help="PTO controller by name (e.g. passive)")
+    p.add_argument("--controller", metavar="NAME",
+                   help=f"PTO controller: {controllers}\n(settings: mbcontrol models MODEL)")
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                    help="controller setting, repeatable (e.g. --set damping=2.0)")
     p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
@@ -159,7 +175,7 @@ def _parser() -> argparse.ArgumentParser:
     _model_options(p)
     _wave_options(p)
     p.add_argument("--controller", required=True, metavar="NAME",
-                   help="passive, reactive, latching, declutching or mpc")
+                   help=f"{controllers}\n(settings: mbcontrol models MODEL)")
     p.add_argument("--pto", help="the PTO to tune and score (default: the first)")
     p.add_argument("--duration", type=float, default=None,
                    help="closed-loop simulation, s (default: 30 periods, longer if the linear\n"

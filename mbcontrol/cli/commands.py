@@ -27,6 +27,9 @@ def _plant(args, **kwargs):
 
 def run_models(args) -> int:
     from ..scene import list_models, load_scene
+    if getattr(args, "name", None):
+        from .describe import run_describe
+        return run_describe(args)
     for name in list_models():
         print(f"{name:16s} {load_scene(name).description}")
     return 0

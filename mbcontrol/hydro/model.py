@@ -150,11 +150,28 @@ def load_hydro_data(scene: Scene, dofs) -> tuple[str, xr.Dataset]:
     # BEM run when the file is absent, e.g. for a parameter value nobody precomputed
     if scene.hydro.file and (Path(scene.hydro.file).exists() or not scene.hydro.omega):
         source = scene.hydro.file
+        if not Path(source).exists():
+            raise HydroError(_missing_file(scene))
         data = read_netcdf(source)
     else:
         source, data = _run_bem(scene, dofs)
     _check_dofs(data, dofs, source)
     return source, data
+
+
+def _missing_file(scene: Scene) -> str:
+    """Why a scene's [hydro] file is not there, and what to do (a copied catalogue scene
+    still names the catalogue's data file, read beside the copy)."""
+    from ..scene import catalogue_dir
+    path = Path(scene.hydro.file)
+    text = (f"{scene.path}: [hydro] file {path.name!r} (read as {path}, relative to the scene's "
+            f"folder): no such file. ")
+    shipped = catalogue_dir() / path.name
+    if shipped.exists() and shipped != path:
+        text += (f"The catalogue has one of that name, for its own geometry: copy it beside "
+                 f"your scene (cp {shipped} {path.parent}/) or set file = \"{shipped}\"; ")
+    return text + ("or remove `file` and give [hydro] omega (rad/s) to compute the data with "
+                   "Capytaine from the bodies' geometry")
 
 
 def fit_hydro_model(data: xr.Dataset, dofs, tol: float | None, source: str,

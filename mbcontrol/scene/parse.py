@@ -10,6 +10,7 @@ from .checks import Reader, catenary_geometry, check_topology
 from .model import (DOF_NAMES, JOINT_TYPES, Body, Drag, EndStop, Friction, Geometry, HydroSettings,
                     Joint, Mooring, Obstacle, Pto, Scene, Water)
 from .template import expand
+from .units import JOINT_DIMENSIONS
 
 
 def parse_scene(data: dict, path: Path, parameters: dict | None = None) -> Scene:
@@ -24,6 +25,7 @@ def parse_scene(data: dict, path: Path, parameters: dict | None = None) -> Scene
     water = _water(top.table("water", required=False))
     bodies = tuple(_body(r, path) for r in top.tables("body", required=True))
     joints = tuple(_joint(r) for r in top.tables("joint", required=True))
+    kinds = {j.name: j.type for j in joints}
     hydro = _hydro(top.table("hydro", required=False), path)
     obstacles = _obstacles(top, path, bodies, hydro)
     scene = Scene(
@@ -31,11 +33,11 @@ def parse_scene(data: dict, path: Path, parameters: dict | None = None) -> Scene
         path=str(path),
         description=top.string("description", default=""),
         water=water, bodies=bodies, joints=joints,
-        ptos=tuple(_pto(r) for r in top.tables("pto")),
+        ptos=tuple(_pto(r, kinds) for r in top.tables("pto")),
         frictions=tuple(_friction(r) for r in top.tables("friction")),
         moorings=tuple(_mooring(r) for r in top.tables("mooring")),
         drags=tuple(_drag(r) for r in top.tables("drag")),
-        end_stops=tuple(_end_stop(r) for r in top.tables("end_stop")),
+        end_stops=tuple(_end_stop(r, kinds) for r in top.tables("end_stop")),
         hydro=hydro,
         parameters=used,
         identify=_identify(top.table("identify", required=False)),
@@ -118,10 +120,13 @@ def _joint(r: Reader) -> Joint:
                  point=r.vector("point", "length", default=None), axis=axis, dofs=dofs)
 
 
-def _pto(r: Reader) -> Pto:
+def _pto(r: Reader, kinds: dict) -> Pto:
     r.allow("name", "joint", "damping", "stiffness", "force_max", "stroke_max", "efficiency",
             "body", "point", "parent", "parent_point", "preload")
     joint = r.string("joint", default=None)
+    # limits in units of the joint's coordinate: "4 m" / "2 MN" (prismatic or between points),
+    # "30 deg" / "5 MN m" (revolute); an unknown joint is named by the scene checks later
+    stroke_dim, force_dim = JOINT_DIMENSIONS.get(kinds.get(joint, "prismatic"), (None, None))
     points = {k: k in r.data for k in ("body", "point", "parent_point")}
     if joint is not None and any(points.values()):
         r.fail("joint", "expected either a joint or body/point/parent_point, not both")
@@ -135,8 +140,8 @@ def _pto(r: Reader) -> Pto:
     return Pto(name=r.name(), joint=joint,
                damping=r.nonnegative("damping", default=0.0),
                stiffness=r.finite("stiffness", default=0.0),
-               force_max=r.positive("force_max", None, default=math.inf, finite=False),
-               stroke_max=r.positive("stroke_max", None, default=math.inf, finite=False),
+               force_max=r.positive("force_max", force_dim, default=math.inf, finite=False),
+               stroke_max=r.positive("stroke_max", stroke_dim, default=math.inf, finite=False),
                efficiency=efficiency,
                body=r.string("body", default=None),
                point=r.vector("point", "length", default=None),
@@ -183,11 +188,12 @@ def _catenary(r: Reader) -> Mooring:
     return m
 
 
-def _end_stop(r: Reader) -> EndStop:
+def _end_stop(r: Reader, kinds: dict) -> EndStop:
     r.allow("name", "joint", "lower", "upper", "stiffness", "damping")
     joint = r.string("joint")
-    lower = r.number("lower", "coordinate", default=-math.inf)
-    upper = r.number("upper", "coordinate", default=math.inf)
+    coordinate = JOINT_DIMENSIONS.get(kinds.get(joint), ("coordinate",))[0]
+    lower = r.number("lower", coordinate, default=-math.inf)
+    upper = r.number("upper", coordinate, default=math.inf)
     if not lower < upper:
         r.fail("upper", f"expected upper > lower, got lower = {lower}, upper = {upper}")
     if not lower < 0 < upper:

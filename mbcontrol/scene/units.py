@@ -18,13 +18,19 @@ UNITS: dict[str, dict[str, float]] = {
     "density": {"kg/m^3": 1.0, "kg/m3": 1.0},
     "acceleration": {"m/s^2": 1.0, "m/s2": 1.0},
     "inertia": {"kg*m^2": 1.0, "kg m^2": 1.0, "kg*m2": 1.0},
+    "force": {"N": 1.0, "kN": 1e3, "MN": 1e6},
+    "moment": {"N m": 1.0, "N*m": 1.0, "Nm": 1.0, "kN m": 1e3, "kN*m": 1e3, "kNm": 1e3,
+               "MN m": 1e6, "MN*m": 1e6, "MNm": 1e6},
 }
-# a joint coordinate: a length (prismatic) or an angle (revolute)
+# a joint coordinate: a length (prismatic) or an angle (revolute), where the joint is not known
 UNITS["coordinate"] = {**UNITS["length"], **UNITS["angle"]}
+# a joint's generalised coordinate and force, by joint type (PTO limits, end stops)
+JOINT_DIMENSIONS = {"prismatic": ("length", "force"), "revolute": ("angle", "moment")}
 
 SI_UNIT = {
     "length": "m", "mass": "kg", "angle": "rad", "time": "s", "frequency": "rad/s",
     "density": "kg/m^3", "acceleration": "m/s^2", "inertia": "kg*m^2", "coordinate": "m or rad",
+    "force": "N", "moment": "N m",
 }
 
 _QUANTITY = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(\S.*?)?\s*$")

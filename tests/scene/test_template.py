@@ -107,7 +107,9 @@ def test_end_stop_parsed_with_units():
     ("0.1", "0.2", r"end_stop\[0\]\.lower: the rest position .* must lie strictly between"),
     ("-0.2", "-0.1", r"end_stop\[0\]\.upper: the rest position"),
     ("0.2", "-0.1", r"end_stop\[0\]\.upper: expected upper > lower"),
-    ("-0.1", "'3 kg'", r"end_stop\[0\]\.upper: expected a coordinate"),
+    ("-0.1", "'3 kg'", r"end_stop\[0\]\.upper: expected an angle"),
+    # hinge1 is revolute: a length is refused (it was read as radians before issue 22)
+    ("-0.1", "'20 mm'", r"end_stop\[0\]\.upper: expected an angle in one of \['deg', 'rad'\], got '20 mm'"),
 ])
 def test_end_stop_narrower_than_rest_is_an_error(lower, upper, message):
     text = STOP.replace('"{LOWER}"', lower).replace('"{UPPER}"', upper.replace("'", '"'))

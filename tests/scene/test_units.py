@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import pytest
 
@@ -51,3 +52,47 @@ def test_to_si_plain_numbers():
 def test_to_si_errors(value, dimension, message):
     with pytest.raises(UnitError, match=message):
         to_si(value, dimension)
+
+
+def _copy(tmp_path, model: str, *edits) -> Path:
+    """A catalogue scene copied elsewhere, its hydro file pointed back at the catalogue's."""
+    from mbcontrol.scene import catalogue_dir
+    text = (catalogue_dir() / f"{model}.toml").read_text()
+    text = text.replace(f'file = "{model}_hydro.nc"', f'file = "{catalogue_dir()}/{model}_hydro.nc"')
+    for old, new in edits:
+        assert old in text, old
+        text = text.replace(old, new)
+    path = tmp_path / f"my_{model}.toml"
+    path.write_text(text)
+    return path
+
+
+def test_pto_limits_take_units_of_their_joint(tmp_path):
+    """A prismatic PTO's limits in "MN" and "mm", a revolute one's in "N m" and "deg": the same
+    SI values as the catalogue's plain numbers; a moment on a prismatic joint is refused,
+    naming the file, the field and what was expected."""
+    from mbcontrol.errors import SceneError
+    from mbcontrol.scene import load_scene
+    sphere = load_scene(str(_copy(tmp_path, "sphere", ("force_max = 2.0e6", 'force_max = "2 MN"'),
+                                  ("stroke_max = 4.0", 'stroke_max = "4000 mm"'))))
+    assert (sphere.ptos[0].force_max, sphere.ptos[0].stroke_max) == (2.0e6, 4.0)
+    barge = load_scene(str(_copy(tmp_path, "hinged_barge", ("force_max = 5.0", 'force_max = "5 N m"'))))
+    assert barge.ptos[0].force_max == 5.0
+    bad = _copy(tmp_path, "sphere", ("force_max = 2.0e6", 'force_max = "2 MN m"'))
+    with pytest.raises(SceneError, match=r"my_sphere.toml.*force_max: expected a force in one "
+                                         r"of \['MN', 'N', 'kN'\], got '2 MN m'"):
+        load_scene(str(bad))
+
+
+def test_a_copied_scene_names_its_missing_hydro_file_and_the_remedy(tmp_path):
+    from mbcontrol.errors import HydroError
+    from mbcontrol.plant import build_plant
+    from mbcontrol.scene import catalogue_dir
+    path = tmp_path / "my_sphere.toml"
+    path.write_text((catalogue_dir() / "sphere.toml").read_text())
+    with pytest.raises(HydroError) as err:
+        build_plant(str(path))
+    text = str(err.value)
+    assert text.startswith(f"{path}: [hydro] file 'sphere_hydro.nc'")
+    assert f"cp {catalogue_dir() / 'sphere_hydro.nc'} {tmp_path}/" in text
+    assert "[hydro] omega" in text

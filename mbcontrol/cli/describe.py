@@ -1,0 +1,131 @@
+"""`mbcontrol models NAME`: what a model is made of and what can be set, without provoking errors.
+
+Lists the scene's bodies, joints, PTOs (with their limits), hydrodynamics, the plant
+parameters (`--param NAME=VALUE` in simulate, design, identify) with their defaults and
+units, the scene parameters, the [identify] table, and every controller with its settings
+(`--set KEY=VALUE`) and defaults, read from the controller registry itself.
+"""
+from __future__ import annotations
+
+import inspect
+import json
+import math
+
+_ROTATIONAL_DOFS = ("Roll", "Pitch", "Yaw")
+
+
+def parameter_unit(plant, name: str) -> str:
+    """SI unit of a plant parameter, from the element it belongs to ("-": dimensionless,
+    "": not known)."""
+    scene = plant.scene
+    head, _, tail = name.rpartition("__")
+    if tail.endswith("_scale"):
+        return "-"
+    coordinate = _coordinates(plant)
+    for pto in scene.ptos:
+        if head == pto.name:
+            c = "m" if pto.between_points else coordinate.get(pto.joint, "m")
+            return _per(tail, c)
+    for friction in scene.frictions:
+        if head == friction.name:
+            c = coordinate.get(friction.joint, "m")
+            force = "N m" if c == "rad" else "N"
+            return {"viscous": f"{force} s/{c}", "coulomb": force,
+                    "velocity_scale": f"{c}/s"}.get(tail, "")
+    for drag in scene.drags:
+        if head == drag.name:
+            dof = tail.removesuffix("_linear")
+            c, force = ("rad", "N m") if dof in _ROTATIONAL_DOFS else ("m", "N")
+            return f"{force} s/{c}" if tail.endswith("_linear") else f"{force} s^2/{c}^2"
+    for mooring in scene.moorings:
+        if head == mooring.name:
+            return {"stiffness": "N/m", "damping": "N s/m"}.get(tail.split("_")[0], "")
+    return ""
+
+
+def _per(kind: str, c: str) -> str:
+    force = "N m" if c == "rad" else "N"
+    return {"damping": f"{force} s/{c}", "stiffness": f"{force}/{c}"}.get(kind, "")
+
+
+def _coordinates(plant) -> dict:
+    return {j.name: ("rad" if j.type == "revolute" else "m") for j in plant.scene.joints}
+
+
+def controller_settings() -> dict:
+    """{name: {setting: default (None: required or the scene's)}} from the registry."""
+    from mbcontrol.controllers import REGISTRY
+    out = {}
+    for name, cls in REGISTRY.items():
+        out[name] = {k: (None if p.default is inspect.Parameter.empty else p.default)
+                     for k, p in inspect.signature(cls).parameters.items()}
+    return out
+
+
+def describe(model: str) -> dict:
+    """The JSON of `mbcontrol models NAME --json` (a stable contract): model, file,
+    description, bodies, joints, ptos, hydro, parameters {name: {default, unit}},
+    scene_parameters, identify, controllers {name: {setting: default}}."""
+    from ..plant import build_plant
+    from ..scene import load_scene
+    scene = load_scene(model)
+    plant = build_plant(scene)
+    limit = (lambda v: None if v is None or not math.isfinite(v) else v)
+    return {
+        "model": scene.name, "file": str(scene.path), "description": scene.description,
+        "bodies": [{"name": b.name, "mass_kg": b.mass, "hydro": bool(b.hydro)}
+                   for b in scene.bodies],
+        "joints": [{"name": j.name, "type": j.type, "parent": j.parent, "child": j.child}
+                   for j in scene.joints],
+        "ptos": [{"name": p.name, "joint": p.joint, "force_max": limit(p.force_max),
+                  "stroke_max": limit(p.stroke_max), "efficiency": p.efficiency}
+                 for p in scene.ptos],
+        "hydro": None if plant.hydro is None else {
+            "source": plant.hydro.source, "dofs": list(plant.hydro.dofs),
+            "radiation_states": int(plant.hydro.radiation.order),
+            "radiation_tol": scene.hydro.radiation_tol,
+            "response_band": scene.hydro.response_band},
+        "parameters": {n: {"default": float(v), "unit": parameter_unit(plant, n)}
+                       for n, v in zip(plant.parameters, plant.p0)},
+        "scene_parameters": dict(scene.parameters),
+        "identify": {k: list(v) for k, v in scene.identify.items()},
+        "controllers": controller_settings(),
+    }
+
+
+def run_describe(args) -> int:
+    info = describe(args.name)
+    if args.json:
+        print(json.dumps(info, indent=2, default=str))
+        return 0
+    print(f"{info['model']}: {info['description']}\n  file: {info['file']}")
+    print("  bodies: " + ", ".join(f"{b['name']} ({b['mass_kg']:.4g} kg"
+                                    f"{', hydro' if b['hydro'] else ''})" for b in info["bodies"]))
+    print("  joints: " + ", ".join(f"{j['name']} ({j['type']}, {j['parent']} -> {j['child']})"
+                                    for j in info["joints"]))
+    for p in info["ptos"]:
+        print(f"  PTO {p['name']} on {p['joint']}: force_max {p['force_max'] or 'none'}, "
+              f"stroke_max {p['stroke_max'] or 'none'}, efficiency {p['efficiency']:g}")
+    h = info["hydro"]
+    if h:
+        band = h["response_band"]
+        band = f", judged per frequency in {band[0]:g}-{band[1]:g} rad/s" if band else ""
+        print(f"  hydro: {h['source']}; DOFs {', '.join(h['dofs'])}; radiation "
+              f"{h['radiation_states']} states (tol {h['radiation_tol']:g}{band})")
+    print("  plant parameters (--param NAME=VALUE), default and unit:")
+    for name, p in info["parameters"].items():
+        print(f"    {name:40s} {p['default']:12.6g}  {p['unit']}")
+    if h:
+        print("    and for identification, per hydro DOF: <DOF>__added_mass_scale, "
+              "__radiation_scale, __excitation_scale (1, dimensionless)")
+    if info["scene_parameters"]:
+        print("  scene parameters ([parameters] in the scene file): " + ", ".join(
+            f"{k} = {v}" for k, v in info["scene_parameters"].items()))
+    if info["identify"]:
+        print("  identified by default ([identify]): " + ", ".join(info["identify"]))
+    print("  controllers (--controller NAME --set KEY=VALUE), settings and defaults:")
+    for name, settings in info["controllers"].items():
+        shown = ", ".join(f"{k}={'(the run wave)' if k == 'wave' else v}"
+                          for k, v in settings.items())
+        print(f"    {name:12s} {shown}")
+    return 0
