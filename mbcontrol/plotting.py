@@ -5,8 +5,6 @@ Axes carry units and the sign convention (NED: heave positive down).
 """
 from __future__ import annotations
 
-import os
-import tempfile
 from pathlib import Path
 
 import matplotlib
@@ -15,16 +13,14 @@ matplotlib.use("Agg")          # files, never a window: this runs in CI and on s
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from .atomic import atomic_path
+
 
 def save(fig, path) -> Path:
     """Write a figure to a temporary file, then rename it into place."""
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=path.suffix)
-    os.close(fd)
-    fig.savefig(tmp, dpi=120, bbox_inches="tight")
-    os.chmod(tmp, 0o644)                 # mkstemp makes 0600; figures are for everyone
-    os.replace(tmp, path)
+    with atomic_path(path, path.suffix) as tmp:
+        fig.savefig(tmp, dpi=120, bbox_inches="tight", format=path.suffix.lstrip(".") or None)
     return path
 
 

@@ -3,12 +3,12 @@ and `jsonable`, the one conversion of results to strict JSON."""
 from __future__ import annotations
 
 import math
-import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
 import xarray as xr
+
+from .atomic import atomic_path
 
 
 def jsonable(obj):
@@ -39,13 +39,6 @@ def save_dataset(ds: xr.Dataset, path) -> Path:
     for name in [v for v in out.data_vars if out[v].dtype.kind == "c"]:
         out[f"{name}__re"], out[f"{name}__im"] = out[name].real, out[name].imag
         out = out.drop_vars(name)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".nc.tmp")
-    os.close(fd)
-    try:
+    with atomic_path(path, ".nc") as tmp:
         out.to_netcdf(tmp)
-        os.chmod(tmp, 0o644)             # mkstemp makes 0600
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
     return path

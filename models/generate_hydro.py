@@ -112,10 +112,7 @@ SHIP_VARIANTS = {"flume_section": [("roll",), ("heave",), ("sway",)]}   # Fideli
 
 def ship_fits(names=None) -> int:
     """Build the plants, copy the fits they used into models/radiation_fits (atomically)."""
-    import os
-    import shutil
-    import tempfile
-
+    from mbcontrol.atomic import write_bytes
     from mbcontrol.cache import cache_dir
     from mbcontrol.hydro import model as hydro_model
     from mbcontrol.plant import Fidelity, build_plant
@@ -131,10 +128,7 @@ def ship_fits(names=None) -> int:
     for fit in sorted(wanted):
         if (out / fit).exists():
             continue
-        fd, tmp = tempfile.mkstemp(dir=out, suffix=".tmp")
-        os.close(fd)
-        shutil.copyfile(cache_dir() / fit, tmp)
-        os.replace(tmp, out / fit)
+        write_bytes(out / fit, (cache_dir() / fit).read_bytes())
     stale = [p for p in out.glob("radiation_*.npz") if p.name not in wanted and not names]
     for path in stale:
         path.unlink()

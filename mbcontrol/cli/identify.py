@@ -170,17 +170,11 @@ def run_identify(args) -> int:
 
 
 def _write(out: Path, problem, result, summary, before, after, v_before, v_after) -> None:
-    import os
-    import tempfile
-
+    from ..atomic import write_text
     from ..studies.identify import report as rep
-    out.mkdir(parents=True, exist_ok=True)
     for name, text in (("summary.json", json.dumps(summary, indent=2)),
                        ("parameters.txt", rep.parameter_table(problem, result) + "\n")):
-        fd, tmp = tempfile.mkstemp(dir=out, suffix=".tmp")
-        with os.fdopen(fd, "w") as fh:
-            fh.write(text)
-        os.replace(tmp, out / name)
+        write_text(out / name, text)
     rep.plot_amplitudes({"scene values": before, "identified": after}, out / "amplitudes.png")
     if v_after:
         rep.plot_amplitudes({"scene values": v_before, "identified": v_after},

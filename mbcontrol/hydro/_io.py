@@ -13,14 +13,14 @@ from __future__ import annotations
 
 import json
 import math
-import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
 import xarray as xr
 
 from mbcontrol.errors import HydroError
+
+from ..atomic import atomic_path
 
 _ENC_KEY = "mbc_encoded_attrs"
 
@@ -98,17 +98,8 @@ def write_netcdf_atomic(ds: xr.Dataset, path: str | Path) -> Path:
     or a full disk never leaves a truncated file under ``path``.
     """
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    os.close(fd)
-    try:
+    with atomic_path(path) as tmp:
         _encode(ds).to_netcdf(tmp, engine="netcdf4")
-        os.chmod(tmp, 0o644)  # mkstemp makes 0600; caches and catalogue files are shared
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.remove(tmp)
-        raise
     return path
 
 

@@ -9,8 +9,6 @@ from __future__ import annotations
 
 import hashlib
 import json
-import os
-import tempfile
 import time
 import warnings
 from dataclasses import dataclass
@@ -19,6 +17,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
+from ..atomic import atomic_path
 from ..cache import cache_dir, status
 from ..errors import HydroError
 from ..scene import DOF_NAMES, Scene
@@ -285,13 +284,10 @@ def _fit_cached(data: xr.Dataset, dofs, tol, source: str, omega_max: float = np.
     model = fit_radiation(data, dofs=list(dofs), tol=tol, omega_max=band, response_band=response_band)
     status(f"radiation model fitted in {time.perf_counter() - started:.1f} s: "
            f"{model.order} states, error {model.fit_error:.2%}")
-    fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".npz.tmp")
-    os.close(fd)
-    with open(tmp, "wb") as fh:
+    with atomic_path(path) as tmp, open(tmp, "wb") as fh:
         np.savez(fh, A=model.A, B=model.B, C=model.C, D=model.D, dofs=np.array(model.dofs),
                  order=model.order, fit_error=model.fit_error, entry_errors=model.entry_errors,
                  report=json.dumps(model.report, default=_jsonable))
-    os.replace(tmp, path)
     return model
 
 

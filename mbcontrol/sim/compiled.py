@@ -1,9 +1,16 @@
 """Compile CasADi Functions to native code with the system C compiler, cached on disk.
 
-The cache key is the generated C source itself (plus flags and CasADi version), so code is
-reused across processes whenever the structure is the same; parameters that stay symbolic
-(PTO, friction, ...) do not enter the key. Without a compiler, the interpreted Function is
-returned, with one warning.
+The cache key is the generated C source itself (plus flags, CasADi version, the compiler and
+its version, the platform and the CPU), so code is reused across processes whenever the
+structure is the same; parameters that stay symbolic (PTO, friction, ...) do not enter the key.
+Without a compiler, the interpreted Function is returned, with one warning.
+
+Every library is checked before it is loaded: its size and SHA-256, recorded beside it
+(`.sha256`) when it was built, must match. A truncated or foreign file (a full disk, a cache
+shared over a network file system) would otherwise crash the process in the loader with no
+message (a bus error); a mismatch is rebuilt, with a warning. Build folders left by a killed
+compile are removed once they are an hour old (a concurrent compile's are younger). Concurrent
+compiles of one function are safe: each builds in its own folder and renames into place.
 """
 from __future__ import annotations
 
@@ -18,6 +25,7 @@ from pathlib import Path
 
 import casadi as ca
 
+from ..atomic import write_text
 from ..cache import cache_dir, status
 
 # -O3 for this CPU, and reassociation so that the radiation model's dense products vectorise;
@@ -36,6 +44,53 @@ def _cpu_tag() -> str:
         import platform
         return platform.machine() + platform.processor()
     return "".join(sorted({l for l in lines if l.startswith(("model name", "flags"))}))
+
+
+STALE_BUILD_S = 3600.0      # a build folder this old belongs to a killed process
+
+
+def _compiler_tag(cc: str) -> str:
+    """The compiler's version line and the platform: a library is only reused where it was made."""
+    import platform
+    try:
+        version = subprocess.run([cc, "--version"], capture_output=True, text=True,
+                                 timeout=30).stdout.splitlines()[:1]
+    except (OSError, subprocess.SubprocessError):
+        version = []
+    return " ".join(version) + platform.platform()
+
+
+def _digest(path: Path) -> str:
+    return f"{path.stat().st_size} {hashlib.sha256(path.read_bytes()).hexdigest()}"
+
+
+def _verified(library: Path) -> bool:
+    """True if the library matches its recorded size and hash; a damaged or unrecorded one is
+    removed (with a warning when it was damaged) so that it is rebuilt."""
+    record = library.with_suffix(".sha256")
+    try:
+        expected = record.read_text().strip()
+        found = _digest(library)
+    except OSError:
+        expected, found = None, None
+    if expected is not None and found == expected:
+        return True
+    if expected is not None:
+        warnings.warn(f"compiled cache entry {library} is damaged (size and SHA-256 {found!r}, "
+                      f"recorded {expected!r}); rebuilding it", RuntimeWarning, stacklevel=3)
+    library.unlink(missing_ok=True)
+    record.unlink(missing_ok=True)
+    return False
+
+
+def _remove_stale_builds(folder: Path) -> None:
+    now = time.time()
+    for build in folder.glob("build-*"):
+        try:
+            if now - build.stat().st_mtime > STALE_BUILD_S:
+                shutil.rmtree(build, ignore_errors=True)
+        except OSError:
+            pass
 
 
 def compiler() -> str | None:
@@ -61,24 +116,36 @@ def compile_function(fun: ca.Function, enabled: bool = True) -> ca.Function:
     generator = ca.CodeGenerator(f"{fun.name()}.c", {"with_header": False})
     generator.add(fun)
     source = generator.dump()
-    key = hashlib.sha256((source + " ".join(FLAGS) + ca.__version__ + cc
+    key = hashlib.sha256((source + " ".join(FLAGS) + ca.__version__ + cc + _tag(cc)
                           + _cpu_tag()).encode())
     library = folder / f"{fun.name()}_{key.hexdigest()[:20]}.so"
-    if library.exists():
+    if library.exists() and _verified(library):
         return ca.external(fun.name(), str(library))
+    _remove_stale_builds(folder)
     started = time.perf_counter()
-    status(f"compiling {fun.name()} ({len(source) // 1000} kB of C): typically 2-60 s, once; "
-           f"cached afterwards")
-    with tempfile.TemporaryDirectory(dir=folder) as tmp:
+    status(f"compiling {fun.name()} ({len(source) // 1000} kB of C): typically 2-60 s, cached "
+           f"afterwards (each distinct structure compiles once)")
+    with tempfile.TemporaryDirectory(prefix="build-", dir=folder) as tmp:
         c_file = Path(tmp) / f"{fun.name()}.c"
         c_file.write_text(source)
         built = Path(tmp) / "out.so"
         result = subprocess.run([cc, *FLAGS, str(c_file), "-o", str(built), "-lm"],
                                 capture_output=True, text=True)
-        status(f"compiled {fun.name()} in {time.perf_counter() - started:.1f} s")
         if result.returncode != 0:
             warnings.warn(f"C compilation failed ({result.stderr[:300]}); using "
                           f"interpreted CasADi code", RuntimeWarning, stacklevel=2)
             return fun
+        status(f"compiled {fun.name()} in {time.perf_counter() - started:.1f} s")
+        # the record first, then the library: a library is never there without its record
+        write_text(library.with_suffix(".sha256"), _digest(built) + "\n")
         os.replace(built, library)        # atomic: readers never see half a library
     return ca.external(fun.name(), str(library))
+
+
+_TAGS: dict = {}
+
+
+def _tag(cc: str) -> str:
+    if cc not in _TAGS:
+        _TAGS[cc] = _compiler_tag(cc)
+    return _TAGS[cc]

@@ -6,10 +6,9 @@ work_precision.nc and, with stability, stability.csv.
 from __future__ import annotations
 
 import csv
-import os
-import tempfile
 from pathlib import Path
 
+from ..atomic import atomic_path
 from ..sim import stability as stab
 from . import workprecision as wp
 
@@ -90,11 +89,5 @@ def _write_csv(rows, path):
 
 def _atomic(path: Path, write) -> None:
     """write(tmp) then rename: a reader never sees half a file."""
-    fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=path.suffix + ".tmp")
-    os.close(fd)
-    try:
-        write(tmp)
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
+    with atomic_path(path, path.suffix) as tmp:
+        write(str(tmp))

@@ -6,12 +6,12 @@ from __future__ import annotations
 
 import json
 import math
-import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
 import xarray as xr
+
+from ...atomic import write_text
 
 
 PROVENANCE_FILE = "provenance.json"
@@ -73,10 +73,7 @@ def _check_inputs(folder: Path, inputs: dict) -> None:
 
 
 def _write_json(path: Path, value) -> None:
-    fd, tmp = tempfile.mkstemp(dir=path.parent, suffix=".tmp")
-    with os.fdopen(fd, "w") as fh:
-        json.dump(value, fh, indent=1, default=_number)
-    os.replace(tmp, path)
+    write_text(path, json.dumps(value, indent=1, default=_number))
 
 
 def _number(value):
