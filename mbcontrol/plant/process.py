@@ -199,10 +199,15 @@ def _preloads(scene, topo, q, s, u, w, chi, tau, pto_signals, params):
     scale = max(1.0, float(np.max(np.abs(np.asarray(args[0])))))
     if np.max(np.abs(residual), initial=0.0) > 1e-9 * scale * max(1.0, _load_scale(scene)):
         worst = np.argsort(-np.abs(residual))[:3]
+        weight = sum(b.mass for b in scene.bodies) * scene.water.g
         listing = ", ".join(f"{tree.coordinate_names[i]}: {residual[i]:.4g}" for i in worst)
         warnings.warn(f"{scene.path}: rest is not an equilibrium; static generalised loads "
-                      f"{listing} (N or N m). Give a PTO preload = \"balance\", or correct "
-                      f"masses, CoGs or the hydro data", RuntimeWarning, stacklevel=3)
+                      f"{listing} (N or N m; the largest is {abs(residual[worst[0]]) / weight:.2%} "
+                      f"of the bodies' weight, {weight:.4g} N). Buoyancy (the hydro data's "
+                      f"displaced volume) and weight, or their centres, do not balance: a mesh "
+                      f"that lost volume, a mass or CoG that is not the floating one. Correct "
+                      f"them, or give the PTO preload = \"balance\" (a constant PTO force that "
+                      f"holds rest)", RuntimeWarning, stacklevel=3)
     return extra
 
 

@@ -2,6 +2,8 @@
 that do not come from the code under test: a hand derivation of the linear matrices (ERRATA
 sections 1 and 3), the frequency-domain solution built straight from the BEM data (no
 radiation fit), CVODES against RK4, and energy balance."""
+import warnings
+
 import numpy as np
 import pytest
 
@@ -218,3 +220,26 @@ def test_results_carry_units_and_round_trip(barge, tmp_path):
     back = xr.load_dataset(path)
     xr.testing.assert_identical(back, ds)            # values, coordinates and attrs
     assert "tmp" not in " ".join(p.name for p in tmp_path.iterdir())   # no leftovers
+
+
+def test_an_unbalanced_rest_says_by_how_much_and_what_to_do(tmp_path):
+    """A sphere 3.2 % heavier than the water its hydro data displace: the warning gives the
+    imbalance as a share of the weight (independent: (m' - m) g / (m' g)), the causes and the
+    remedy, preload = "balance", which then holds rest."""
+    from mbcontrol.scene import catalogue_dir
+    text = (catalogue_dir() / "sphere.toml").read_text().replace(
+        'file = "sphere_hydro.nc"', f'file = "{catalogue_dir()}/sphere_hydro.nc"')
+    heavy = tmp_path / "heavy.toml"
+    heavy.write_text(text.replace("mass = 261724.0", "mass = 270000.0"))
+    with pytest.warns(RuntimeWarning) as caught:
+        build_plant(str(heavy))
+    message = next(str(w.message) for w in caught if "not an equilibrium" in str(w.message))
+    share = (270000.0 - 261724.0) / 270000.0
+    assert f"{share:.2%} of the bodies' weight" in message and 'preload = "balance"' in message
+    balanced = tmp_path / "balanced.toml"
+    balanced.write_text(heavy.read_text().replace("[[pto]]\n", '[[pto]]\npreload = "balance"\n'))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        plant = build_plant(str(balanced))
+    preload = plant.p0[plant.parameters.index("pto__preload")]
+    assert abs(preload) == pytest.approx((270000.0 - 261724.0) * 9.81, rel=0.01)
