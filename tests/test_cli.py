@@ -93,6 +93,9 @@ def test_design_text_prints_parameters_margins_bounds_and_rerun(capsys):
     assert "stable closed loop" in out and "gain margin 1.344 at 0 rad/s" in out
     assert "re-run: mbcontrol simulate sphere --wave regular --height 2.5 --period 9.6664" in out
     assert "--controller reactive --set damping=" in out
+    # duration and step without float noise (30 periods of 9.6664 s: 289.992 s)
+    rerun = next(line for line in out.splitlines() if "re-run:" in line).split()
+    assert rerun[rerun.index("--duration") + 1] == "289.992"
 
 
 def test_design_errors_are_clear(capsys):
@@ -220,3 +223,11 @@ def test_help_names_every_registered_controller(capsys, command):
         main([command, "--help"])
     text = capsys.readouterr().out
     assert all(name in text for name in REGISTRY), text
+
+
+def test_simulate_text_gives_units(capsys):
+    code, out, err = run(capsys, "simulate", "hinged_barge", "--wave", "regular", "--height",
+                         "0.02", "--period", "1.0", "--duration", "5")
+    assert code == 0, err
+    line = next(l for l in out.splitlines() if "hinge_pto:" in l)
+    assert " W, max force " in line and " N m, max stroke " in line and line.endswith(" rad")

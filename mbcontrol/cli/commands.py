@@ -113,7 +113,7 @@ def run_simulate(args) -> int:
     if args.json:
         print(json.dumps(result, indent=2))
     else:
-        _print_summary(result)
+        _print_summary(result, plant)
     for note in result["validity_warnings"]:
         print(f"mbcontrol: warning: {note}", file=sys.stderr)
     if not result["valid"]:
@@ -148,7 +148,8 @@ def run_design(args) -> int:
 
 def _simulate_command(args, result) -> str:
     """The `mbcontrol simulate` command line that re-runs the design's simulation; numbers
-    in repr form, which round-trips a float exactly."""
+    in repr form, which round-trips a float exactly, except duration and step: 12
+    significant digits (289.992, not 289.99199999999996: the same steps)."""
     import shlex
     words = ["mbcontrol", "simulate", args.model]
     for item in args.scene_param:
@@ -162,7 +163,7 @@ def _simulate_command(args, result) -> str:
             words += ["--gamma", repr(args.gamma)]
     sim = result.simulation
     if sim is not None:
-        words += ["--duration", repr(sim["duration_s"]), "--dt", repr(sim["dt_s"])]
+        words += ["--duration", f"{sim['duration_s']:.12g}", "--dt", f"{sim['dt_s']:.12g}"]
     words += ["--controller", result.name]
     for key, value in result.parameters.items():
         items = value.items() if isinstance(value, dict) else [(None, value)]
@@ -374,7 +375,7 @@ def _key_value(item: str, flag: str, text: bool = False):
         raise ValueError(f"{flag} {key}: expected a number, got {value!r}") from None
 
 
-def _print_summary(result: dict) -> None:
+def _print_summary(result: dict, plant) -> None:
     print(f"{result['model']}: {result['duration_s']:.4g} s simulated in "
           f"{result['wall_time_s']:.3g} s ({result['method']}, dt = {result['dt_s']} s)")
     for body, values in result["bodies"].items():
@@ -382,7 +383,8 @@ def _print_summary(result: dict) -> None:
               f"{values['pitch_amplitude_rad']:.4g} rad")
     for pto, values in result["ptos"].items():
         print(f"  {pto}: mean absorbed power {values['mean_power_W']:.4g} W, max force "
-              f"{values['max_force']:.4g}, max stroke {values['max_stroke']:.4g}")
+              f"{values['max_force']:.4g} {plant.units(pto)}, max stroke "
+              f"{values['max_stroke']:.4g} {plant.units(pto + '__position')}")
     checks = result.get("validity", {})
     if "bound_W" in checks:
         print(f"  complex-conjugate bound of this wave {checks['bound_W']:.4g} W (all PTOs, "
