@@ -85,7 +85,7 @@ def tune(plant, wave, name, pto_obj, limits, model_params, notes):
                          "to get wrong")
     if name in ("mpc", "nmpc"):
         # one wave period ahead in 40 steps: the horizon that reaches the constrained bound
-        # on the sphere (tests/test_mpc.py) and a QP of real-time size
+        # on the sphere (tests/controllers/test_mpc.py) and a QP of real-time size
         own.setdefault("horizon_s", float(wave.period))
         own.setdefault("dt_s", float(wave.period) / 40)
         if "force_max" in finite:      # a drive's slew: a full reversal in a fifth of a period

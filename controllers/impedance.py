@@ -110,8 +110,8 @@ def fd_statistics(Z, F, wave, damping, stiffness, *, efficiency: float | None = 
       a peak factor b / s of 4.5 for 150 zero-crossing periods and the default 1 % (T_z =
       2 pi s / s', the mean zero-crossing period from the spectral moments). The chance that
       the record's largest value exceeds b is at most about `exceedance`: Rice counts
-      crossings, and they come in clusters (tests/test_limits.py measures 2-3 % of random-phase
-      records at exceedance 10 %);
+      crossings, and they come in clusters (tests/controllers/test_limits.py measures 2-3 % of
+      random-phase records at exceedance 10 %);
     - stroke_std, force_std: standard deviations (m, N).
     """
     w, a = np.asarray(wave.omega, float), np.asarray(wave.amplitude, float)

@@ -5,10 +5,10 @@ Examples:
   mbcontrol models sphere
   mbcontrol hydro hinged_barge
   mbcontrol simulate hinged_barge --wave regular --height 0.02 --period 1.0 --duration 30 --json
-  mbcontrol simulate hinged_barge --wave jonswap --hs 0.03 --tp 1.0 --seed 3 --out run.nc
+  mbcontrol simulate hinged_barge --wave jonswap --hs 0.03 --tp 1.0 --seed 3 --out out/run.nc
   mbcontrol simulate hinged_barge --wave regular --height 0.02 --period 1 --controller passive --set damping=1.5
   mbcontrol simulate rm3 --wave jonswap --hs 2 --tp 9 --controller mpc --set forecast=ar --json
-  mbcontrol linearize hinged_barge --bode bode.png --json
+  mbcontrol linearize hinged_barge --bode out/bode.png --json
   mbcontrol design sphere --controller reactive --wave regular --height 2.5 --period 9.6664
   mbcontrol design sphere --controller passive --wave jonswap --hs 2.5 --tp 8 --json
   mbcontrol bench rm3 --wave jonswap --hs 2.5 --tp 8 --stability
