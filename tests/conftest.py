@@ -10,13 +10,13 @@ import os
 import pytest
 
 # CI sets this (.ci/run): a test that skips because ../shared data are missing fails instead,
-# so a clone without the data cannot pass by skipping (skip reasons say "... not found ...")
+# so a clone without the data cannot pass by skipping (skip reasons say "... data not found")
 REQUIRE_SHARED = os.environ.get("MBCONTROL_REQUIRE_SHARED") == "1"
 
 
 def _skipped_for_missing_data(report) -> bool:
     reason = report.longrepr[-1] if isinstance(report.longrepr, tuple) else str(report.longrepr)
-    return report.skipped and "not found" in str(reason)
+    return report.skipped and "data not found" in str(reason)
 
 
 @pytest.hookimpl(hookwrapper=True)

@@ -1,5 +1,5 @@
 """CI cannot pass by skipping: with MBCONTROL_REQUIRE_SHARED=1 (set by .ci/run) a test that
-skips because ../shared data are "not found" fails; other skips (no C compiler) stay skips."""
+skips because ../shared "data not found" fails; other skips (no C compiler) stay skips."""
 import os
 import shutil
 import subprocess
