@@ -189,3 +189,25 @@ def test_cited_test_files_exist():
             cited.setdefault(name, str(path.relative_to(ROOT)))
     missing = {name: where for name, where in cited.items() if not (ROOT / name).exists()}
     assert not missing, missing
+
+
+def _package(module: str) -> str:
+    """The stage (or common module) a module belongs to: mbcontrol.hydro.bem -> hydro."""
+    parts = module.split(".")
+    return parts[1] if len(parts) > 1 else parts[0]
+
+
+def test_no_private_name_is_imported_across_packages():
+    """A `_name` is its package's own business: another package importing it couples to
+    internals that may change without notice (issue 22 found `_PLANTS` and `_band`)."""
+    crossing = []
+    for module, path in MODULES.items():
+        for node in ast.walk(ast.parse(path.read_text(), str(path))):
+            if isinstance(node, ast.ImportFrom):
+                target = _resolve(module, path, node)
+                if not target.startswith("mbcontrol"):
+                    continue
+                crossing += [f"{module} imports {target}.{a.name}" for a in node.names
+                             if a.name.startswith("_") and not a.name.startswith("__")
+                             and _package(target) != _package(module)]
+    assert not crossing, crossing
