@@ -74,6 +74,11 @@ def runs():
         return load_runs(sorted((TANK / "scenario_c").glob("[456]*.csv.xz")), drop_bad=True)
 
 
+# the README's identification table (RMS relative amplitude error per DOF)
+README_IDENTIFIED = {"Sway": 0.076, "Heave": 0.062, "Roll": 0.050}
+README_HELD_OUT = {"Sway": 0.103, "Heave": 0.087, "Roll": 0.075}      # worst over the series
+
+
 def _errors(problem, values, omega_max=np.inf):
     rows = [r for r in rep.amplitude_rows(problem, values) if r["omega"] <= omega_max]
     return {c: e["rms_relative_error"] for c, e in rep.channel_errors(rows).items()}
@@ -81,13 +86,14 @@ def _errors(problem, values, omega_max=np.inf):
 
 def test_identified_model_reproduces_every_run(runs):
     """All 31 usable runs, the scene's default parameters, Gauss-Newton on the harmonic cost:
-    each free DOF within 10 % RMS relative amplitude error. Where the radiation model was fitted
-    (the runs at or below 6.67 rad/s, the last BEM frequency under the data's mesh limit, 6.99
-    rad/s; 18 of the 31, the other 13 flagged as extrapolated) roll and sway at
+    each free DOF within the README's identified errors (7.6, 6.2, 5.0 %). Where the radiation
+    model was fitted (the runs at or below 6.67 rad/s, the last BEM frequency under the data's
+    mesh limit, 6.99 rad/s; 18 of the 31, the other 13 flagged as extrapolated) roll and sway at
     least twice as close as the model with the scene's values (potential flow, rig data), heave
     closer. Above it the model extrapolates the fit (runs at 7-9.3 rad/s): there two passive fits
     of equal error in the band (1 % in sway and roll) put the identified sway 6.6 % or 7.8 % off
-    over all runs, so no improvement ratio is claimed there (issue 21: extrapolation said aloud)."""
+    over all runs (the previous parameter set), so no improvement ratio is claimed there (issue
+    21: extrapolation said aloud)."""
     assert len(runs) == 31
     with pytest.warns(ExtrapolationWarning, match=r"fit runs 4101_2 \(7\), .* rad/s: above the "
                                                   r"radiation fit's 6.67 rad/s"):
@@ -114,7 +120,9 @@ def test_identified_model_reproduces_every_run(runs):
     assert all(f["rms_relative_spread"] < 0.025 for f in floor.values()), floor
     after = _errors(problem, result.values)
     assert set(after) == {"Sway", "Heave", "Roll"}
-    assert max(after.values()) <= 0.10, after
+    # the README's table (7.6, 6.2, 5.0 %), half a point allowed for another machine's rounding
+    for dof, claimed in README_IDENTIFIED.items():
+        assert after[dof] <= claimed + 0.005, (dof, after)
     before, after = _errors(problem, {}, fitted), _errors(problem, result.values, fitted)
     assert before["Roll"] >= 2 * after["Roll"] and before["Sway"] >= 2 * after["Sway"], \
         (before, after)
@@ -124,10 +132,12 @@ def test_identified_model_reproduces_every_run(runs):
 
 @pytest.mark.parametrize("held_out", [4, 5, 6])
 def test_cross_validation_by_series(runs, held_out):
-    """Each series predicted by a fit on the other two: within 20 % on every free DOF."""
+    """Each series predicted by a fit on the other two: every free DOF within the README's
+    worst held-out error for that DOF (10.3, 8.7, 7.5 %; issue 21 asks at most 20 %)."""
     train = [r for r in runs if not r.name.startswith(str(held_out))]
     test = [r for r in runs if r.name.startswith(str(held_out))]
     problem = flume_identification("flume_section", None, runs=train)
     result = fit(problem, "gauss-newton")
     predicted = _errors(prediction(problem, test), result.values)
-    assert max(predicted.values()) <= 0.20, predicted
+    for dof, error in predicted.items():
+        assert error <= README_HELD_OUT[dof] + 0.005, (dof, predicted)
