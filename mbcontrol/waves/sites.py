@@ -11,8 +11,10 @@ site's own sea (its Hm0, Tp and Te / Tp) in the device's depth; a file's J colum
 from __future__ import annotations
 
 import csv
+import dataclasses
 import gzip
 import math
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -111,6 +113,10 @@ def read_seas(path, gamma: float = 3.3) -> list[SeaState]:
         if abs(total - 1.0) > WEIGHT_SUM_TOLERANCE:
             raise ValueError(f"{path}: weights sum to {total:.4g}; expected 1 within "
                              f"{WEIGHT_SUM_TOLERANCE} (shares of the year)")
+        if abs(total - 1.0) > 1e-9:         # rounding in the file: shares of the year add to 1
+            warnings.warn(f"{path}: weights sum to {total:.6g}; normalised to 1",
+                          UserWarning, stacklevel=2)
+            seas = [dataclasses.replace(s, weight=s.weight / total) for s in seas]
     return seas
 
 

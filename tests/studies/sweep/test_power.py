@@ -52,6 +52,14 @@ def test_bad_seas_files_are_named(tmp_path, text, message):
     assert str(path) in str(exc.value) and message in str(exc.value)
 
 
+def test_weights_within_rounding_are_normalised(tmp_path):
+    path = tmp_path / "seas.csv"
+    path.write_text("Hm0,Tp,weights\n1.0,8,0.5\n2.0,9,0.51\n")
+    with pytest.warns(UserWarning, match=r"weights sum to 1.01; normalised to 1"):
+        seas = read_seas(path)
+    assert [s.weight for s in seas] == pytest.approx([0.5 / 1.01, 0.51 / 1.01])
+
+
 @pytest.mark.skipif(not SITES.exists(), reason="site data not found")
 def test_pacwave_file_reads_with_its_weights():
     seas = read_seas(SITES / "pacwave_cluster_32.csv")
