@@ -159,7 +159,11 @@ def _parser() -> argparse.ArgumentParser:
                    help="controller setting, repeatable (e.g. --set damping=2.0)")
     p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
                    help="plant parameter override, repeatable (e.g. hinge_pto__damping=3)")
-    p.add_argument("--out", help="write the full result to this netCDF file")
+    p.add_argument("--out", help="write the full result to this netCDF file (compressed)")
+    p.add_argument("--out-float32", action="store_true",
+                   help="--out in single precision (relative rounding 6e-8; about half the size)")
+    p.add_argument("--out-every", type=int, default=1, metavar="K",
+                   help="--out keeps every K-th time step (default 1: all)")
     p.add_argument("--plot", help="write a time-series figure (PNG) to this file")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
     p.add_argument("--allow-invalid", action="store_true",

@@ -104,7 +104,8 @@ def run_simulate(args) -> int:
     result = summary(ds, plant)             # checks the result; the verdict goes into ds.attrs
     if args.out:
         from ..results import save_dataset
-        save_dataset(ds, args.out)
+        save_dataset(ds, args.out, precision="float32" if args.out_float32 else "float64",
+                     every=args.out_every)
     if args.plot:
         from ..plotting import time_series
         names = list(plant.topology.tree.coordinate_names) + [

@@ -220,6 +220,16 @@ def test_results_carry_units_and_round_trip(barge, tmp_path):
     back = xr.load_dataset(path)
     xr.testing.assert_identical(back, ds)            # values, coordinates and attrs
     assert "tmp" not in " ".join(p.name for p in tmp_path.iterdir())   # no leftovers
+    assert oct(path.stat().st_mode & 0o777) != oct(0o600)             # readable by others
+    # compact: single precision and every 5th sample, the same values to float32 rounding
+    small = xr.load_dataset(save_dataset(ds, tmp_path / "small.nc", precision="float32",
+                                         every=5))
+    thinned = ds.isel(time=slice(None, None, 5))
+    np.testing.assert_array_equal(small["time"].values, thinned["time"].values)   # time exact
+    for name in ("pivot", "hinge_pto__power", "energy"):
+        np.testing.assert_allclose(small[name].values, thinned[name].values, rtol=1e-6,
+                                   atol=1e-6 * np.abs(thinned[name].values).max())
+    assert (tmp_path / "small.nc").stat().st_size < 0.3 * path.stat().st_size
 
 
 def test_an_unbalanced_rest_says_by_how_much_and_what_to_do(tmp_path):
