@@ -108,12 +108,18 @@ def main(argv=None) -> int:
     report["design"].update(mpc_rate_limit=rate, mpc_power_change_by_rate_limit=limited / free - 1)
     print(f"  the {rate:.0f} N m/s torque-rate limit changes the MPC's power by "
           f"{100 * (limited / free - 1):+.1f} %")
+    mean_mw = {k: f"mean {r['ptos']['hinge_pto']['mean_power_W'] * 1e3:.3g} mW"
+               for k, r in runs.items()}
     plotting.compare_runs({k: v.sel(time=slice(20, 40)) for k, v in records.items()},
                           ["hinge", "hinge_pto__force", "hinge_pto__power"],
-                          title="hinged barge in a JONSWAP sea (Hs 3 cm, Tp 1.1 s): each "
-                                "column one controller",
+                          title=f"hinged barge in a JONSWAP sea (Hs 3 cm, Tp 1.1 s): each column "
+                                f"one controller; 20-40 s of each {args.duration:g} s run shown, "
+                                f"means over each run after its ramp",
                           units={"hinge": "rad", "hinge_pto__force": "N m",
                                  "hinge_pto__power": "W"},
+                          labels={"hinge": "hinge angle", "hinge_pto__force": "PTO torque",
+                                  "hinge_pto__power": "absorbed power"},
+                          notes={"hinge_pto__power": mean_mw},
                           path=out / "closed_loop.png")
     report["closed_loop"] = runs
 

@@ -54,14 +54,49 @@ def bode(sys, pairs, omega, *, title=None, path=None, fd=None):
     return fig
 
 
+_KINDS = {"power": "power", "force": "force", "velocity": "velocity", "position": "position",
+          "vel": "rate", "tension": "tension"}
+
+
+def signal_label(name: str) -> str:
+    """A reader's name for a plant signal: "hinge_pto__power" -> "hinge_pto power",
+    "barge2__Heave" -> "barge2 heave (z down)", "eta" -> "wave elevation (up)"."""
+    if name == "eta":
+        return "wave elevation (up)"
+    if name.startswith("u__"):
+        return f"{name[3:]} command"
+    if name.startswith("w__"):
+        body, _, dof = name[3:].rpartition("__")
+        return f"wave load, {body} {dof.lower()}"
+    base, _, kind = name.rpartition("__")
+    if not base:
+        return name                       # a joint coordinate: its own name
+    if kind == "Heave":
+        return f"{base} heave (z down)"
+    return f"{base} {_KINDS.get(kind, kind.lower())}"
+
+
+def _ylabel(ax, name, unit, label=None):
+    ax.set_ylabel(f"{label or signal_label(name)}\n[{unit}]" if unit else
+                  (label or signal_label(name)), fontsize=8)
+
+
 def time_series(ds, names, *, title=None, path=None, units=None):
-    """Stacked time histories of named variables of a simulation result."""
+    """Stacked time histories of named variables of a simulation result, each labelled for a
+    reader with its unit; power panels carry their mean over the statistics window."""
     fig, axes = plt.subplots(len(names), 1, sharex=True, figsize=(8, 1.9 * len(names) + 0.6))
     axes = np.atleast_1d(axes)
+    start = _window_start(ds)
     for ax, name in zip(axes, names):
-        ax.plot(ds["time"].values, ds[name].values, lw=0.9)
+        t, y = ds["time"].values, ds[name].values
+        ax.plot(t, y, lw=0.9)
         unit = (units or {}).get(name, ds[name].attrs.get("units", ""))
-        ax.set_ylabel(f"{name}\n{unit}", fontsize=8)
+        _ylabel(ax, name, unit)
+        if name.endswith("__power") and np.any(t >= start):
+            mean = float(np.mean(y[t >= start]))
+            ax.axhline(mean, color="C3", lw=0.9, ls="--")
+            ax.annotate(f"mean {mean:.3g} {unit} (t >= {start:.3g} s)", (0.01, 0.88),
+                        xycoords="axes fraction", fontsize=8, color="C3")
         ax.grid(alpha=0.3)
     axes[-1].set_xlabel("time (s)")
     axes[0].set_title(title or ds.attrs.get("model", ""))
@@ -87,15 +122,22 @@ def result_label(ds) -> str:
     return " | ".join(notes)
 
 
+def _window_start(ds) -> float:
+    """Where the statistics start (s): after the wave's ramp and the controller's warm-up."""
+    import json
+    wave = json.loads(ds.attrs.get("wave", "{}") or "{}")
+    controller = json.loads(ds.attrs.get("controller", "null") or "null") or {}
+    return max(float(wave.get("ramp_s", 0.0) or 0.0),
+               float(controller.get("warm_up_s", 0.0) or 0.0))
+
+
 def mark_result(ds, axes, title_ax) -> None:
     """Shade what the statistics leave out (the wave's ramp, the controller's warm-up) and
     mark an invalid or oracle result on its axes (red faces, a note under the title)."""
     import json
     import textwrap
     wave = json.loads(ds.attrs.get("wave", "{}") or "{}")
-    controller = json.loads(ds.attrs.get("controller", "null") or "null") or {}
-    start = max(float(wave.get("ramp_s", 0.0) or 0.0),
-                float(controller.get("warm_up_s", 0.0) or 0.0))
+    start = _window_start(ds)
     first = float(ds["time"].values[0])
     for ax in np.ravel(axes):
         if start > first and wave.get("type") != "regular":
@@ -109,9 +151,12 @@ def mark_result(ds, axes, title_ax) -> None:
                            color="C3" if ds.attrs.get("valid", 1) == 0 else "C1")
 
 
-def compare_runs(runs: dict, names, *, title=None, units=None, path=None):
+def compare_runs(runs: dict, names, *, title=None, units=None, path=None, labels=None,
+                 notes=None):
     """Runs side by side: a column per run (titled by its label), a row per variable, each
-    row on one y scale, so what the title of a column says is what it shows."""
+    row on one y scale, so what the title of a column says is what it shows. labels: name ->
+    the row's label (default `signal_label`); notes: name -> {run label: text} written in the
+    panel (e.g. the run's mean power, which a shared scale can hide)."""
     fig, axes = plt.subplots(len(names), len(runs), sharex=True, sharey="row", squeeze=False,
                              figsize=(3.2 * len(runs), 1.8 * len(names) + 0.9))
     for j, (label, ds) in enumerate(runs.items()):
@@ -119,8 +164,12 @@ def compare_runs(runs: dict, names, *, title=None, units=None, path=None):
         for i, name in enumerate(names):
             axes[i, j].plot(ds["time"].values, ds[name].values, lw=0.8)
             axes[i, j].grid(alpha=0.3)
+            text = (notes or {}).get(name, {}).get(label)
+            if text:
+                axes[i, j].annotate(text, (0.02, 0.86), xycoords="axes fraction", fontsize=8,
+                                    color="C3", fontweight="bold")
             if j == 0:
-                axes[i, j].set_ylabel(f"{name}\n{(units or {}).get(name, '')}", fontsize=8)
+                _ylabel(axes[i, j], name, (units or {}).get(name, ""), (labels or {}).get(name))
         axes[-1, j].set_xlabel("time (s)")
         mark_result(ds, axes[:, j], axes[0, j])
     if title:
