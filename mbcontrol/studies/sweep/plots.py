@@ -20,61 +20,104 @@ def _invalid_cells(ds, table, period: str) -> dict:
     return cells
 
 
+def _edges(centres) -> np.ndarray:
+    """Cell edges around sorted centres: midpoints, the ends half a step out."""
+    c = np.asarray(centres, float)
+    if c.size == 1:
+        return np.array([c[0] - 0.5, c[0] + 0.5])
+    mid = 0.5 * (c[1:] + c[:-1])
+    return np.concatenate([[c[0] - (mid[0] - c[0])], mid, [c[-1] + (c[-1] - mid[-1])]])
+
+
+def _matrix(fig, ax, ds, table, period):
+    """A grid of sea states: cells on the real Hs and Tp values, annotated, invalid hatched."""
+    import matplotlib.pyplot as plt
+    x, y = table[period].values, table.hs.values
+    xe, ye = _edges(x), _edges(y)
+    image = ax.pcolormesh(xe, ye, np.ma.masked_invalid(table.values), cmap="viridis")
+    if table.size <= 120:
+        for (i, j), v in np.ndenumerate(table.values):
+            if np.isfinite(v):
+                ax.text(x[j], y[i], f"{v:.3g}", ha="center", va="center", fontsize=6, color="w")
+    for (i, j), n in _invalid_cells(ds, table, period).items():   # shown, never averaged
+        ax.add_patch(plt.Rectangle((xe[j], ye[i]), xe[j + 1] - xe[j], ye[i + 1] - ye[i],
+                                   fill=False, hatch="xx", edgecolor="C3", lw=0))
+        ax.text(x[j], y[i], f"{n} invalid", ha="center", va="center", fontsize=6, color="C3",
+                bbox={"facecolor": "white", "edgecolor": "none", "pad": 1})
+    fig.colorbar(image, ax=ax, label="mean power, kW")
+    ax.set_xlabel("peak period Tp, s")
+    ax.set_ylabel("significant wave height Hs, m")
+
+
+def _scattered(fig, ax, ds):
+    """Sea states that do not fill a grid (a site's list): a dot each at its Hs and Tp,
+    coloured and labelled by mean power (kW); invalid ones as red crosses."""
+    power = ds["mean_power_W"].mean([d for d in ds["mean_power_W"].dims if d != "sea"]) / 1e3
+    ok = np.isfinite(power.values)
+    dots = ax.scatter(ds["tp"].values[ok], ds["hs"].values[ok], c=power.values[ok],
+                      cmap="viridis", s=60, edgecolor="k", lw=0.3)
+    for tp, hs, v in zip(ds["tp"].values[ok], ds["hs"].values[ok], power.values[ok]):
+        ax.annotate(f"{v:.3g}", (tp, hs), textcoords="offset points", xytext=(0, 5),
+                    ha="center", fontsize=6)
+    if (~ok).any():
+        ax.scatter(ds["tp"].values[~ok], ds["hs"].values[~ok], marker="x", color="C3", s=30,
+                   label="invalid (left out)")
+        ax.legend(fontsize=7, loc="upper left")
+    fig.colorbar(dots, ax=ax, label="mean power, kW")
+    ax.set_xlabel("peak period Tp, s")
+    ax.set_ylabel("significant wave height Hs, m")
+    ax.grid(alpha=0.3)
+
+
 def plot_sweep(ds, summary: dict, path=None):
-    """Three panels (power matrix, capture width, annual energy by sea); returns the figure,
-    written to path when given."""
+    """Three panels on the same axes, peak period Tp (s) across and Hs (m) up: the power
+    matrix (mean power, kW, cells on the real Hs and Tp values, a colourbar), capture width
+    (or its ratio) against Tp coloured by Hs, and, for a weighted list, each sea state's
+    annual energy (MWh) as a bubble at its Hs and Tp. Returns the figure, written to path when
+    given."""
     import matplotlib.pyplot as plt
 
     from ...plotting import save
     weighted = summary.get("annual_energy_MWh") is not None
-    fig, axes = plt.subplots(1, 3 if weighted else 2, figsize=(15 if weighted else 10, 4.2))
+    fig, axes = plt.subplots(1, 3 if weighted else 2, figsize=(16 if weighted else 10.5, 4.4))
     period = "tp"
     try:
         table = power_matrix(ds, period=period) / 1e3
-        ax = axes[0]
-        image = ax.imshow(table.values, origin="lower", aspect="auto", cmap="viridis")
-        ax.set_xticks(range(table[period].size), [f"{v:.3g}" for v in table[period].values],
-                      rotation=90 if table[period].size > 12 else 0, fontsize=7)
-        ax.set_yticks(range(table.hs.size), [f"{v:.3g}" for v in table.hs.values], fontsize=7)
-        if table.size <= 120:
-            for (i, j), v in np.ndenumerate(table.values):
-                if np.isfinite(v):
-                    ax.text(j, i, f"{v:.3g}", ha="center", va="center", fontsize=6, color="w")
-        invalid = _invalid_cells(ds, table, period)
-        for (i, j), n in invalid.items():        # failed physics checks: shown, never averaged
-            ax.add_patch(plt.Rectangle((j - 0.5, i - 0.5), 1, 1, fill=False, hatch="xx",
-                                       edgecolor="C3", lw=0))
-            ax.text(j, i, f"{n} invalid", ha="center", va="center", fontsize=7, color="C3",
-                    bbox={"facecolor": "white", "edgecolor": "none", "pad": 1.5})
-        fig.colorbar(image, ax=ax, label="mean power, kW")
-        ax.set_xlabel("Tp, s")
-        ax.set_ylabel("Hs, m")
+        if np.isfinite(table.values).mean() >= 0.5:
+            _matrix(fig, axes[0], ds, table, period)
+        else:                       # a site's scattered list: each sea state where it lies
+            _scattered(fig, axes[0], ds)
         n_bad = summary.get("invalid_cases", 0)
-        ax.set_title(f"{ds.attrs.get('model')}: power matrix"
-                     + (f"\n{n_bad} invalid cases left out (hatched)" if n_bad else ""),
-                     fontsize=10)
+        axes[0].set_title(f"{ds.attrs.get('model')}: mean power by sea state"
+                          + (f"\n{n_bad} invalid cases left out (red crosses / hatched)"
+                             if n_bad else ""), fontsize=9)
     except ValueError as exc:                       # other quantities varied: no single table
         axes[0].text(0.5, 0.5, str(exc), ha="center", va="center", wrap=True, fontsize=8)
         axes[0].set_axis_off()
     ax = axes[1]
     ratio = "capture_width_ratio" if "capture_width_ratio" in ds else "capture_width_m"
     values = ds[ratio].mean([d for d in ds[ratio].dims if d != "sea"])
-    x = ds["te"].values if np.all(np.isfinite(ds["te"].values)) else ds["tp"].values
-    ax.scatter(x, values, c=ds["hs"].values, cmap="viridis", s=18)
-    ax.set_xlabel("Te, s" if np.all(np.isfinite(ds["te"].values)) else "Tp, s")
-    ax.set_ylabel("capture width ratio" if ratio == "capture_width_ratio" else "capture width, m")
+    dots = ax.scatter(ds["tp"].values, values, c=ds["hs"].values, cmap="viridis", s=18)
+    fig.colorbar(dots, ax=ax, label="Hs, m")
+    ax.set_xlabel("peak period Tp, s")
+    ax.set_ylabel("capture width ratio, -" if ratio == "capture_width_ratio"
+                  else "capture width, m")
     ax.grid(alpha=0.3)
-    ax.set_title("capture width (colour: Hs)" + (", valid cases only"
-                                                  if summary.get("invalid_cases") else ""))
+    ax.set_title("capture width" + (", valid cases only" if summary.get("invalid_cases")
+                                    else ""), fontsize=9)
     if weighted:
         ax = axes[2]
         power = ds["mean_power_W"].mean([d for d in ds["mean_power_W"].dims if d != "sea"])
-        energy = ds["weight"].values * power.values * 8766 / 1e6
-        ax.bar(range(energy.size), energy)
-        ax.set_xlabel("sea state")
-        ax.set_ylabel("energy per year, MWh")
-        ax.set_title(f"annual energy {summary['annual_energy_MWh']:.4g} MWh by sea state")
-        ax.grid(alpha=0.3, axis="y")
+        energy = np.nan_to_num(ds["weight"].values * power.values * 8766 / 1e6)
+        size = 400 * energy / max(energy.max(), 1e-300) + 4
+        bubbles = ax.scatter(ds["tp"].values, ds["hs"].values, s=size, c=energy,
+                             cmap="magma_r", edgecolor="k", lw=0.4)
+        fig.colorbar(bubbles, ax=ax, label="energy per year, MWh")
+        ax.set_xlabel("peak period Tp, s")
+        ax.set_ylabel("significant wave height Hs, m")
+        ax.grid(alpha=0.3)
+        ax.set_title(f"annual energy {summary['annual_energy_MWh']:.4g} MWh: each sea state's "
+                     f"share (area)", fontsize=9)
     fig.tight_layout()
     if path is not None:
         save(fig, path)

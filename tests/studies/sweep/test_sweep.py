@@ -93,3 +93,24 @@ def test_an_existing_cluster_by_its_address():
                                scheduler=cluster.scheduler_address, **SHORT)
     assert result["computed"] == 2
     xr.testing.assert_identical(serial.drop_attrs(), remote.drop_attrs())
+
+
+def test_sweep_figure_on_real_axes(tmp_path):
+    """A grid of sea states is drawn on its real Hs and Tp values (cells centred on them, a
+    colourbar in kW), not on row and column numbers; a site's scattered list as dots."""
+    from matplotlib.collections import QuadMesh
+
+    from mbcontrol.studies.sweep.plots import plot_sweep
+    ds, result = sweep("sphere", SEAS, workers=0, **SHORT)
+    fig = plot_sweep(ds, result, tmp_path / "sweep.png")
+    ax = fig.axes[0]
+    (mesh,) = [c for c in ax.collections if isinstance(c, QuadMesh)]
+    assert ax.get_xlabel() == "peak period Tp, s" and ax.get_ylabel().endswith("Hs, m")
+    lo, hi = ax.get_xlim()
+    assert lo < 8.0 and 11.0 < hi and ax.get_ylim()[0] < 1.0 < 2.0 < ax.get_ylim()[1]
+    texts = {t.get_text() for t in ax.texts}
+    kw = ds["mean_power_W"].mean("seed").values / 1e3 if "seed" in ds["mean_power_W"].dims \
+        else ds["mean_power_W"].values / 1e3
+    assert {f"{v:.3g}" for v in np.ravel(kw)} <= texts
+    assert any(a.get_ylabel() == "mean power, kW" for a in fig.axes)
+    assert (tmp_path / "sweep.png").stat().st_size > 10_000
