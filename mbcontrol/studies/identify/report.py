@@ -17,6 +17,11 @@ from ...results import jsonable
 from .costs import harmonic, whole_periods
 
 
+def channel_unit(channel: str) -> str:
+    """SI unit of a measured channel (records are converted on reading): rad or m."""
+    return "rad" if channel.lower().startswith(("roll", "pitch", "yaw")) else "m"
+
+
 def amplitude_rows(problem, values: dict) -> list[dict]:
     """Per run and free channel: {run, group, omega (rad/s), incident (m), channel, unit,
     measured, model (first-harmonic amplitudes, channel unit), relative_error, extrapolated
@@ -31,8 +36,7 @@ def amplitude_rows(problem, values: dict) -> list[dict]:
             model = abs(harmonic(t, y, run.omega, start, end))
             rows.append({"run": run.name, "group": run.group, "omega": run.omega,
                          "incident": run.amplitude, "channel": channel,
-                         "unit": "rad" if channel.lower().startswith(("roll", "pitch", "yaw"))
-                         else "m", "measured": measured, "model": model,
+                         "unit": channel_unit(channel), "measured": measured, "model": model,
                          "relative_error": (model - measured) / measured,
                          "extrapolated": reasons(problem, run.omega)})
     return rows
@@ -247,7 +251,8 @@ def plot_time_series(problem, run_name: str, values_by_label: dict, path=None):
         for i, (label, sim) in enumerate(sims.items()):
             t, y, _ = sim[channel]
             ax.plot(t, y, color=f"C{i}", lw=1, label=label)
-        ax.set_ylabel(channel)
+        ax.set_ylabel(f"{channel}\n[{channel_unit(channel)}]"
+                      + (" (up)" if channel.lower() == "heave" else ""))
         ax.grid(alpha=0.3)
     axes[0, 0].set_title(f"{run.name}: {run.group}, omega {run.omega:.3f} rad/s, wave amplitude "
                          f"{1000 * run.amplitude:.1f} mm")
