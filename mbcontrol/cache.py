@@ -2,6 +2,7 @@
 ~/.cache/mbcontrol. Generated C and compiled libraries go here and nowhere else."""
 from __future__ import annotations
 
+import logging
 import os
 from pathlib import Path
 
@@ -13,9 +14,29 @@ def cache_dir() -> Path:
     return path
 
 
-def status(message: str) -> None:
-    """One line on stderr for a long job the cache will spare next time (a radiation fit, a
-    compilation): what it is doing and how long it usually takes. MBCONTROL_QUIET=1 hides it."""
-    import sys
-    if not os.environ.get("MBCONTROL_QUIET"):
-        print(f"mbcontrol: {message}", file=sys.stderr, flush=True)
+def status(message: str, name: str = "mbcontrol") -> None:
+    """One line for a long job the cache will spare next time (a radiation fit, a
+    compilation): what it is doing and how long it usually takes. Logged at INFO on the
+    logger `name` (a package's, e.g. "mbcontrol.hydro.model"; they all propagate to
+    "mbcontrol"). Unless the application configured logging itself, the "mbcontrol" logger
+    gets one stderr handler ("mbcontrol: ..."), at INFO, or WARNING with MBCONTROL_QUIET=1
+    (the CLI's -q and -v set the level too)."""
+    _ensure_handler()
+    logging.getLogger(name).info(message)
+
+
+def _ensure_handler() -> None:
+    logger = logging.getLogger("mbcontrol")
+    if logger.handlers or logging.getLogger().handlers:
+        return                           # the application decides where messages go
+    handler = logging.StreamHandler()
+    handler.setFormatter(logging.Formatter("mbcontrol: %(message)s"))
+    logger.addHandler(handler)
+    if logger.level == logging.NOTSET:
+        logger.setLevel(logging.WARNING if os.environ.get("MBCONTROL_QUIET") else logging.INFO)
+
+
+def set_verbosity(level: int) -> None:
+    """The "mbcontrol" logger's level (logging.DEBUG, INFO, WARNING ...), e.g. from -v / -q."""
+    _ensure_handler()
+    logging.getLogger("mbcontrol").setLevel(level)

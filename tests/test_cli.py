@@ -231,3 +231,23 @@ def test_simulate_text_gives_units(capsys):
     assert code == 0, err
     line = next(l for l in out.splitlines() if "hinge_pto:" in l)
     assert " W, max force " in line and " N m, max stroke " in line and line.endswith(" rad")
+
+
+def test_quiet_and_verbose(tmp_path):
+    """Status lines go through the 'mbcontrol' logger: shown by default (a cold cache
+    compiles), hidden by -q along with the progress bars; -v is accepted."""
+    import os
+    import subprocess
+    import sys
+    args = ["simulate", "sphere", "--height", "1", "--period", "8", "--duration", "10"]
+
+    def stderr(*flags, cache):
+        env = {**os.environ, "MBCONTROL_CACHE": str(tmp_path / cache)}
+        env.pop("MBCONTROL_QUIET", None)
+        return subprocess.run([sys.executable, "-m", "mbcontrol", *flags, *args], env=env,
+                              capture_output=True, text=True, check=True).stderr
+
+    assert "mbcontrol: compiling chunk" in stderr(cache="a")
+    quiet = stderr("-q", cache="b")
+    assert "compiling" not in quiet and "step/s" not in quiet
+    assert "mbcontrol: compiling chunk" in stderr("-v", cache="c")

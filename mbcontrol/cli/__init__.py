@@ -99,16 +99,36 @@ def _version() -> str:
 
 
 def main(argv=None) -> int:
+    import logging
+    logger = logging.getLogger("mbcontrol")
     previous, warnings.formatwarning = warnings.formatwarning, _format_warning
+    level, bars = logger.level, os.environ.get("TQDM_DISABLE")
     try:
         return _main(argv)
-    finally:
+    finally:                     # a caller (a test, a notebook) gets its settings back
         warnings.formatwarning = previous
+        logger.setLevel(level)
+        if bars is None:
+            os.environ.pop("TQDM_DISABLE", None)
+        else:
+            os.environ["TQDM_DISABLE"] = bars
+
+
+def _loudness(args) -> None:
+    """-v / -q: the "mbcontrol" logger's level, and progress bars off with -q."""
+    import logging
+
+    from ..cache import set_verbosity
+    if args.verbose or args.quiet:
+        set_verbosity(logging.DEBUG if args.verbose else logging.WARNING)
+    if args.quiet:
+        os.environ["TQDM_DISABLE"] = "1"
 
 
 def _main(argv) -> int:
     parser = _parser()
     args = parser.parse_args(argv)
+    _loudness(args)
     if not hasattr(args, "run"):
         parser.print_help()
         return 2
@@ -126,6 +146,11 @@ def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="mbcontrol", description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
     parser.add_argument("--version", action="version", version=f"mbcontrol {_version()}")
+    loudness = parser.add_mutually_exclusive_group()
+    loudness.add_argument("-v", "--verbose", action="store_true",
+                          help="more messages (the 'mbcontrol' logger at DEBUG)")
+    loudness.add_argument("-q", "--quiet", action="store_true",
+                          help="only warnings and errors: no status lines, no progress bars")
     sub = parser.add_subparsers(title="commands", metavar="COMMAND")
 
     p = sub.add_parser("models", help="list the catalogue, or describe one model: its bodies, "

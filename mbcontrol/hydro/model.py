@@ -280,10 +280,10 @@ def _fit_cached(data: xr.Dataset, dofs, tol, source: str, omega_max: float = np.
             path.unlink(missing_ok=True)       # a stale or foreign file: refit
     started = time.perf_counter()
     status(f"fitting the radiation model of {Path(source).name} ({len(dofs)} DOFs, tolerance "
-           f"{tol:g}): typically 5-90 s, once; cached afterwards")
+           f"{tol:g}): typically 5-90 s, once; cached afterwards", __name__)
     model = fit_radiation(data, dofs=list(dofs), tol=tol, omega_max=band, response_band=response_band)
     status(f"radiation model fitted in {time.perf_counter() - started:.1f} s: "
-           f"{model.order} states, error {model.fit_error:.2%}")
+           f"{model.order} states, error {model.fit_error:.2%}", __name__)
     with atomic_path(path) as tmp, open(tmp, "wb") as fh:
         np.savez(fh, A=model.A, B=model.B, C=model.C, D=model.D, dofs=np.array(model.dofs),
                  order=model.order, fit_error=model.fit_error, entry_errors=model.entry_errors,

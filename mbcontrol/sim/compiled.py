@@ -124,7 +124,7 @@ def compile_function(fun: ca.Function, enabled: bool = True) -> ca.Function:
     _remove_stale_builds(folder)
     started = time.perf_counter()
     status(f"compiling {fun.name()} ({len(source) // 1000} kB of C): typically 2-60 s, cached "
-           f"afterwards (each distinct structure compiles once)")
+           f"afterwards (each distinct structure compiles once)", __name__)
     with tempfile.TemporaryDirectory(prefix="build-", dir=folder) as tmp:
         c_file = Path(tmp) / f"{fun.name()}.c"
         c_file.write_text(source)
@@ -135,7 +135,7 @@ def compile_function(fun: ca.Function, enabled: bool = True) -> ca.Function:
             warnings.warn(f"C compilation failed ({result.stderr[:300]}); using "
                           f"interpreted CasADi code", RuntimeWarning, stacklevel=2)
             return fun
-        status(f"compiled {fun.name()} in {time.perf_counter() - started:.1f} s")
+        status(f"compiled {fun.name()} in {time.perf_counter() - started:.1f} s", __name__)
         # the record first, then the library: a library is never there without its record
         write_text(library.with_suffix(".sha256"), _digest(built) + "\n")
         os.replace(built, library)        # atomic: readers never see half a library
