@@ -25,8 +25,6 @@ _PLANTS: dict = {}
 # a run's records (35 MB for rm3 over an hour) top glibc's heap and go back to the kernel, and
 # the next case faults them in again page by page (rm3: 4,300 page faults, 12 ms of 70 a case)
 _LAST_RUN: list = []
-FAULT_ENV = "MBCONTROL_SWEEP_FAULT"     # test hook: "exit-after:N" (the sweep process) or
-                                        # "kill-worker-once:PATH" (a worker, once)
 
 
 def _plant(model: str, scene_params: tuple):
@@ -102,12 +100,6 @@ def case_record(case, plant, wave, run, start: float) -> dict:
 
 def run_group(cases) -> list[dict]:
     """A task: the cases of one plant, run in order."""
-    fault = os.environ.get(FAULT_ENV, "")
-    if fault.startswith("kill-worker-once:"):
-        flag = fault.split(":", 1)[1]
-        if not os.path.exists(flag):
-            open(flag, "w").close()
-            os._exit(1)                    # a worker dies in the middle of its task
     return [run_case(c) for c in cases]
 
 
@@ -157,18 +149,12 @@ def execute(cases, store, *, workers: int | None = None, scheduler: str | None =
     reused = len(cases) - len(todo)
     start = time.perf_counter()
     bar = _bar(progress, len(cases), reused)
-    stop_after = _exit_after()
-    done = 0
 
     def save(records):
-        nonlocal done
         for r in records:
             store.write(r["case"], r)
-            done += 1
             if bar is not None:
                 bar.update(1)
-            if stop_after is not None and done >= stop_after:
-                os._exit(9)                # the sweep process is killed part-way
 
     where = "serial"
     queue = [c for group in groups(todo, len(todo) or 1) for c in group]   # a plant at a time
@@ -213,8 +199,7 @@ def _cluster_pays(serial_s: float, n_workers: int, method: str = "spawn") -> boo
 def _local(queue: list, save, n: int, per_task) -> str:
     """Run `queue` (emptied) on a local cluster of n workers when it pays, else leave it to
     the caller's serial loop. Returns where the cases ran."""
-    forced = (os.environ.get(CLUSTER_ENV) == "always"
-              or os.environ.get(FAULT_ENV, "").startswith("kill-worker-once:"))
+    forced = os.environ.get(CLUSTER_ENV) == "always"
     method = _start_method()
     if not forced:
         timed = []
@@ -321,11 +306,6 @@ def _on_dask(queue: list, save, client, per_task) -> None:
     futures = [client.submit(run_group, g, pure=False, retries=2) for g in groups(todo, size)]
     for future in as_completed(futures):
         save(future.result())
-
-
-def _exit_after():
-    fault = os.environ.get(FAULT_ENV, "")
-    return int(fault.split(":", 1)[1]) if fault.startswith("exit-after:") else None
 
 
 def _bar(progress: bool, total: int, reused: int):

@@ -4,6 +4,7 @@ import json
 import os
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -14,7 +15,7 @@ from mbcontrol.analysis import summary
 from mbcontrol.plant import build_plant
 from mbcontrol.sim import simulate
 from mbcontrol.studies.sweep import grid, sweep
-from mbcontrol.studies.sweep.runner import CLUSTER_ENV, FAULT_ENV
+from mbcontrol.studies.sweep.runner import CLUSTER_ENV
 
 SEAS = grid([1.0, 2.0], [8.0, 11.0])
 SHORT = dict(duration=120.0, dt=0.1, progress=False)
@@ -47,17 +48,21 @@ def test_serial_and_two_workers_agree(monkeypatch):
     xr.testing.assert_identical(serial.drop_attrs(), dask.drop_attrs())
 
 
-def _cli(store, *extra, env=None):
-    argv = [sys.executable, "-m", "mbcontrol.cli", "sweep", "sphere", "--hs", "1", "2",
-            "--tp", "8", "10", "12", "--duration", "100", "--dt", "0.1", "--store", str(store),
-            "--json", *extra]
-    return subprocess.run(argv, capture_output=True, text=True, timeout=600,
-                          env={**os.environ, **(env or {})})
+FAULTS = Path(__file__).resolve().parents[2] / "sweep_faults.py"
+
+
+def _cli(store, *extra, fault=None):
+    """The sweep command in a fresh process; fault: injected by tests/sweep_faults.py."""
+    head = [sys.executable, str(FAULTS), fault] if fault else [sys.executable, "-m",
+                                                              "mbcontrol.cli"]
+    argv = [*head, "sweep", "sphere", "--hs", "1", "2", "--tp", "8", "10", "12", "--duration",
+            "100", "--dt", "0.1", "--store", str(store), "--json", *extra]
+    return subprocess.run(argv, capture_output=True, text=True, timeout=600, env=os.environ)
 
 
 def test_killed_sweep_resumes_with_each_case_once(tmp_path):
     store = tmp_path / "store"
-    killed = _cli(store, "--workers", "0", env={FAULT_ENV: "exit-after:2"})
+    killed = _cli(store, "--workers", "0", fault="exit-after:2")
     assert killed.returncode == 9                       # stopped after two cases were kept
     assert len(list((store / "cases").glob("*.json"))) == 2
     assert not list((store / "cases").glob("*.tmp"))     # nothing half written
@@ -75,7 +80,7 @@ def test_killed_sweep_resumes_with_each_case_once(tmp_path):
 def test_a_dead_worker_loses_only_its_task(tmp_path):
     flag = tmp_path / "killed"
     store = tmp_path / "store"
-    run = _cli(store, "--workers", "2", env={FAULT_ENV: f"kill-worker-once:{flag}"})
+    run = _cli(store, "--workers", "2", fault=f"kill-worker-once:{flag}")
     assert run.returncode == 0, run.stderr
     assert flag.exists()                                 # a worker did die mid-task
     s = json.loads(run.stdout)
