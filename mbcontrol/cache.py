@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import logging
 import os
+import sys
 from pathlib import Path
 
 
@@ -25,11 +26,26 @@ def status(message: str, name: str = "mbcontrol") -> None:
     logging.getLogger(name).info(message)
 
 
+class _Stderr(logging.StreamHandler):
+    """Writes to the sys.stderr of the moment, which pytest and notebooks swap."""
+
+    def __init__(self):
+        super().__init__(sys.stderr)
+
+    @property
+    def stream(self):
+        return sys.stderr
+
+    @stream.setter
+    def stream(self, value):
+        pass
+
+
 def _ensure_handler() -> None:
     logger = logging.getLogger("mbcontrol")
     if logger.handlers or logging.getLogger().handlers:
         return                           # the application decides where messages go
-    handler = logging.StreamHandler()
+    handler = _Stderr()
     handler.setFormatter(logging.Formatter("mbcontrol: %(message)s"))
     logger.addHandler(handler)
     if logger.level == logging.NOTSET:
