@@ -36,6 +36,23 @@ def test_sweep_json_contract_and_annual_energy(capsys, tmp_path):
         assert r["mean_power_W"] > 0
         assert r["capture_width_m"] == pytest.approx(r["mean_power_W"] / r["energy_flux_W_per_m"])
         assert r["capture_width_ratio"] == pytest.approx(r["capture_width_m"] / 10)
+    # each sea's power against its own simulate() run, the flux against the JONSWAP flux in
+    # the scene's water: computed here, not read back from the sweep
+    from mbcontrol import waves
+    from mbcontrol.analysis import summary
+    from mbcontrol.plant import build_plant
+    from mbcontrol.sim import simulate
+    from mbcontrol.waves import energy_flux
+    plant = build_plant("sphere")
+    omega = plant.hydro.omega
+    for r in rows:
+        wave = waves.irregular(r["hs"], r["tp"], seed=0, duration=100.0,
+                               data_band=(float(omega[0]), float(omega[-1])))
+        own = summary(simulate(plant, wave, duration=100.0, dt=0.1), plant)
+        assert r["mean_power_W"] == pytest.approx(own["ptos"]["pto"]["mean_power_W"], rel=1e-9)
+        water = plant.scene.water                  # the device's water: rho 1000 for sphere
+        assert r["energy_flux_W_per_m"] == pytest.approx(
+            energy_flux(r["hs"], r["tp"], depth=water.depth, rho=water.rho, g=water.g), rel=1e-9)
     weighted = sum(r["weight"] * r["mean_power_W"] for r in rows)
     assert s["weighted_mean_power_W"] == pytest.approx(weighted)
     assert s["annual_energy_MWh"] == pytest.approx(weighted * 8766 / 1e6)
