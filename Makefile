@@ -4,12 +4,14 @@ VENV   := .venv
 PY     := $(VENV)/bin/python
 OUT    ?= out
 
-.PHONY: demo test bench clean help
+.PHONY: demo test bench docs clean help
 
 help:
 	@echo "make demo   - hinged barge: scene -> hydro -> linear model -> Bode -> control -> closed loop ($(OUT)/demo)"
 	@echo "make test   - the whole test suite, notebooks included"
 	@echo "make bench  - speed and accuracy benchmarks (ratios against baselines, one run)"
+	@echo "make docs   - the documentation site ($(OUT)/docs/html/index.html): guide, scene keys,"
+	@echo "              defaults, CLI, tutorials (the notebooks, executed), API reference"
 
 $(VENV)/bin/python:
 	$(PYTHON) -m venv $(VENV)
@@ -23,11 +25,19 @@ $(VENV)/.installed-test: pyproject.toml | $(VENV)/bin/python
 	$(PY) -m pip install --quiet -e ".[test]"
 	touch $@ $(VENV)/.installed
 
+$(VENV)/.installed-docs: pyproject.toml | $(VENV)/bin/python
+	$(PY) -m pip install --quiet -e ".[test,docs]"
+	touch $@ $(VENV)/.installed-test $(VENV)/.installed
+
 demo: $(VENV)/.installed
 	$(PY) -m mbcontrol.demo --out $(OUT)/demo
 
 test: $(VENV)/.installed-test
 	$(PY) -m pytest -q
+
+# Sphinx with warnings as errors; reuses the notebooks `make test` executed (out/notebooks)
+docs: $(VENV)/.installed-docs
+	$(PY) notebooks/make_docs.py --out $(OUT)/docs
 
 bench: $(VENV)/.installed-test
 	$(PY) benchmarks/run.py --out $(OUT)/bench

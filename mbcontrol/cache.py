@@ -1,16 +1,18 @@
-"""Where BEM results, radiation fits and compiled code are cached: $MBCONTROL_CACHE, else
-~/.cache/mbcontrol. Generated C and compiled libraries go here and nowhere else."""
+"""Where BEM results, radiation fits and compiled code are cached: the default "cache.folder"
+($MBCONTROL_CACHE, else ~/.cache/mbcontrol; mbcontrol.defaults). Generated C and compiled
+libraries go here and nowhere else."""
 from __future__ import annotations
 
 import logging
-import os
 import sys
 from pathlib import Path
+
+from . import defaults
 
 
 def cache_dir() -> Path:
     """The cache folder (created if missing)."""
-    path = Path(os.environ.get("MBCONTROL_CACHE", Path.home() / ".cache" / "mbcontrol"))
+    path = Path(defaults.get("cache.folder")).expanduser()
     path.mkdir(parents=True, exist_ok=True)
     return path
 
@@ -49,10 +51,19 @@ def _ensure_handler() -> None:
     handler.setFormatter(logging.Formatter("mbcontrol: %(message)s"))
     logger.addHandler(handler)
     if logger.level == logging.NOTSET:
-        logger.setLevel(logging.WARNING if os.environ.get("MBCONTROL_QUIET") else logging.INFO)
+        logger.setLevel(logging.WARNING if defaults.get("log.quiet") else logging.INFO)
 
 
 def set_verbosity(level: int) -> None:
     """The "mbcontrol" logger's level (logging.DEBUG, INFO, WARNING ...), e.g. from -v / -q."""
     _ensure_handler()
     logging.getLogger("mbcontrol").setLevel(level)
+
+
+def progress_bar(**options):
+    """A tqdm bar for long work, off when the default "log.quiet" is set (-q, MBCONTROL_QUIET=1)
+    or TQDM_DISABLE is; options go to tqdm (total, desc, unit ...)."""
+    from tqdm.auto import tqdm
+    if defaults.get("log.quiet"):
+        options["disable"] = True
+    return tqdm(**options)

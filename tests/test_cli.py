@@ -213,7 +213,7 @@ def test_models_name_describes_parameters_units_and_controllers(capsys):
     assert info["scene_parameters"] == {"sway_extra_mass": 0.0, "axle_mass": 0.05}
     assert main(["models", "sphere"]) == 0
     text = capsys.readouterr().out
-    assert "pto__damping" in text and "N s/m" in text and "force_max 2000000.0" in text
+    assert "pto__damping" in text and "N s/m" in text and "force_max 2e+06 N, stroke_max 4 m" in text
 
 
 @pytest.mark.parametrize("command", ["simulate", "design"])

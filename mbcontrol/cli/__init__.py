@@ -22,10 +22,13 @@ import os
 import sys
 import warnings
 
+from .. import defaults
 from ..errors import MbcontrolError
 from ..sim.methods import METHODS
-from .commands import (run_bench, run_design, run_fidelity, run_hydro, run_linearize, run_models,
+from .commands import (run_bench, run_fidelity, run_hydro, run_linearize, run_models,
                        run_simulate)
+from .describe import default_help, run_defaults
+from .design import run_design
 from .identify import add_parser as add_identify_parser
 from .sweep import add_parser as add_sweep_parser
 
@@ -103,11 +106,16 @@ def main(argv=None) -> int:
     logger = logging.getLogger("mbcontrol")
     previous, warnings.formatwarning = warnings.formatwarning, _format_warning
     level, bars = logger.level, os.environ.get("TQDM_DISABLE")
+    quiet = defaults.get("log.quiet") if defaults.source("log.quiet") == "set" else None
     try:
         return _main(argv)
     finally:                     # a caller (a test, a notebook) gets its settings back
         warnings.formatwarning = previous
         logger.setLevel(level)
+        if quiet is None:
+            defaults.reset("log.quiet")
+        else:
+            defaults.set("log.quiet", quiet)
         if bars is None:
             os.environ.pop("TQDM_DISABLE", None)
         else:
@@ -122,11 +130,12 @@ def _loudness(args) -> None:
     if args.verbose or args.quiet:
         set_verbosity(logging.DEBUG if args.verbose else logging.WARNING)
     if args.quiet:
-        os.environ["TQDM_DISABLE"] = "1"
+        defaults.set("log.quiet", True)     # our progress bars
+        os.environ["TQDM_DISABLE"] = "1"    # third-party ones (Capytaine's)
 
 
 def _main(argv) -> int:
-    parser = _parser()
+    parser = build_parser()
     args = parser.parse_args(argv)
     _loudness(args)
     if not hasattr(args, "run"):
@@ -140,7 +149,7 @@ def _main(argv) -> int:
         return 1
 
 
-def _parser() -> argparse.ArgumentParser:
+def build_parser() -> argparse.ArgumentParser:
     from mbcontrol.controllers import REGISTRY
     controllers = ", ".join(REGISTRY)
     parser = argparse.ArgumentParser(
@@ -159,6 +168,12 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="print the description as JSON")
     p.set_defaults(run=run_models)
 
+    p = sub.add_parser("defaults", help="every default (time steps, methods, tolerances, cache "
+                                        "folder, workers): value, where it came from, how to "
+                                        "change it")
+    p.add_argument("--json", action="store_true", help="print the table as JSON")
+    p.set_defaults(run=run_defaults)
+
     p = sub.add_parser("hydro", help="load or compute a model's BEM data and fit its radiation "
                                      "model; print the fit report")
     _model_options(p)
@@ -173,11 +188,12 @@ def _parser() -> argparse.ArgumentParser:
     _wave_options(p)
     p.add_argument("--duration", type=float, default=None,
                    help="simulated time, s (default: 30 periods, or 600 s for irregular seas)")
-    p.add_argument("--dt", type=float, default=0.01, help="time step, s (default 0.01)")
-    p.add_argument("--method", choices=tuple(METHODS), default="rk4",
-                   help="\n".join(f"{m.name}: {m.description}" for m in METHODS.values()))
-    p.add_argument("--rtol", type=float, default=1e-8,
-                   help="relative tolerance of the adaptive methods (cvodes, adams)")
+    p.add_argument("--dt", type=float, help=f"time step, s ({default_help('sim.dt')})")
+    p.add_argument("--method", choices=tuple(METHODS),
+                   help="\n".join([*(f"{m.name}: {m.description}" for m in METHODS.values()),
+                                   f"({default_help('sim.method')})"]))
+    p.add_argument("--rtol", type=float, help="relative tolerance of the adaptive methods "
+                   f"(cvodes, adams; {default_help('sim.rtol')})")
     p.add_argument("--controller", metavar="NAME",
                    help=f"PTO controller: {controllers}\n(settings: mbcontrol models MODEL)")
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
@@ -249,9 +265,9 @@ def _parser() -> argparse.ArgumentParser:
                        formatter_class=argparse.RawTextHelpFormatter)
     _model_options(p)
     _wave_options(p)
-    p.add_argument("--tol", type=float, default=0.01,
+    p.add_argument("--tol", type=float,
                    help="largest relative RMS error against the full model, over body motions\n"
-                        "and PTO velocity and power (default 0.01)")
+                        f"and PTO velocity and power ({default_help('fidelity.tol')})")
     p.add_argument("--duration", type=float, default=None,
                    help="comparison record, s (default: the ramp plus 40 peak periods)")
     p.add_argument("--out", help="write the candidate table to this netCDF file")

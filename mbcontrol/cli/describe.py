@@ -11,6 +11,8 @@ import inspect
 import json
 import math
 
+from .. import defaults
+
 _ROTATIONAL_DOFS = ("Roll", "Pitch", "Yaw")
 
 
@@ -78,8 +80,8 @@ def describe(model: str) -> dict:
         "joints": [{"name": j.name, "type": j.type, "parent": j.parent, "child": j.child}
                    for j in scene.joints],
         "ptos": [{"name": p.name, "joint": p.joint, "force_max": limit(p.force_max),
-                  "stroke_max": limit(p.stroke_max), "efficiency": p.efficiency}
-                 for p in scene.ptos],
+                  "stroke_max": limit(p.stroke_max), "efficiency": p.efficiency,
+                  **_pto_units(plant, p)} for p in scene.ptos],
         "hydro": None if plant.hydro is None else {
             "source": plant.hydro.source, "dofs": list(plant.hydro.dofs),
             "radiation_states": int(plant.hydro.radiation.order),
@@ -93,6 +95,12 @@ def describe(model: str) -> dict:
     }
 
 
+def _pto_units(plant, pto) -> dict:
+    """The units of a PTO's force and stroke: N and m, or N m and rad on a revolute joint."""
+    rotary = not pto.between_points and _coordinates(plant).get(pto.joint) == "rad"
+    return {"force_unit": "N m" if rotary else "N", "stroke_unit": "rad" if rotary else "m"}
+
+
 def run_describe(args) -> int:
     info = describe(args.name)
     if args.json:
@@ -104,8 +112,10 @@ def run_describe(args) -> int:
     print("  joints: " + ", ".join(f"{j['name']} ({j['type']}, {j['parent']} -> {j['child']})"
                                     for j in info["joints"]))
     for p in info["ptos"]:
-        print(f"  PTO {p['name']} on {p['joint']}: force_max {p['force_max'] or 'none'}, "
-              f"stroke_max {p['stroke_max'] or 'none'}, efficiency {p['efficiency']:g}")
+        force = f"{p['force_max']:g} {p['force_unit']}" if p["force_max"] else "none"
+        stroke = f"{p['stroke_max']:g} {p['stroke_unit']}" if p["stroke_max"] else "none"
+        print(f"  PTO {p['name']} on {p['joint'] or 'two body points'}: force_max {force}, "
+              f"stroke_max {stroke}, efficiency {p['efficiency']:g}")
     h = info["hydro"]
     if h:
         band = h["response_band"]
@@ -128,4 +138,28 @@ def run_describe(args) -> int:
         shown = ", ".join(f"{k}={'(the run wave)' if k == 'wave' else v}"
                           for k, v in settings.items())
         print(f"    {name:12s} {shown}")
+    return 0
+
+
+def default_help(key: str) -> str:
+    """"default 0.01 s: sim.dt" for a --help text (the value in force, environment included)."""
+    entry = next(row for row in defaults.table() if row["key"] == key)
+    unit = f" {entry['unit']}" if entry["unit"] else ""
+    return f"default {entry['value']}{unit}: '{key}' in mbcontrol defaults"
+
+
+def run_defaults(args) -> int:
+    """`mbcontrol defaults [--json]`: every default, its value and where the value came from."""
+    rows = defaults.table()
+    if args.json:
+        print(json.dumps(rows, indent=2))
+        return 0
+    width = max(len(r["key"]) for r in rows)
+    print(f"{'key':<{width}}  {'value':<24} {'from':<10} environment variable")
+    for r in rows:
+        value = f"{r['value']}{' ' + r['unit'] if r['unit'] else ''}"
+        print(f"{r['key']:<{width}}  {value:<24} {r['source']:<10} {r['env']}\n"
+              f"{'':<{width}}  {r['doc']}")
+    print("\nChange one for a shell with its environment variable, in Python with "
+          "mbcontrol.defaults.set(key, value);\na command's own flag wins over both.")
     return 0

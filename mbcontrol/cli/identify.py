@@ -6,6 +6,8 @@ import sys
 import warnings
 from pathlib import Path
 
+from .describe import default_help
+
 IDENTIFY_HELP = """Fit a model's unknown parameters so it reproduces measured regular-wave runs.
 
 Data files follow the flume dataset's naming SPPH[_R] (../shared/data/tank, its README): series
@@ -59,16 +61,17 @@ def add_parser(sub) -> None:
                    help="a parameter to fit (repeatable; default: the scene's [identify] table)")
     p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
                    help="a fixed parameter value (repeatable)")
-    p.add_argument("--method", choices=("gauss-newton", "nelder-mead"), default="gauss-newton")
+    p.add_argument("--method", choices=("gauss-newton", "nelder-mead"),
+                   help=f"optimiser ({default_help('identify.method')})")
     p.add_argument("--cost", choices=("harmonic", "peaks", "timeseries"), default="harmonic")
     p.add_argument("--phase", action="store_true", help="harmonic cost: fit phases too")
     p.add_argument("--starts", type=int, default=1, help="multi-start: random starts in the bounds")
     p.add_argument("--validate", nargs="+", default=[], metavar="FILE",
                    help="runs to predict with the fitted values (not fitted)")
-    p.add_argument("--dt", type=float, default=0.01, help="simulation step, s (0.01)")
-    p.add_argument("--settle", type=float, default=60.0,
-                   help="simulated time before each steady window, s (60: the flume "
-                        "model's lightly damped 8 s sway mode needs it to settle)")
+    p.add_argument("--dt", type=float, help=f"simulation step, s ({default_help('identify.dt')})")
+    p.add_argument("--settle", type=float,
+                   help="simulated time before each steady window, s (the flume model's "
+                        f"lightly damped 8 s sway mode needs 60; {default_help('identify.settle')})")
     p.add_argument("--drop-bad", action="store_true",
                    help="skip unusable runs with a warning instead of stopping")
     p.add_argument("--out", metavar="DIR", help="write summary.json, tables and figures here")

@@ -4,6 +4,9 @@ from __future__ import annotations
 import json
 import sys
 
+from .. import defaults
+from .describe import default_help
+
 SWEEP_HELP = """Simulate a model in closed loop over sea states (an Hs x Tp grid or a weighted
 list), wave seeds and varied settings, and report power, capture width and annual energy.
 
@@ -62,18 +65,30 @@ def add_parser(sub) -> None:
     p.add_argument("--vary", action="append", default=[], metavar="NAME=v1,v2,...",
                    help="a swept quantity (repeatable): one dimension per name")
     p.add_argument("--seeds", type=int, default=1, help="wave realisations per sea (1)")
-    p.add_argument("--duration", type=float, default=600.0, help="simulated time per case, s")
-    p.add_argument("--dt", type=float, default=0.05, help="time step, s (0.05)")
-    p.add_argument("--method", default="rk4", help="fixed-step integration method (rk4)")
+    p.add_argument("--duration", type=float,
+                   help=f"simulated time per case, s ({default_help('sweep.duration')})")
+    p.add_argument("--dt", type=float, help=f"time step, s ({default_help('sweep.dt')})")
+    p.add_argument("--method", help="fixed-step integration method "
+                                    f"({default_help('sweep.method')})")
     run = p.add_mutually_exclusive_group()
-    run.add_argument("--workers", type=int, default=None,
-                     help="local Dask workers (default: one per core; 0: no Dask)")
+    run.add_argument("--workers", type=int,
+                     help="local Dask workers (-1: one per core; 0: no Dask; "
+                          f"{default_help('sweep.workers')})")
     run.add_argument("--scheduler", metavar="ADDRESS", help="an existing Dask scheduler")
     p.add_argument("--store", metavar="DIR", help="keep cases and sweep.nc here (resumable)")
     p.add_argument("--width", type=float, help="characteristic width, m (capture width ratio)")
     p.add_argument("--plot", metavar="FILE.png", help="power matrix, capture width, energy")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
     p.set_defaults(run=run_sweep)
+
+
+def _workers(given: int | None) -> int | None:
+    """--workers (else the \"sweep.workers\" default) as sweep() takes it: -1 -> None (one per
+    core), 0 serial, N."""
+    n = defaults.resolve("sweep.workers", given)
+    if n < -1:
+        raise ValueError(f"--workers {n}: expected -1 (one per core), 0 (serial) or a count")
+    return None if n == -1 else n
 
 
 def run_sweep(args) -> int:
@@ -110,7 +125,7 @@ def run_sweep(args) -> int:
         scene_params=dict(_key_value(s, "--scene-param") for s in args.scene_param),
         controller=args.controller, settings=settings,
         duration=args.duration, dt=args.dt, method=args.method, store=args.store,
-        workers=args.workers, scheduler=args.scheduler, width=args.width,
+        workers=_workers(args.workers), scheduler=args.scheduler, width=args.width,
         progress=not args.json)
     if args.plot:
         from ..studies.sweep.plots import plot_sweep

@@ -21,6 +21,7 @@ import xarray as xr
 
 from mbcontrol.errors import HydroError
 
+from ..cache import progress_bar
 from . import _io
 from .frames import to_body_frames
 from .geometry import NED_TO_ZUP, RIGID_DOFS, BemBody, hull_mesh, lid_mesh, mirror_symmetric, validate_body
@@ -155,8 +156,6 @@ def _solve(solver, problems, *, progress: bool, n_jobs: int):
     """Solve ``problems`` (grouped by ω so each influence matrix is built and factorised once)."""
     if n_jobs != 1:
         return solver.solve_all(problems, n_jobs=n_jobs, progress_bar=progress)
-    from tqdm.auto import tqdm
-
     try:  # Capytaine's resolution / depth / irregular-frequency warnings, once for the whole set
         from capytaine.bem import problems_checks as chk
         for check in (chk._check_wavelength_and_mesh_resolution, chk._check_wavelength_and_water_depth,
@@ -168,7 +167,8 @@ def _solve(solver, problems, *, progress: bool, n_jobs: int):
     for p in problems:
         groups[float(p.omega)].append(p)
     results = []
-    for w in tqdm(sorted(groups), desc="BEM (per frequency)", unit="ω", disable=not progress):
+    for w in progress_bar(iterable=sorted(groups), desc="BEM (per frequency)", unit="ω",
+                          disable=not progress):
         results += solver.solve_all(groups[w], progress_bar=False, _check_wavelength=False)
     return results
 

@@ -20,7 +20,13 @@ _DOFS = ("Surge", "Sway", "Heave", "Roll", "Pitch", "Yaw")
 
 
 class Reader:
-    """Typed access to one table of a scene file, with precise error messages."""
+    """Typed access to one table of a scene file, with precise error messages.
+
+    `Reader.record`, when set to a callable, is told of every key a parser allows and reads
+    (section, key, what): `scene.reference` builds the scene-key reference from it, so the
+    reference lists what the parser really takes."""
+
+    record = None
 
     def __init__(self, data, file: str, where: str):
         if data is not None and not isinstance(data, dict):
@@ -40,14 +46,22 @@ class Reader:
     def fail(self, key: str, expected: str):
         raise SceneError(f"{self.file}: {self.field(key)}: {expected}")
 
+    def _note(self, key: str, **what) -> None:
+        if Reader.record is not None:
+            Reader.record(self.where, key, what)
+
     def allow(self, *keys: str) -> None:
+        for key in keys:
+            self._note(key, allowed=True)
         for key in self.data:
             if key not in keys:
                 hint = difflib.get_close_matches(key, keys, n=1)
                 also = f" (did you mean '{hint[0]}'?)" if hint else ""
                 self.fail(key, f"unknown key{also}; expected one of {', '.join(keys)}")
 
-    def _get(self, key: str, default):
+    def _get(self, key: str, default, **what):
+        self._note(key, required=default is _REQUIRED, **what,
+                   **({} if default is _REQUIRED else {"default": default}))
         if key in self.data:
             return self.data[key]
         if default is _REQUIRED:
@@ -56,13 +70,13 @@ class Reader:
 
     # -- nested tables
     def table(self, key: str, required: bool = True) -> "Reader":
-        value = self._get(key, _REQUIRED if required else None)
+        value = self._get(key, _REQUIRED if required else None, shape="table")
         if value is not None and not isinstance(value, dict):
             self.fail(key, f"expected a table, got {type(value).__name__}")
         return Reader(value, self.file, self.field(key))
 
     def tables(self, key: str, required: bool = False) -> list["Reader"]:
-        value = self._get(key, _REQUIRED if required else [])
+        value = self._get(key, _REQUIRED if required else [], shape="[[tables]]")
         if not isinstance(value, list) or (required and not value):
             self.fail(key, f"expected one or more [[{key}]] tables")
         readers = []
@@ -74,7 +88,7 @@ class Reader:
 
     # -- scalars
     def string(self, key: str, default=_REQUIRED):
-        value = self._get(key, default)
+        value = self._get(key, default, shape="string")
         if value is not None and not isinstance(value, str):
             self.fail(key, f"expected a string, got {value!r}")
         return value
@@ -87,19 +101,19 @@ class Reader:
         return value
 
     def boolean(self, key: str, default=_REQUIRED) -> bool:
-        value = self._get(key, default)
+        value = self._get(key, default, shape="true or false")
         if not isinstance(value, bool):
             self.fail(key, f"expected true or false, got {value!r}")
         return value
 
     def choice(self, key: str, options, default=_REQUIRED) -> str:
-        value = self._get(key, default)
+        value = self._get(key, default, options=tuple(options))
         if value not in options:
             self.fail(key, f"expected one of {', '.join(options)}, got {value!r}")
         return value
 
     def number(self, key: str, dimension: str | None, default=_REQUIRED) -> float:
-        value = self._get(key, default)
+        value = self._get(key, default, dimension=dimension, shape="number")
         if value is default and default is not _REQUIRED:
             return value
         return self._convert(key, value, dimension)
@@ -143,7 +157,7 @@ class Reader:
 
     # -- arrays
     def number_list(self, key: str, dimension: str | None, default=_REQUIRED) -> list[float]:
-        value = self._get(key, default)
+        value = self._get(key, default, dimension=dimension, shape="list of numbers")
         if value is default and default is not _REQUIRED:
             return list(value)
         if not isinstance(value, list):
@@ -151,7 +165,7 @@ class Reader:
         return [self._convert(key, v, dimension) for v in value]
 
     def vector(self, key: str, dimension: str | None, default=_REQUIRED):
-        value = self._get(key, default)
+        value = self._get(key, default, dimension=dimension, shape="[x, y, z]")
         if value is default and default is not _REQUIRED:
             return value
         numbers = self.number_list(key, dimension)
@@ -161,7 +175,7 @@ class Reader:
 
     def inertia(self, key: str):
         """[Ixx, Iyy, Izz] or a 3x3 matrix about the CoG; must be symmetric positive definite."""
-        value = self._get(key, _REQUIRED)
+        value = self._get(key, _REQUIRED, dimension="inertia", shape="[Ixx, Iyy, Izz] or 3x3")
         rows = value if isinstance(value, list) else None
         if rows and all(isinstance(r, list) for r in rows):
             matrix = (np.array([[self._convert(key, v, "inertia") for v in r] for r in rows])
@@ -181,13 +195,13 @@ class Reader:
         return tuple(tuple(float(v) for v in row) for row in matrix)
 
     def string_list(self, key: str, default=_REQUIRED) -> list[str]:
-        value = self._get(key, default)
+        value = self._get(key, default, shape="list of strings")
         if not isinstance(value, (list, tuple)) or not all(isinstance(v, str) for v in value):
             self.fail(key, f"expected a list of strings, got {value!r}")
         return list(value)
 
     def dof_list(self, key: str, default=_REQUIRED) -> tuple[str, ...]:
-        value = self._get(key, default)
+        value = self._get(key, default, shape="list of DOF names")
         if (not isinstance(value, (list, tuple)) or not value
                 or any(v not in _DOFS for v in value) or len(set(value)) != len(value)):
             self.fail(key, f"expected distinct DOF names from {', '.join(_DOFS)}, got {value!r}")
@@ -197,7 +211,7 @@ class Reader:
         """Frequencies (rad/s): a list of numbers, a segment {min, max, n, spacing, endpoint}
         or a list of segments (joined, duplicates removed). spacing is "linear" (default) or
         "log"; endpoint (default true) says whether max belongs to the segment."""
-        value = self._get(key, ())
+        value = self._get(key, (), dimension="frequency", shape="frequencies or segments")
         if isinstance(value, dict) or (isinstance(value, list) and value
                                        and all(isinstance(v, dict) for v in value)):
             segments = [value] if isinstance(value, dict) else value

@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import defaults
 from .checks import Reader, catenary_geometry, check_topology
 from .model import (DOF_NAMES, JOINT_TYPES, Body, Drag, EndStop, Friction, Geometry, HydroSettings,
                     Joint, Mooring, Obstacle, Pto, Scene, Water)
@@ -239,7 +240,8 @@ def _hydro(r: Reader, path: Path) -> HydroSettings:
         omega=omega,
         headings=tuple(r.finite_list("headings", "angle", default=(0.0,))),
         lid=r.boolean("lid", default=True),
-        radiation_tol=r.positive("radiation_tol", None, default=0.01),
+        radiation_tol=r.positive("radiation_tol", None,
+                                 default=defaults.get("hydro.radiation_tol")),
         dofs=r.dof_list("dofs", default=DOF_NAMES),
         fit_omega_max=r.positive("fit_omega_max", "frequency", default=math.inf, finite=False),
         response_band=tuple(band) if band is not None else None,

@@ -20,6 +20,8 @@ from importlib import metadata
 import numpy as np
 import xarray as xr
 
+from .. import defaults
+from ..cache import progress_bar
 from ..errors import SimulationError
 from ..plant import provenance
 from ..results import jsonable
@@ -27,13 +29,14 @@ from . import diagnose, integrators, sampled
 from .moorings import mooring_report
 
 
-def simulate(plant, wave=None, *, duration: float, dt: float = 0.01, controller=None,
-             method: str = "rk4", x0=None, params=None, compiled: bool = True,
-             rtol: float = 1e-8, progress: bool = False, audit: bool = True) -> xr.Dataset:
+def simulate(plant, wave=None, *, duration: float, dt: float | None = None, controller=None,
+             method: str | None = None, x0=None, params=None, compiled: bool = True,
+             rtol: float | None = None, progress: bool = False, audit: bool = True) -> xr.Dataset:
     """Simulate `plant` in `wave` (None: still water) for `duration` s with step `dt` s.
 
-    method: a name in mbcontrol.sim.METHODS. For fixed-step methods dt is the step;
-    for the adaptive ones ("cvodes", "adams") dt is the output (and controller) grid and
+    dt, method and rtol left out take the defaults "sim.dt" (0.01 s), "sim.method" ("rk4")
+    and "sim.rtol" (1e-8) of mbcontrol.defaults. method: a name in mbcontrol.sim.METHODS.
+    For fixed-step methods dt is the step; for the adaptive ones ("cvodes", "adams") dt is the output (and controller) grid and
     rtol sets the accuracy. params: a dict of parameter overrides or a full vector. With a
     controller, the PTO force is the controller's command alone: the scene's PTO damping and
     stiffness are zeroed unless params sets them. audit: check the energy balance (see
@@ -44,6 +47,8 @@ def simulate(plant, wave=None, *, duration: float, dt: float = 0.01, controller=
     and a static law has its held loop checked first (sim.sampled: a RuntimeWarning when
     unstable; the verdict in attrs["sampled_loop"], which analysis.validity reads).
     """
+    dt, method = defaults.resolve("sim.dt", dt), defaults.resolve("sim.method", method)
+    rtol = defaults.resolve("sim.rtol", rtol)
     if duration <= 0 or dt <= 0 or dt > duration:
         raise ValueError(f"expected 0 < dt <= duration, got dt={dt}, duration={duration}")
     spec = integrators.method(method)
@@ -333,8 +338,7 @@ def _divergence_check(plant, dt, method, bar, why=None):
 def _progress_bar(progress: bool, n: int):
     if not progress:
         return None
-    from tqdm.auto import tqdm
-    return tqdm(total=n, unit="step", desc="simulate", leave=False)
+    return progress_bar(total=n, unit="step", desc="simulate", leave=False)
 
 
 def _dataset(plant, t, X, U, W, Y, eta, wave, controller, method, dt, p, wall):

@@ -19,6 +19,7 @@ import warnings
 import casadi as ca
 import numpy as np
 
+from ..cache import progress_bar
 from ..errors import SimulationError
 from . import integrators
 
@@ -176,8 +177,7 @@ def stability_table(scene, wave, *, methods=("rk3", "rk4", "dopri5", "exp-rk4"),
     rows, jobs = [], [(s, m) for s in scenarios for m in methods]
     bar = None
     if progress:
-        from tqdm.auto import tqdm
-        bar = tqdm(total=len(jobs), desc="stability", leave=False)
+        bar = progress_bar(total=len(jobs), desc="stability", leave=False)
     for (name, plant, controller), method in jobs:
         linear = None                     # switching control: no linear analysis applies
         if name == "end stop":            # the step map with the stop engaged, held there

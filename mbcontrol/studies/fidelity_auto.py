@@ -20,6 +20,8 @@ from dataclasses import dataclass, field
 import numpy as np
 import xarray as xr
 
+from .. import defaults
+from ..cache import progress_bar
 from ..plant import ProcessPlant
 from ..plant.fidelity import Fidelity, FidelityError, has_couplings, plant_for
 from ..plant.freeze import as_wave_list
@@ -142,13 +144,14 @@ class FidelityReport:
         return ds
 
 
-def auto(scene: Scene | str, waves, tol: float = 0.01, *, duration: float | None = None,
+def auto(scene: Scene | str, waves, tol: float | None = None, *, duration: float | None = None,
          dt: float | None = None, signals=None, method: str = "rk4", params=None,
          radiation_tols=RADIATION_LADDER, options=("radiation_tol", "couplings", "freeze",
                                                    "kinematics"),
          repeats: int = 3, progress: bool = False) -> FidelityReport:
     """The cheapest model of `scene` whose error in `waves` is at most `tol` (see module doc).
 
+    tol : the error allowed (default "fidelity.tol", 0.01, in mbcontrol.defaults).
     waves : a Wave or a list (errors and walls: worst and sum over them). duration (s) : default
         the longest ramp plus 40 peak periods. dt (s) : default T_p/200 (shortest T_p), halved (up
         to 3 times) until the full model's own step error, measured against dt/2, is below
@@ -163,6 +166,7 @@ def auto(scene: Scene | str, waves, tol: float = 0.01, *, duration: float | None
     then the lower error.
     """
     scene = load_scene(scene) if not isinstance(scene, Scene) else scene
+    tol = defaults.resolve("fidelity.tol", tol)
     wave_list = as_wave_list(waves)
     if not wave_list:
         raise FidelityError("auto: waves: expected a Wave or a non-empty list of Waves")
@@ -215,8 +219,7 @@ def _peak_period(wave) -> float:
 def _bar(progress, total):
     if not progress:
         return None
-    from tqdm.auto import tqdm
-    return tqdm(total=total, desc="fidelity candidates", leave=False)
+    return progress_bar(total=total, desc="fidelity candidates", leave=False)
 
 
 def _tick(bar):

@@ -21,6 +21,7 @@ import warnings
 import numpy as np
 import xarray as xr
 
+from ..cache import progress_bar
 from ..errors import SimulationError
 from ..sim import METHODS
 
@@ -214,8 +215,7 @@ def plot(ds: xr.Dataset, path=None, tol: float | None = 0.01):
 def _bar(progress: bool, total: int):
     if not progress:
         return None
-    from tqdm.auto import tqdm
-    return tqdm(total=total, desc="work-precision", leave=False)
+    return progress_bar(total=total, desc="work-precision", leave=False)
 
 
 def _tick(bar) -> None:

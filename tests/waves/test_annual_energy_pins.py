@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import readme
 from mbcontrol import waves
 
 SITES = Path(__file__).resolve().parents[3] / "shared" / "data" / "sites"
@@ -57,9 +58,18 @@ def _aep(seas, damping):
             summary["annual_energy_unchecked_MWh"])
 
 
+def _as_quoted(site: str, valid: float, coverage: float, linear: float) -> None:
+    """The README's table ("site") rounds these: valid-seas MWh, share of the year, linear MWh."""
+    *_, share, valid_mwh, linear_mwh = readme.numbers(" ".join(readme.row("site", site)))
+    assert abs(share - 100 * coverage) <= 0.051, (site, share, coverage)
+    assert abs(valid_mwh - valid) <= 0.51 and abs(linear_mwh - linear) <= 0.51, \
+        (site, valid_mwh, valid, linear_mwh, linear)
+
+
 def test_pacwave_annual_energy(tuned):
     seas, damping = tuned
     valid, coverage, linear = _aep(seas, damping)
+    _as_quoted("PacWave South", valid, coverage, linear)
     assert linear == pytest.approx(1705.3, rel=1e-3)
     assert (valid, coverage) == pytest.approx(PACWAVE_VALID, rel=1e-3)
 
@@ -73,6 +83,7 @@ def test_buoy_46042_annual_energy(tuned):
     bins = waves.bin_seas(table, gamma=3.3)
     assert len(bins) == 92 and sum(s.weight for s in bins) == pytest.approx(1.0)
     valid, coverage, linear = _aep(bins, damping)
+    _as_quoted("NOAA 46042", valid, coverage, linear)
     assert linear == pytest.approx(1313.9, rel=1e-3)
     assert (valid, coverage) == pytest.approx(BUOY_VALID, rel=1e-3)
 

@@ -15,6 +15,8 @@ import warnings
 
 import numpy as np
 
+from ...cache import progress_bar
+
 TIE = 0.01           # scores within 1 % (relative) of the best: the smaller structure wins
 
 
@@ -83,5 +85,4 @@ def table(cv: dict) -> str:
 def _bar(progress: bool, total: int):
     if not progress:
         return None
-    from tqdm.auto import tqdm
-    return tqdm(total=total, desc="cross-validation", unit="fold", leave=False)
+    return progress_bar(total=total, desc="cross-validation", unit="fold", leave=False)

@@ -32,6 +32,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ... import defaults
+from ...cache import progress_bar
+
 METHODS = ("gauss-newton", "nelder-mead")
 CORRELATION_LIMIT = 0.95
 CONDITION_LIMIT = 1e6
@@ -66,11 +69,13 @@ class FitResult:
     uncertainty_method: str = "independent residuals"
 
 
-def fit(problem, method: str = "gauss-newton", *, starts: int = 1, seed: int = 0,
+def fit(problem, method: str | None = None, *, starts: int = 1, seed: int = 0,
         max_evaluations: int | None = None, tol: float = 1e-8, progress: bool = False,
         theta0=None) -> FitResult:
     """Fit `problem` (an Identification) by `method`; starts > 1 adds random starts inside
-    the bounds (uniform in theta) and keeps the best. Returns a FitResult with uncertainty."""
+    the bounds (uniform in theta) and keeps the best. Returns a FitResult with uncertainty.
+    method left out: the default "identify.method" ("gauss-newton"; mbcontrol.defaults)."""
+    method = defaults.resolve("identify.method", method)
     from scipy.optimize import least_squares, minimize
     if method not in METHODS:
         raise ValueError(f"method {method!r}: expected one of {', '.join(METHODS)}")
@@ -230,8 +235,7 @@ def _covariance(params, theta, r, J, blocks=None):
 def _bar(progress: bool, method: str):
     if not progress:
         return None
-    from tqdm.auto import tqdm
-    return tqdm(desc=f"identify ({method})", unit="eval", leave=False)
+    return progress_bar(desc=f"identify ({method})", unit="eval", leave=False)
 
 
 def _tick(bar, cost: float) -> None:

@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ... import waves
+from ... import defaults, waves
 from ...plant import Fidelity, build_plant
 from ...scene import load_scene
 from ...sim.batch import batch_states
@@ -107,7 +107,8 @@ class Identification:
     overrides of other plant parameters; weights: channel -> w_c (default 1); settle: s of
     simulation before each window (the model starts at rest: long enough for its slowest mode
     to die out, so that the window holds its steady response); ramp_periods: the simulated
-    wave's half-cosine ramp; dt: step (s); direction: wave heading in the n-frame (rad);
+    wave's half-cosine ramp; dt: step (s; default "identify.dt", 0.01 s, and settle "identify.settle",
+    60 s, in mbcontrol.defaults); direction: wave heading in the n-frame (rad);
     batch: step a plant's runs together in one compiled call, each for the longest run's
     duration (True), or one call per run for its own duration (False, the default: measured
     10-20 % faster on the flume data, `benchmarks/identify.py`, as a compiled call of 512
@@ -118,7 +119,7 @@ class Identification:
 
     def __init__(self, scene, runs, fit, *, outputs: dict, cost: str = "harmonic",
                  phase: bool = False, weights: dict | None = None, params: dict | None = None,
-                 dt: float = 0.01, settle: float = 60.0, ramp_periods: float = 5.0,
+                 dt: float | None = None, settle: float | None = None, ramp_periods: float = 5.0,
                  direction: float = math.pi / 2, method: str = "rk4",
                  samples_per_period: int = 40, compiled: bool = True, batch: bool = False,
                  drop_absent: bool = False):
@@ -129,6 +130,7 @@ class Identification:
         names = [p.name for p in fit]
         if len(set(names)) != len(names):
             raise ValueError(f"identification: a parameter is listed twice in {names}")
+        dt, settle = defaults.resolve("identify.dt", dt), defaults.resolve("identify.settle", settle)
         self.options = dict(cost=cost, phase=phase, weights=weights, params=params, dt=dt,
                             settle=settle, ramp_periods=ramp_periods, direction=direction,
                             method=method, samples_per_period=samples_per_period,

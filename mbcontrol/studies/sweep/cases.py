@@ -10,6 +10,8 @@ import itertools
 import json
 from dataclasses import asdict, dataclass, field
 
+from ... import defaults
+
 # The seas themselves (SeaState, grids, the site CSV, Te/Tp) live in the waves package;
 # re-exported here so that `from mbcontrol.studies.sweep.cases import SeaState` keeps working.
 from ...waves.sites import WEIGHT_SUM_TOLERANCE, SeaState, grid, read_seas  # noqa: F401
@@ -29,7 +31,7 @@ class Case:
     scene_params: tuple = ()            # fixed scene parameters
     controller: str | None = None
     settings: tuple = ()                # fixed controller settings
-    duration: float = 600.0
+    duration: float = 600.0             # s; build_cases fills these from the "sweep.*" defaults
     dt: float = 0.05
     method: str = "rk4"
     roles: dict = field(default_factory=dict, compare=False)   # varied name -> its kind
@@ -55,11 +57,13 @@ class Case:
 
 def build_cases(model: str, seas, *, seeds: int = 1, vary: dict | None = None, roles=None,
                 params=None, scene_params=None, controller=None, settings=None,
-                duration: float = 600.0, dt: float = 0.05, method: str = "rk4",
-                inputs: dict | None = None) -> list[Case]:
+                duration: float | None = None, dt: float | None = None,
+                method: str | None = None, inputs: dict | None = None) -> list[Case]:
     """Every sea x seed x combination of the varied values. roles: varied name -> "param",
     "scene" or "setting" (see `roles_for`); inputs: the plant's provenance (content hashes),
-    part of every case's key."""
+    part of every case's key. duration, dt and method left out: the "sweep.*" defaults."""
+    duration = defaults.resolve("sweep.duration", duration)
+    dt, method = defaults.resolve("sweep.dt", dt), defaults.resolve("sweep.method", method)
     vary = dict(vary or {})
     names = list(vary)
     cases = []

@@ -20,6 +20,8 @@ import sys
 import time
 from collections import defaultdict
 
+from ...cache import progress_bar
+
 _PLANTS: dict = {}
 # The last light run of this process, kept until the next one has its arrays: freed at once,
 # a run's records (35 MB for rm3 over an hour) top glibc's heap and go back to the kernel, and
@@ -311,5 +313,4 @@ def _on_dask(queue: list, save, client, per_task) -> None:
 def _bar(progress: bool, total: int, reused: int):
     if not progress:
         return None
-    from tqdm.auto import tqdm
-    return tqdm(total=total, initial=reused, desc="sweep", unit="case")
+    return progress_bar(total=total, initial=reused, desc="sweep", unit="case")

@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ... import defaults
 from ...plant import provenance
 from ...results import jsonable
 from .cases import build_cases, roles_for
@@ -21,7 +22,7 @@ from .store import CaseStore, assemble
 
 def sweep(model: str, seas, *, seeds: int = 1, vary: dict | None = None, params=None,
           scene_params=None, controller: str | None = None, settings=None,
-          duration: float = 600.0, dt: float = 0.05, method: str = "rk4",
+          duration: float | None = None, dt: float | None = None, method: str | None = None,
           store=None, workers: int | None = 0, scheduler: str | None = None,
           width: float | None = None, progress: bool = True):
     """Run a sweep and return (Dataset, summary).
@@ -30,12 +31,16 @@ def sweep(model: str, seas, *, seeds: int = 1, vary: dict | None = None, params=
     parameter, plant parameter or controller setting); workers: 0 serial, None one Dask
     worker per core, N workers; scheduler: a Dask scheduler address; store: a folder (resume:
     finished cases are not run again; `<store>/sweep.nc` holds the Dataset); width: the
-    characteristic width (m) for the capture width ratio."""
+    characteristic width (m) for the capture width ratio. duration, dt (s) and method left out
+    take the defaults "sweep.duration" (600 s), "sweep.dt" (0.05 s) and "sweep.method"
+    (mbcontrol.defaults)."""
     from mbcontrol.controllers import REGISTRY
 
     from ...plant import build_plant
     from ...scene import load_scene
     start = time.perf_counter()
+    duration = defaults.resolve("sweep.duration", duration)
+    dt, method = defaults.resolve("sweep.dt", dt), defaults.resolve("sweep.method", method)
     vary = {k: list(v) for k, v in (vary or {}).items()}
     scene = load_scene(model, scene_params or None)
     if controller is not None and controller not in REGISTRY:

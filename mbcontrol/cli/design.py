@@ -1,0 +1,131 @@
+"""`mbcontrol design`: tune a controller, check and bound it, simulate it, print how to re-run it."""
+from __future__ import annotations
+
+import json
+import sys
+
+from .commands import _plant, _wave
+
+
+def run_design(args) -> int:
+    from mbcontrol.controllers.design import design
+    plant = _plant(args)
+    if args.wave == "none":
+        raise ValueError("design needs a wave: --wave regular|jonswap|pm")
+    wave = _wave(args, plant, args.duration or 600.0)
+    result = design(plant, wave, args.controller, pto=args.pto, simulate_s=args.duration,
+                    dt=args.dt, bounds={"auto": True, "full": "full", "off": False}[args.bounds],
+                    limits=not args.unconstrained)
+    command = _simulate_command(args, result)
+    if args.json:
+        print(json.dumps({**result.to_dict(), "model": plant.name, "wave": wave.describe(),
+                          "simulate_command": command}, indent=2, allow_nan=False))
+    else:
+        _print_design(plant, wave, result, command)
+    for note in result.warnings:
+        print(f"mbcontrol: warning: {note}", file=sys.stderr)
+    return 0
+
+
+def _simulate_command(args, result) -> str:
+    """The `mbcontrol simulate` command line that re-runs the design's simulation; numbers
+    in repr form, which round-trips a float exactly, except duration and step: 12
+    significant digits (289.992, not 289.99199999999996: the same steps)."""
+    import shlex
+    words = ["mbcontrol", "simulate", args.model]
+    for item in args.scene_param:
+        words += ["--scene-param", item]
+    words += ["--wave", args.wave]
+    if args.wave == "regular":
+        words += ["--height", repr(args.height), "--period", repr(args.period)]
+    else:
+        words += ["--hs", repr(args.hs), "--tp", repr(args.tp), "--seed", str(args.seed)]
+        if args.wave == "jonswap":
+            words += ["--gamma", repr(args.gamma)]
+    sim = result.simulation
+    if sim is not None:
+        words += ["--duration", f"{sim['duration_s']:.12g}", "--dt", f"{sim['dt_s']:.12g}"]
+    words += ["--controller", result.name]
+    for key, value in result.parameters.items():
+        items = value.items() if isinstance(value, dict) else [(None, value)]
+        for pto, v in items:          # per-PTO values as KEY.PTO=VALUE
+            words += ["--set", f"{key}{'' if pto is None else '.' + pto}={_tidy(v)}"]
+    return shlex.join(words)
+
+
+def _power(value) -> str:
+    if value is None:
+        return "n/a"
+    for scale, unit in ((1e6, "MW"), (1e3, "kW"), (1.0, "W"), (1e-3, "mW")):
+        if abs(value) >= scale or scale == 1e-3:
+            return f"{value / scale:.4g} {unit}"
+
+
+def _print_design(plant, wave, result, command) -> None:
+    F = plant.units(f"{result.pto}__force")
+    X = plant.units(f"{result.pto}__position")
+    units = {"damping": f"{F} s/{X}", "stiffness": f"{F}/{X}", "force_max": F, "stroke_max": X,
+             "rate_max": f"{F}/s"}
+    sea = (f"a regular wave (H {wave.settings['height']:.6g} m, T {wave.settings['period']:.6g} s)"
+           if wave.kind == "regular" else
+           f"a {wave.kind.upper()} sea (Hs "
+           f"{wave.settings['hs']:.6g} m, Tp {wave.settings['tp']:.6g} s, seed "
+           f"{wave.settings['seed']})")
+    print(f"{plant.name}: {result.name} control of PTO {result.pto!r} designed for {sea}")
+    print("  parameters:")
+    for key, value in result.parameters.items():
+        print(f"    {key} = {_tidy(value)} {units.get(key, 's')}")
+    print(f"  predicted (linear theory): {_power(result.predicted_power_W)}")
+    if "other_ptos" in result.tuner:
+        print(f"  other PTOs: {result.tuner['other_ptos']}")
+    if "simulated_power_W" in result.tuner:
+        print(f"  tuner's own simulation: {_power(result.tuner['simulated_power_W'])}")
+    if result.margins is not None:
+        print(f"  stability: {result.margins.message}")
+    b = result.bound
+    limits = f"|F| <= {b['force_max']:.4g} {F}, |x| <= {b['stroke_max']:.4g} {X}"
+    constrained = (_power(b["constrained_W"]) if b["constrained_W"] is not None
+                   else f"n/a ({b['constrained_reason']})")
+    if b.get("constrained_kind") == "reference":        # not a bound on what was simulated
+        constrained += f" - a REFERENCE, not a bound: {b['constrained_kind_reason']}"
+    print(f"  bounds: complex-conjugate {_power(b['complex_conjugate_W'])}; constrained "
+          f"({limits}) {constrained}")
+    if b.get("total_complex_conjugate_W") is not None:
+        print(f"  bound on all PTOs together (multiport complex-conjugate): "
+              f"{_power(b['total_complex_conjugate_W'])}")
+    m = result.metrics
+    if m is None:
+        print("  not simulated (see the warning)")
+    else:
+        sim = result.simulation
+        pct = result.percent_of_bound
+        kind = {"constrained": "reference" if b.get("constrained_kind") == "reference"
+                else "bound"}
+        share = ", ".join(f"{v:.1f} % of the {k.replace('_', '-')} {kind.get(k, 'bound')}"
+                          for k, v in pct.items() if v is not None)
+        print(f"  simulated ({sim['duration_s']:.4g} s, dt {sim['dt_s']:.4g} s, nonlinear plant): "
+              f"mean absorbed power {_power(m['mean_power_W'])} ({share})")
+        if "total_mean_power_W" in m:
+            print(f"    all PTOs together: {_power(m['total_mean_power_W'])} "
+                  f"({pct['total_complex_conjugate']:.1f} % of their bound)")
+        print(f"    max force {m['max_force']:.4g} {F}, max stroke {m['max_stroke']:.4g} {X}, "
+              f"peak/mean power {m['papr']:.3g}, samples outside the limits "
+              f"{100 * m['violation_fraction']:.3g} %")
+        estimator = sim["summary"].get("estimator")
+        if estimator:
+            print(f"    excitation estimate error {100 * estimator['excitation_error']:.3g} % "
+                  f"(RMS, against the simulation's true excitation, after "
+                  f"{estimator['window_start_s']:.4g} s)")
+        print("    result: valid (bound, energy balance, linear-hydrodynamics range checked)"
+              if result.valid else "    result: INVALID - " + "; ".join(result.invalid_reasons))
+    print(f"  re-run: {command}")
+
+
+def _tidy(value) -> str:
+    """A setting as printed: floats to 6 significant digits (the re-run reproduces the design
+    to ~1e-6), per-PTO dicts and other values as they are."""
+    if isinstance(value, float):
+        return f"{value:.6g}"
+    if isinstance(value, dict):
+        return "{" + ", ".join(f"{k}: {_tidy(v)}" for k, v in value.items()) + "}"
+    return repr(value)

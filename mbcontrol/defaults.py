@@ -1,0 +1,153 @@
+"""Every default of the toolbox in one place, documented, and overridable.
+
+Like python-control's ``config.defaults``: a function whose argument is left out (``None``)
+takes its value from here, so one setting changes every call that does not say otherwise.
+The value of a key is, first match wins:
+
+1. set in this process: ``defaults.set("sim.dt", 0.005)`` or ``with defaults.override(...)``;
+2. the environment: ``MBCONTROL_SIM_DT=0.005`` (the key upper-cased, dots as underscores;
+   the cache folder keeps its historical name ``MBCONTROL_CACHE``);
+3. the built-in value below.
+
+An explicit argument (or a CLI flag) always wins over all three. ``mbcontrol defaults``
+lists every key with its value and where the value came from.
+"""
+from __future__ import annotations
+
+import os
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+
+
+@dataclass(frozen=True)
+class Default:
+    value: object
+    unit: str           # "" when dimensionless or not a quantity
+    doc: str
+    kind: type = float  # how an environment value is read
+    env: str = ""       # the environment variable, when not the key's own
+
+    def variable(self, key: str) -> str:
+        return self.env or "MBCONTROL_" + key.upper().replace(".", "_")
+
+
+_REGISTRY: dict[str, Default] = {
+    "cache.folder": Default(str(Path.home() / ".cache" / "mbcontrol"), "",
+                            "BEM results, radiation fits and compiled code", str,
+                            env="MBCONTROL_CACHE"),
+    "log.quiet": Default(False, "", "hide status lines and progress bars (the CLI's -q)", bool,
+                         env="MBCONTROL_QUIET"),
+    "sim.dt": Default(0.01, "s", "time step of simulate() and simulate --dt"),
+    "sim.method": Default("rk4", "", "integration method of simulate() (mbcontrol.sim.METHODS)",
+                          str),
+    "sim.rtol": Default(1e-8, "", "relative tolerance of the adaptive methods (cvodes, adams)"),
+    "sweep.duration": Default(600.0, "s", "simulated time of each sweep case"),
+    "sweep.dt": Default(0.05, "s", "time step of sweep cases"),
+    "sweep.method": Default("rk4", "", "fixed-step method of sweep cases", str),
+    "sweep.workers": Default(-1, "", "local Dask workers of a sweep: -1 one per core, "
+                                     "0 serial in this process", int),
+    "identify.dt": Default(0.01, "s", "simulation step of identification runs"),
+    "identify.method": Default("gauss-newton", "", "optimiser: gauss-newton or nelder-mead",
+                               str),
+    "identify.settle": Default(60.0, "s", "time each identification run is simulated from rest "
+                                          "before its measured window"),
+    "hydro.radiation_tol": Default(0.01, "", "radiation fit error of a scene that sets none "
+                                             "([hydro] radiation_tol)"),
+    "fidelity.tol": Default(0.01, "", "error a simplified model may add (fidelity auto)"),
+}
+
+_set: dict[str, object] = {}
+
+
+def keys() -> list[str]:
+    return sorted(_REGISTRY)
+
+
+def _entry(key: str) -> Default:
+    try:
+        return _REGISTRY[key]
+    except KeyError:
+        raise KeyError(f"unknown default {key!r}; expected one of {', '.join(keys())}") from None
+
+
+def _read(key: str, entry: Default, text: str):
+    name = entry.variable(key)
+    try:
+        if entry.kind is bool:
+            lowered = text.strip().lower()
+            if lowered in ("", "0", "false", "no", "off"):
+                return False
+            if lowered in ("1", "true", "yes", "on"):
+                return True
+            raise ValueError
+        return entry.kind(text)
+    except ValueError:
+        raise ValueError(f"environment variable {name}={text!r}: expected "
+                         f"{'true or false' if entry.kind is bool else 'a ' + entry.kind.__name__}"
+                         f" ({entry.doc})") from None
+
+
+def get(key: str):
+    """The value of default `key` (see the module's docstring for the order)."""
+    entry = _entry(key)
+    if key in _set:
+        return _set[key]
+    text = os.environ.get(entry.variable(key))
+    if text is not None:
+        return _read(key, entry, text)
+    return entry.value
+
+
+def resolve(key: str, value):
+    """`value` unless it is None, else the default `key`: for arguments left out."""
+    return get(key) if value is None else value
+
+
+def source(key: str) -> str:
+    """Where get(key) comes from: "set", the environment variable's name, or "built-in"."""
+    entry = _entry(key)
+    if key in _set:
+        return "set"
+    if entry.variable(key) in os.environ:
+        return entry.variable(key)
+    return "built-in"
+
+
+def set(key: str, value) -> None:  # noqa: A001 (the registry's verb, as in control.config)
+    """Set default `key` for this process (reset(key) undoes it)."""
+    entry = _entry(key)
+    if entry.kind is float and isinstance(value, int) and not isinstance(value, bool):
+        value = float(value)
+    if not isinstance(value, entry.kind):
+        raise TypeError(f"default {key!r}: expected a {entry.kind.__name__}, got {value!r}")
+    _set[key] = value
+
+
+def reset(key: str | None = None) -> None:
+    """Forget what set() changed: one key, or all."""
+    if key is None:
+        _set.clear()
+    else:
+        _entry(key)
+        _set.pop(key, None)
+
+
+@contextmanager
+def override(**values):
+    """Set defaults for a block: ``with override(sim_dt=0.005):`` (dots as underscores)."""
+    previous = dict(_set)
+    try:
+        for name, value in values.items():
+            key = name.replace("_", ".", 1)
+            set(key, value)
+        yield
+    finally:
+        _set.clear()
+        _set.update(previous)
+
+
+def table() -> list[dict]:
+    """Every default: key, value, unit, source, environment variable and description."""
+    return [{"key": k, "value": get(k), "unit": _REGISTRY[k].unit, "source": source(k),
+             "env": _REGISTRY[k].variable(k), "doc": _REGISTRY[k].doc} for k in keys()]

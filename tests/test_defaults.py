@@ -1,0 +1,72 @@
+"""The defaults registry (mbcontrol/defaults.py): one value per key, overridable in order
+set() > environment > built-in, and the functions that take their defaults from it."""
+import json
+
+import numpy as np
+import pytest
+
+from mbcontrol import defaults
+from mbcontrol.cli import main
+
+
+@pytest.fixture(autouse=True)
+def _clean():
+    defaults.reset()
+    yield
+    defaults.reset()
+
+
+def test_order_set_over_environment_over_built_in(monkeypatch):
+    assert defaults.get("sim.dt") == 0.01 and defaults.source("sim.dt") == "built-in"
+    monkeypatch.setenv("MBCONTROL_SIM_DT", "0.002")
+    assert defaults.get("sim.dt") == 0.002 and defaults.source("sim.dt") == "MBCONTROL_SIM_DT"
+    defaults.set("sim.dt", 0.005)
+    assert defaults.get("sim.dt") == 0.005 and defaults.source("sim.dt") == "set"
+    defaults.reset("sim.dt")
+    assert defaults.get("sim.dt") == 0.002
+    with defaults.override(sim_method="dopri5"):
+        assert defaults.get("sim.method") == "dopri5"
+    assert defaults.get("sim.method") == "rk4"
+
+
+def test_bad_values_name_the_variable_or_key(monkeypatch):
+    monkeypatch.setenv("MBCONTROL_SIM_DT", "fast")
+    with pytest.raises(ValueError, match="MBCONTROL_SIM_DT='fast': expected a float"):
+        defaults.get("sim.dt")
+    with pytest.raises(KeyError, match="unknown default 'sim.step'.*sim.dt"):
+        defaults.get("sim.step")
+    with pytest.raises(TypeError, match="'sim.method': expected a str"):
+        defaults.set("sim.method", 4)
+
+
+def test_cache_folder_and_quiet_keep_their_historical_variables(monkeypatch, tmp_path):
+    from mbcontrol.cache import cache_dir, progress_bar
+    monkeypatch.setenv("MBCONTROL_CACHE", str(tmp_path / "c"))
+    assert cache_dir() == tmp_path / "c" and cache_dir().is_dir()
+    monkeypatch.setenv("MBCONTROL_QUIET", "1")
+    assert progress_bar(total=3).disable
+    monkeypatch.setenv("MBCONTROL_QUIET", "0")
+    assert defaults.get("log.quiet") is False
+
+
+def test_simulate_takes_its_step_and_method_from_the_registry():
+    from mbcontrol import build_plant, simulate, waves
+    plant = build_plant("sphere")
+    wave = waves.regular(1.0, 9.0)
+    with defaults.override(sim_dt=0.1, sim_method="rk3"):   # stable below 0.15 s
+        ds = simulate(plant, wave, duration=5.0)
+    assert ds.attrs["dt_s"] == 0.1 and ds.attrs["method"] == "rk3"
+    assert np.allclose(np.diff(ds.time), 0.1)
+    ds = simulate(plant, wave, duration=5.0, dt=0.05)         # an argument wins
+    assert ds.attrs["dt_s"] == 0.05 and ds.attrs["method"] == "rk4"
+
+
+def test_cli_lists_every_key_and_its_help_shows_the_value_in_force(capsys, monkeypatch):
+    assert main(["defaults", "--json"]) == 0
+    rows = json.loads(capsys.readouterr().out)
+    assert [r["key"] for r in rows] == defaults.keys()
+    assert {"key", "value", "unit", "source", "env", "doc"} <= set(rows[0])
+    monkeypatch.setenv("MBCONTROL_SWEEP_DT", "0.1")
+    with pytest.raises(SystemExit):
+        main(["sweep", "--help"])
+    assert "default 0.1 s: 'sweep.dt'" in capsys.readouterr().out.replace("\n", " ")

@@ -1,0 +1,203 @@
+"""The README is tested: its commands parse and name files that exist, the cheap ones run,
+its Python example runs, the demo prints what the README shows, every module, file and make
+target it names exists, and each of its tables is either read by a test (the numbers checked
+against a computation) or marked as a measurement with the command that remakes it.
+
+The numbers of the identification and annual-energy tables are checked where they are
+computed (tests/studies/identify/test_flume_data.py, tests/waves/test_annual_energy_pins.py),
+which read them from the README through tests/readme.py.
+"""
+from __future__ import annotations
+
+import glob
+import importlib
+import json
+import os
+import re
+import subprocess
+import sys
+
+import pytest
+
+import readme
+from mbcontrol.cli import build_parser, main
+from mbcontrol.scene import list_models, load_scene
+
+ROOT = readme.ROOT
+
+# Each table of the README, by its first header cell, and what stands behind its numbers:
+# ("test", path): a test reads the table and checks it against a computation;
+# ("measured", command): timings and studies remade by a command the README names beside it;
+# ("reference", why): a list of names, no figures to check.
+TABLES = {
+    "model": None,      # two tables share this header: resolved by line below
+    "N barges": ("measured", "benchmarks/scaling.py"),
+    "sphere, H 2.5 m, T 9.67 s": ("measured", "notebooks/controllers_sphere.ipynb"),
+    "QP path": ("measured", "benchmarks/mpc.py"),
+    "sea (Hs m, Tp s, γ)": ("measured", "benchmarks/wecccomp.py"),
+    "": ("test", "tests/studies/identify/test_flume_data.py"),
+    "key": ("reference", "the scene keys, generated (tests/scene/test_reference.py)"),
+    "candidate (added to the previous set: quadratic + linear roll damping, roll added mass, "
+    "heave and sway rig damping)": ("measured", "--cross-validate"),
+    "rm3, scene PTO, 1 h at dt 0.05 s": ("measured", "benchmarks/sweep_light.py"),
+    "site": ("test", "tests/waves/test_annual_energy_pins.py"),
+    "data": ("measured", "benchmarks/radiation_fit.py"),
+    "method": ("reference", "the integration methods by name"),
+    "scenario": ("measured", "--stability"),
+    "model, sea, tol": ("measured", "fidelity_auto"),
+}
+MODEL_TABLES = {"mbcontrol (method, dt, radiation tol)": ("measured", "benchmarks/speed.py"),
+                "what it is": ("reference", "the catalogue (tests/test_catalogue.py builds each)")}
+
+
+def _mbcontrol_commands():
+    return [words[1:] for words in readme.commands() if words[0] == ".venv/bin/mbcontrol"]
+
+
+def test_every_table_is_checked_or_says_how_it_was_measured():
+    lines = readme.text().splitlines()
+    for start, rows in readme.tables():
+        header = rows[0]
+        kind = TABLES.get(header[0]) if header[0] != "model" else MODEL_TABLES.get(header[2],
+                                                                                  MODEL_TABLES.get(header[1]))
+        assert kind is not None, f"README.md line {start}: table {header[0]!r} is not classified"
+        what, where = kind
+        if what == "test":                     # the test exists and reads this very table
+            source = (ROOT / where).read_text()
+            assert "readme.table(" in source or "readme.row(" in source, where
+        elif what == "measured":               # the command that remakes it is named nearby
+            context = "\n".join(lines[max(0, start - 40):start + len(rows) + 3])
+            assert where in context, f"README.md line {start}: {where} not named near the table"
+
+
+def test_commands_parse_and_name_what_exists():
+    """Every `.venv/bin/mbcontrol ...` line parses with the real parser; the models it names
+    are in the catalogue, the data files it reads exist (../shared beside the clone)."""
+    commands = _mbcontrol_commands()
+    assert len(commands) >= 10
+    for words in commands:
+        expanded = []
+        for word in words:
+            if any(c in word for c in "*?["):
+                matches = sorted(glob.glob(str(ROOT / word)))
+                assert matches, f"README: {' '.join(words)}: {word} matches no file"
+                expanded += matches
+            else:
+                expanded.append(word)
+        if expanded[:1] == ["--version"]:
+            continue
+        args = build_parser().parse_args(expanded)        # SystemExit (fails) on a bad flag
+        model = getattr(args, "model", None) or getattr(args, "name", None)
+        if model and model.endswith(".toml"):          # a scene the walkthrough writes
+            assert f"cat > {model} <<" in readme.text(), words
+        elif model:
+            assert model in list_models(), words
+        for option in ("seas", "data"):
+            for path in (getattr(args, option, None) or []) if option == "data" else \
+                    [getattr(args, option, None)] if getattr(args, option, None) else []:
+                assert (ROOT / path).exists(), f"README: {' '.join(words)}: {path} not found"
+
+
+def test_make_targets_files_and_modules_named_in_the_readme_exist():
+    text = readme.text()
+    makefile = (ROOT / "Makefile").read_text()
+    for target in set(re.findall(r"`make (\w+)`", text)) | {"demo", "test", "bench", "docs"}:
+        assert re.search(rf"^{target}:", makefile, re.M), f"README names make {target}"
+    for path in set(re.findall(r"(?<![\w/.])((?:models|notebooks|benchmarks|controllers|"
+                               r"mbcontrol|tests)/[\w/.-]+\.(?:py|toml|ipynb|png|md|nc))", text)):
+        assert (ROOT / path).exists(), f"README names {path}, which does not exist"
+    for dotted in set(re.findall(r"`(mbcontrol(?:\.\w+)+)", text)):
+        parts = dotted.split(".")
+        for cut in range(len(parts), 0, -1):          # the longest importable module ...
+            try:
+                obj = importlib.import_module(".".join(parts[:cut]))
+            except ImportError:
+                continue
+            for attr in parts[cut:]:                   # ... and the rest as attributes
+                assert hasattr(obj, attr), f"README names {dotted}: no {attr}"
+                obj = getattr(obj, attr)
+            break
+
+
+@pytest.mark.parametrize("words", [
+    ["--version"], ["models"], ["models", "sphere"], ["defaults"], ["hydro", "hinged_barge"],
+    ["simulate", "hinged_barge", "--wave", "regular", "--height", "0.02", "--period", "1.0",
+     "--json"],
+    ["linearize", "hinged_barge", "--bode", "out/bode.png", "--json"],
+], ids=lambda w: " ".join(w[:2]))
+def test_cheap_commands_run_as_printed(words, tmp_path, monkeypatch, capsys):
+    assert words in _mbcontrol_commands(), "the README no longer shows this command"
+    monkeypatch.chdir(tmp_path)                       # its out/ files land in a scratch folder
+    if words == ["--version"]:
+        with pytest.raises(SystemExit) as stop:
+            main(words)
+        assert stop.value.code == 0 and re.match(r"mbcontrol \d", capsys.readouterr().out)
+        return
+    assert main(words) == 0
+
+
+def test_python_example_runs():
+    (block,) = readme.code_blocks("python")
+    done = subprocess.run([sys.executable, "-c", block], capture_output=True, text=True,
+                          cwd=ROOT, timeout=600)
+    assert done.returncode == 0, done.stderr[-2000:]
+    power, unit, verdict = done.stdout.split()[:3]
+    assert unit == "W" and float(power) > 0 and verdict == "valid", done.stdout
+
+
+TIMING = re.compile(r"(built in [\d.]+ s|[\d,]+x real time)")
+
+
+def _skeleton(line: str) -> str:
+    return readme.NUMBER.sub("#", TIMING.sub("T", line)).strip()
+
+
+def _agree(quoted: str, measured: float) -> bool:
+    """A quoted figure holds when the measurement rounds to it, give or take one unit of its
+    last digit or 0.5 % (the MPC runs vary by about 0.1 % between machines)."""
+    decimals = len(quoted.split(".")[1]) if "." in quoted else 0
+    value = float(quoted.replace(",", ""))
+    return abs(measured - value) <= max(1.0 * 10.0 ** -decimals, 0.005 * abs(value))
+
+
+@pytest.mark.slow
+def test_demo_prints_what_the_readme_shows(tmp_path):
+    """`make demo`'s output, as the README quotes it, line for line; timings and real-time
+    factors are the machine's and are not compared."""
+    shown = [b for b in readme.code_blocks("") if b.startswith("[demo] 1/6")]
+    assert len(shown) == 1, "README: the demo's output block is missing"
+    done = subprocess.run([sys.executable, "-m", "mbcontrol.demo", "--out", str(tmp_path)],
+                          capture_output=True, text=True, cwd=ROOT, timeout=900)
+    assert done.returncode == 0, done.stderr[-2000:]
+    printed = {_skeleton(line): line for line in done.stdout.splitlines()}
+    for line in shown[0].splitlines():
+        if line.startswith("  wrote "):
+            continue
+        key = _skeleton(line)
+        assert key in printed, f"README demo line not printed any more: {line!r}"
+        quoted = readme.NUMBER.findall(TIMING.sub("T", line))
+        measured = [float(n.replace(",", "")) for n in
+                    readme.NUMBER.findall(TIMING.sub("T", printed[key]))]
+        for q, m in zip(quoted, measured):
+            assert _agree(q, m), f"README: {line.strip()!r}\n  demo: {printed[key].strip()!r}"
+
+
+@pytest.mark.slow
+def test_the_walkthrough_runs_as_written(tmp_path):
+    """"Your own device in five minutes", pasted into a shell in an empty folder: the scene
+    written, its BEM data computed by Capytaine, the fit, the design and the simulation, with
+    limits in N and mm. At most one message on stderr besides progress: the note that part of
+    the sea lies above the BEM data."""
+    (block,) = [b for b in readme.code_blocks("bash") if "cat > my_buoy/buoy.toml" in b]
+    script = block.replace(".venv/bin/mbcontrol", f"{sys.executable} -m mbcontrol")
+    done = subprocess.run(["bash", "-euo", "pipefail", "-c", script], capture_output=True,
+                          text=True, cwd=tmp_path, timeout=900,
+                          env={**os.environ, "TQDM_DISABLE": "1"})
+    assert done.returncode == 0, done.stderr[-3000:]
+    assert (tmp_path / "my_buoy" / "run.png").stat().st_size > 10_000
+    summary = json.loads(done.stdout[done.stdout.index("{"):])
+    pto = summary["ptos"]["generator"]
+    assert summary["valid"] and pto["force_max"] == 150.0 and pto["stroke_max"] == 0.08
+    assert 0.13 < pto["mean_power_W"] < 0.15, pto              # the README's "about 142 mW"
+    messages = {line for line in done.stderr.splitlines() if line.startswith("mbcontrol:")}
+    assert all("lies outside the hydro data" in m for m in messages), messages
