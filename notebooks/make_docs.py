@@ -226,7 +226,7 @@ def main(argv=None) -> int:
                              str(out / "html")])
     print(log.getvalue(), end="")
     if status:
-        print(f"[docs] failed: Sphinx reported warnings or errors (above)", file=sys.stderr)
+        print("[docs] failed: Sphinx reported warnings or errors (above)", file=sys.stderr)
         return status
     print(f"[docs] {out / 'html' / 'index.html'}")
     return 0
