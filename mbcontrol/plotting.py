@@ -9,7 +9,9 @@ from pathlib import Path
 
 import matplotlib
 
-matplotlib.use("Agg")          # files, never a window: this runs in CI and on servers
+# files, never a window (this runs in CI and on servers); a notebook's backend is kept
+if not any(k in matplotlib.get_backend().lower() for k in ("inline", "module://", "widget", "nbagg")):
+    matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 

@@ -41,7 +41,7 @@ TOUR = [
              " wave, duration=20.0, dt=0.005, controller=make('passive', damping=c))\n"
              "    last = ds.time > 10\n    print(f'added damping {c:3.1f} N m s/rad: mean PTO "
              "power {1e3 * float(ds.hinge_pto__power[last].mean()):.3f} mW')"),
-    ("code", "import matplotlib\nmatplotlib.use('Agg')\nfrom mbcontrol.plotting import "
+    ("code", "from mbcontrol.plotting import "
              "time_series\nfig = time_series(ds.sel(time=slice(10, 20)), ['eta', 'hinge', "
              "'hinge_pto__power'])"),
 ]
@@ -52,7 +52,7 @@ CONTROLLERS = [
            "H 2.5 m, T 9.6664 s (the issue's case). Each controller runs on the nonlinear "
            "process plant in closed loop; its mean power (from the PTO's work) is set beside the "
            "complex-conjugate bound and the constrained (2 MN, 4 m) pseudo-spectral bound."),
-    ("code", "import numpy as np\nimport matplotlib\nmatplotlib.use('Agg')\n"
+    ("code", "import numpy as np\n"
              "import matplotlib.pyplot as plt\nfrom mbcontrol import waves\n"
              "from mbcontrol.plant import build_plant\nfrom mbcontrol.sim import simulate\n"
              "from mbcontrol.analysis import complex_conjugate_bound, pseudo_spectral_bound\n"
@@ -105,7 +105,7 @@ CONTROLLERS = [
              "    d = runs[n].sel(time=slice(120, 150))\n"
              "    bx.plot(d.time, d.pto__force / 1e6, label=f'{n}: force (MN)')\n"
              "bx.axhline(F_MAX / 1e6, color='C3', ls=':')\nbx.axhline(-F_MAX / 1e6, color='C3', ls=':')\n"
-             "bx.set_xlabel('time (s)')\nbx.legend(fontsize=8)\nfig.tight_layout()\n"
+             "bx.set_xlabel('time (s)')\nbx.set_ylabel('PTO force, MN')\nbx.legend(fontsize=8)\nfig.tight_layout()\n"
              "fig.savefig('figures/controllers_sphere.png', dpi=110)"),
 ]
 
@@ -157,8 +157,8 @@ IDENTIFICATION = [
            "frequencies. The model is `models/flume_section.toml`: the rig as a joint tree, 2-D "
            "hydrodynamics from long Capytaine prisms differenced in length, the rig's measured "
            "springs and damping, and viscous damping left for the fit."),
-    ("code", "import glob, math, warnings\nimport numpy as np\nimport matplotlib\n"
-             "matplotlib.use('Agg')\nfrom mbcontrol.studies.identify import fit\n"
+    ("code", "import glob, math, warnings\nimport numpy as np\n"
+             "from mbcontrol.studies.identify import fit\n"
              "from mbcontrol.studies.identify import report as rep\n"
              "from mbcontrol.studies.identify.flume import load_runs\n"
              "from mbcontrol.studies.identify.setup import flume_identification, prediction\n"
@@ -225,36 +225,43 @@ IDENTIFICATION = [
              "    print(held_out, 'predicted:', {c: f\"{100 * v['rms_relative_error']:.1f} %\"\n"
              "                                   for c, v in e.items()})\n"
              "    assert max(v['rms_relative_error'] for v in e.values()) <= 0.20"),
-    ("md", "## What the roll damping means\n"
-           "Linear (B_l) and quadratic (B_q) viscous roll damping act alike at one wave "
-           "height, so each alone is poorly determined; their combination at the resonance, "
-           "the equivalent linear damping B_eq = B_l + 8/(3 pi) omega phi_a B_q (phi_a the "
-           "measured roll amplitude there), is well determined. As a share of critical "
-           "damping 2 sqrt(C (I + A)) at the roll resonance (sway clamped, 1.28 s):"),
-    ("code", "from mbcontrol.hydro import read_netcdf\nfrom mbcontrol.scene import load_scene\n"
-             "scene = load_scene('flume_section')\nds = read_netcdf(scene.hydro.file)\n"
-             "roll = dict(radiating_dof='section__Roll', influenced_dof='section__Roll')\n"
-             "I = [b for b in scene.bodies if b.name == 'section'][0].inertia[0][0]\n"
-             "C = float(ds.hydrostatic_stiffness.sel(**roll))\n"
-             "scale = result.values['section__Roll__added_mass_scale']\n"
-             "w = 2 * math.pi / 1.28\n"
-             "A = scale * float(ds.added_mass.sel(**roll).interp(omega=w))\n"
-             "B_pot = float(ds.radiation_damping.sel(**roll).interp(omega=w))\n"
-             "peak = max((r for r in after if r['channel'] == 'Roll'), key=lambda r: r['measured'])\n"
-             "names = [p.name for p in problem.fit]\n"
-             "g = np.zeros(len(names))\n"
-             "g[names.index('viscous__Roll_linear')] = 1.0\n"
-             "g[names.index('viscous__Roll')] = 8 / (3 * math.pi) * w * peak['measured']\n"
-             "sd = np.array([result.std[n] for n in names])\n"
-             "cov = result.correlation * np.outer(sd, sd)\n"
-             "B_eq = sum(g[i] * result.values[n] for i, n in enumerate(names))\n"
-             "sigma = math.sqrt(g @ cov @ g)\n"
-             "critical = 2 * math.sqrt(C * (I + A))\n"
-             "print(f'roll amplitude at resonance {math.degrees(peak[\"measured\"]):.1f} deg ({peak[\"run\"]})')\n"
-             "print(f'potential-flow damping {B_pot:.3f} N m s/rad: {100 * B_pot / critical:.1f} % of critical')\n"
-             "print(f'viscous, equivalent linear {B_eq:.3f} +- {sigma:.3f} N m s/rad: '\n"
-             "      f'{100 * B_eq / critical:.1f} +- {100 * sigma / critical:.1f} % of critical')\n"
-             "assert sigma < 0.5 * B_eq      # the combination is seen by the data"),
+    ("md", """## What the roll damping means
+The scene's identified set (chosen by cross-validation, see the README) fits a linear viscous roll damping B_l and a scale on the roll radiation kernel; a quadratic part B_q, when fitted (`--fit viscous__Roll`), acts like the linear one at one wave height and goes to its bound. Their combination at the resonance, the equivalent linear damping B_eq = B_l + 8/(3 pi) omega phi_a B_q (phi_a the measured roll amplitude there), is what the data determine. As a share of critical damping 2 sqrt(C (I + A)) at the roll resonance (sway clamped, 1.28 s):"""),
+    ("code", """from mbcontrol.hydro import read_netcdf
+from mbcontrol.scene import load_scene
+scene = load_scene('flume_section')
+ds = read_netcdf(scene.hydro.file)
+roll = dict(radiating_dof='section__Roll', influenced_dof='section__Roll')
+I = [b for b in scene.bodies if b.name == 'section'][0].inertia[0][0]
+C = float(ds.hydrostatic_stiffness.sel(**roll))
+scale = result.values['section__Roll__added_mass_scale']
+kernel = result.values.get('section__Roll__radiation_scale', 1.0)
+w = 2 * math.pi / 1.28
+# the plant's meaning (plant.process.build_process_plant): added_mass_scale scales A(inf) only;
+# radiation_scale the kernel: B(w) and A(w) - A(inf) together
+A_inf = float(ds.added_mass_inf.sel(**roll))
+A = scale * A_inf + kernel * (float(ds.added_mass.sel(**roll).interp(omega=w)) - A_inf)
+B_pot = kernel * float(ds.radiation_damping.sel(**roll).interp(omega=w))
+peak = max((r for r in after if r['channel'] == 'Roll'), key=lambda r: r['measured'])
+names = [p.name for p in problem.fit]
+g = np.zeros(len(names))
+g[names.index('viscous__Roll_linear')] = 1.0
+if 'viscous__Roll' in names:        # a quadratic part, when fitted: its equivalent linear share
+    g[names.index('viscous__Roll')] = 8 / (3 * math.pi) * w * peak['measured']
+# a parameter at its bound (result.at_bound) has no sigma: it is held there, and the
+# interval below is the reduced problem's, conditional on that
+sd = np.array([0.0 if n in result.at_bound else result.std[n] for n in names])
+cov = result.correlation * np.outer(sd, sd)
+B_eq = sum(g[i] * result.values[n] for i, n in enumerate(names))
+sigma = math.sqrt(g @ cov @ g)
+critical = 2 * math.sqrt(C * (I + A))
+print('at a bound:', result.at_bound or 'none')
+print(f'roll amplitude at resonance {math.degrees(peak["measured"]):.1f} deg ({peak["run"]})')
+print(f'potential-flow damping (radiation scale {kernel:.3f}) {B_pot:.3f} N m s/rad: '
+      f'{100 * B_pot / critical:.1f} % of critical')
+print(f'viscous, equivalent linear {B_eq:.3f} +- {sigma:.3f} N m s/rad: '
+      f'{100 * B_eq / critical:.1f} +- {100 * sigma / critical:.1f} % of critical')
+assert sigma < 0.5 * B_eq      # the combination is seen by the data"""),
 ]
 
 
@@ -265,7 +272,7 @@ POWER_MATRIX = [
            "states of PacWave South (`../shared/data/sites`, from MHKiT's examples), on a local "
            "Dask cluster; then a power matrix over an Hs x Tp grid, and the annual energy at "
            "NOAA buoy 46042 (Monterey Bay) from a year of hourly spectra."),
-    ("code", "import math, numpy as np, matplotlib\nmatplotlib.use('Agg')\n"
+    ("code", "import math, numpy as np\n"
              "from mbcontrol import waves\nfrom mbcontrol.plant import build_plant\n"
              "from mbcontrol.controllers.passive import optimal_damping\n"
              "from mbcontrol.studies.sweep import grid, read_seas, sweep, power_matrix, occurrence\n"
@@ -333,7 +340,12 @@ POWER_MATRIX = [
 
 
 def build(cells):
+    """A notebook of the cells; its first code cell starts with `%matplotlib inline`, so the
+    figures show in the notebook and on the documentation site (also where MPLBACKEND=Agg)."""
     nb = nbformat.v4.new_notebook()
+    first = next(i for i, (kind, _) in enumerate(cells) if kind == "code")
+    cells = [(k, "%matplotlib inline\n" + src if i == first else src)
+             for i, (k, src) in enumerate(cells)]
     nb.cells = [nbformat.v4.new_markdown_cell(src) if kind == "md" else
                 nbformat.v4.new_code_cell(src) for kind, src in cells]
     nb.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3",

@@ -26,3 +26,18 @@ def test_notebook_runs(path):
 
 def test_there_are_notebooks():
     assert NOTEBOOKS, "notebooks/ has no .ipynb files"
+
+
+def test_notebooks_are_what_make_notebooks_writes():
+    """The .ipynb files are generated (notebooks/make_notebooks.py keeps them reviewable as
+    Python): an edit made to a notebook alone would be lost at the next regeneration."""
+    import runpy
+    maker = runpy.run_path(str(ROOT / "notebooks" / "make_notebooks.py"))
+    written = {"tour_hinged_barge": "TOUR", "controllers_sphere": "CONTROLLERS",
+               "work_precision_rm3": "WORK_PRECISION", "identification_flume": "IDENTIFICATION",
+               "power_matrix": "POWER_MATRIX"}
+    assert sorted(written) == sorted(p.stem for p in NOTEBOOKS)
+    for stem, cells in written.items():
+        built = maker["build"](maker[cells])
+        committed = nbformat.read(ROOT / "notebooks" / f"{stem}.ipynb", as_version=4)
+        assert [c.source for c in committed.cells] == [c.source for c in built.cells], stem

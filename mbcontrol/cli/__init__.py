@@ -27,7 +27,7 @@ from ..errors import MbcontrolError
 from ..sim.methods import METHODS
 from .commands import (run_bench, run_fidelity, run_hydro, run_linearize, run_models,
                        run_simulate)
-from .describe import default_help, run_defaults
+from .describe import default_help, run_defaults, run_keys
 from .design import run_design
 from .identify import add_parser as add_identify_parser
 from .sweep import add_parser as add_sweep_parser
@@ -173,6 +173,12 @@ def build_parser() -> argparse.ArgumentParser:
                                         "change it")
     p.add_argument("--json", action="store_true", help="print the table as JSON")
     p.set_defaults(run=run_defaults)
+
+    p = sub.add_parser("keys", help="every key a scene file takes, by section: value, unit, "
+                                     "default, meaning (Markdown, from the parser itself)")
+    p.add_argument("--readme", nargs="?", const="README.md", metavar="FILE",
+                   help="write the reference into FILE's scene-keys section (default README.md)")
+    p.set_defaults(run=run_keys)
 
     p = sub.add_parser("hydro", help="load or compute a model's BEM data and fit its radiation "
                                      "model; print the fit report")

@@ -141,6 +141,22 @@ def run_describe(args) -> int:
     return 0
 
 
+def run_keys(args) -> int:
+    """`mbcontrol keys [--readme [FILE]]`: the scene-key reference, printed or written into
+    the README's scene-keys section."""
+    from pathlib import Path
+
+    from ..atomic import write_text
+    from ..scene import reference
+    if args.readme:
+        path = Path(args.readme)
+        write_text(path, reference.in_readme(path.read_text()))
+        print(f"wrote the scene keys into {path}")
+    else:
+        print(reference.markdown(), end="")
+    return 0
+
+
 def default_help(key: str) -> str:
     """"default 0.01 s: sim.dt" for a --help text (the value in force, environment included)."""
     entry = next(row for row in defaults.table() if row["key"] == key)

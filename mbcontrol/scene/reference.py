@@ -5,8 +5,9 @@ does not (end stops, a catenary line, third-party hydro options), is parsed with
 `Reader.record` listening: the keys each section allows, which are required, their defaults,
 units and choices are what the parser did, not a copy of it. Only the one-line meanings are
 written here, and `tests/scene/test_reference.py` fails when a key has none or a meaning names
-a key the parser does not take. `python -m mbcontrol.scene.reference` prints the Markdown (the
-README's "Scene keys" section and the documentation's page are this output).
+a key the parser does not take. `mbcontrol keys` prints the Markdown (the README's "Scene
+keys" section and the documentation's page are this output; `mbcontrol keys --readme`
+rewrites the former).
 """
 from __future__ import annotations
 
@@ -316,25 +317,3 @@ def in_readme(readme: str) -> str:
         raise ValueError(f"README: expected the markers {BEGIN.strip()} and {END}")
     return head + BEGIN + markdown() + END + rest.partition(END)[2]
 
-
-def main(argv=None) -> int:
-    import argparse
-
-    from ..atomic import write_text
-    parser = argparse.ArgumentParser(prog="python -m mbcontrol.scene.reference",
-                                     description="Print the scene-key reference (Markdown), or "
-                                                 "write it into the README's scene-keys section.")
-    parser.add_argument("--readme", nargs="?", const=str(Path(__file__).parents[2] / "README.md"),
-                        metavar="FILE", help="rewrite FILE's section (default: the repository's "
-                                             "README.md)")
-    args = parser.parse_args(argv)
-    if args.readme:
-        path = Path(args.readme)
-        write_text(path, in_readme(path.read_text()))
-    else:
-        print(markdown(), end="")
-    return 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())

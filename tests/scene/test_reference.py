@@ -40,7 +40,17 @@ def test_what_it_records_is_what_the_parser_does(schema, tmp_path):
     assert schema["mooring"]["EA"]["required"] and "anchor" in schema["mooring"]
 
 
+def test_the_keys_command_prints_it_and_rewrites_a_readme(capsys, tmp_path):
+    from mbcontrol.cli import main
+    assert main(["keys"]) == 0 and capsys.readouterr().out == reference.markdown()
+    stale = tmp_path / "README.md"
+    stale.write_text("intro\n" + reference.BEGIN + "old\n" + reference.END + "\nrest\n")
+    assert main(["keys", "--readme", str(stale)]) == 0
+    assert stale.read_text() == ("intro\n" + reference.BEGIN + reference.markdown()
+                                 + reference.END + "\nrest\n")
+
+
 def test_the_readme_section_is_current():
     text = readme.text()
     assert reference.in_readme(text) == text, \
-        "README's Scene keys section is stale: python -m mbcontrol.scene.reference --readme"
+        "README's Scene keys section is stale: mbcontrol keys --readme"

@@ -217,7 +217,7 @@ def plot_amplitudes(rows_by_label: dict, path=None, title: str | None = None):
                             fmt="none", ecolor=f"C{k}", capsize=3, lw=0.8,
                             label=f"{label}: 95 % prediction interval")
         ax.set_xlabel("wave frequency, rad/s")
-        ax.set_ylabel(f"{channel} amplitude / wave amplitude, {unit}/m")
+        ax.set_ylabel(f"{channel} per wave amplitude, {unit}/m")   # the RAO
         ax.set_title(channel)
         ax.grid(alpha=0.3)
     legend = {}
@@ -228,7 +228,7 @@ def plot_amplitudes(rows_by_label: dict, path=None, title: str | None = None):
                ncol=min(len(legend), 4), frameon=False)
     if title:
         fig.suptitle(title)
-    fig.tight_layout(rect=(0, 0.06 * math.ceil(len(legend) / 4), 1, 1))
+    fig.tight_layout(rect=(0, 0.06 * math.ceil(len(legend) / 4), 1, 0.93 if title else 1))
     if path is not None:
         save(fig, path)
     return fig
