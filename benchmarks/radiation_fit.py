@@ -123,6 +123,7 @@ def plot(rows, path, title):
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    import matplotlib.ticker
 
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 4.2))
     styles = {"vector fit (unconstrained)": ("o--", "C0"), "vector fit + passivity": ("s-", "C2"),
@@ -147,6 +148,9 @@ def plot(rows, path, title):
     ax2.set(xlabel="states", ylabel="min eig ½(K+Kᴴ) / max eig", title="passivity margin (< 0: not passive)")
     for ax in (ax1, ax2):
         ax.grid(True, which="both", alpha=0.3)
+    ax1.yaxis.set_major_locator(matplotlib.ticker.FixedLocator([0.1, 0.2, 0.5, 1, 2, 5, 10, 20]))
+    ax1.yaxis.set_major_formatter(matplotlib.ticker.FormatStrFormatter("%g"))   # 2, not 2x10^0
+    ax1.yaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
     ax1.legend(fontsize=8)
     fig.suptitle(title, fontsize=10)
     fig.tight_layout()

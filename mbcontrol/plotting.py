@@ -39,7 +39,7 @@ def bode(sys, pairs, omega, *, title=None, path=None, fd=None):
         i, o = sys.input_labels.index(inp), sys.output_labels.index(out)
         G = np.array([C[o] @ np.linalg.solve(1j * w * eye - A, B[:, i]) + D[o, i]
                       for w in omega])
-        line, = ax_mag.loglog(omega, np.abs(G), label=f"{inp} → {out}")
+        line, = ax_mag.loglog(omega, np.abs(G), label=f"{signal_label(inp)} → {signal_label(out)}")
         ax_ph.semilogx(omega, np.degrees(np.unwrap(np.angle(G))), color=line.get_color())
         if fd and (inp, out) in fd:
             ref = fd[(inp, out)]
