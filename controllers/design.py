@@ -72,7 +72,10 @@ class DesignResult:
     the controller's own force_max / stroke_max where it takes them, inf: none, null in
     JSON, `--set force_max=inf`); predicted_power_W: linear theory (None for
     switching and predictive control); bound: complex_conjugate_W, constrained_W (None with
-    constrained_reason when skipped or infeasible), force_max, stroke_max; metrics:
+    constrained_reason when skipped or infeasible), force_max, stroke_max, and electrical_W
+    for a PTO with a drivetrain (impedance.electrical_optimum: no limit in it, so it bounds
+    the limited runs too; percent_of_bound["electrical"] sets the simulated electrical power
+    against it); metrics:
     metrics.pto_metrics of the designed PTO in closed loop (None if not simulated);
     percent_of_bound: 100 x simulated power / each bound; margins: controllers.margins.Margins
     (passive and reactive); tuner: what tuned it and what it reported; simulation: duration_s,
@@ -224,6 +227,9 @@ def design(plant, wave, name: str, *, pto: str | None = None, simulate_s: float 
             for key, ref in (("complex_conjugate", bound.get("complex_conjugate_W")),
                              ("constrained", bound.get("constrained_W"))):
                 percent[key] = 100 * power / ref if ref else None
+            if bound.get("electrical_W"):
+                percent["electrical"] = (100 * metrics["mean_electrical_power_W"]
+                                         / bound["electrical_W"])
             if bound.get("total_complex_conjugate_W"):
                 total = sum(pto_metrics(ds, p)["mean_power_W"] for p in plant.scene.ptos)
                 metrics["total_mean_power_W"] = total
@@ -291,6 +297,9 @@ def _bounds(plant, wave, pto, limit_values, mode, params=None, whole=False) -> d
         out["constrained_reason"] = f"no bound: {exc}"
         return out
     out["complex_conjugate_W"] = cc.power
+    if next(p for p in plant.scene.ptos if p.name == pto).drivetrain is not None:
+        from .impedance import electrical_optimum     # limits only lower it: still a bound
+        out["electrical_W"] = electrical_optimum(plant, wave, pto=pto, params=params)["power_W"]
     force_max, stroke_max = limit_values["force_max"], limit_values["stroke_max"]
     if not (math.isfinite(force_max) or math.isfinite(stroke_max)):
         out["constrained_W"] = cc.power

@@ -62,6 +62,45 @@ def complex_conjugate_power(plant, wave, *, pto: str | None = None, params=None)
     return float(np.sum(np.abs(F * wave.amplitude) ** 2 / (8 * Z.real)))
 
 
+def electrical_optimum(plant, wave, *, pto: str | None = None, params=None) -> dict:
+    """The largest mean electrical power (W) a PTO with a drivetrain can deliver in `wave` in
+    linear theory, with no force, stroke or electrical limit, and the load that reaches it.
+
+    Seen from its terminals the machine is a source: with current I (exp(+i omega t)) the PTO
+    force is F = G kt' I, the velocity v = (F_eq + F) / Z_i and the voltage
+    V = (R + i omega L) I + G kt' v = V_oc + Z_out I, with V_oc = G kt' F_eq / Z_i and
+    Z_out = R + i omega L + (G kt')^2 / Z_i. The delivered power -Re(V I*) / 2 is largest at
+    I = -V_oc / (2 Re Z_out): |V_oc|^2 / (8 Re Z_out) per component. With R = 0 this is the
+    complex-conjugate bound; with losses the optimal mechanical load Z_pto = -F / v is no
+    longer conj(Z_i). Z_i holds the drivetrain's reflected inertia and friction (the plant
+    does). Returns {"power_W", "omega", "power_per_omega_W", "load_impedance" (Z_pto, N s/m or
+    N m s/rad), "electrical_load" (V / -I, ohm), "mechanical_power_W" (its -F v)}.
+    """
+    name = pto or plant.scene.ptos[0].name
+    drive = next(p for p in plant.scene.ptos if p.name == name).drivetrain
+    if drive is None:
+        raise ValueError(f"PTO {name!r} has no [pto.drivetrain]: its electrical optimum is "
+                         f"the complex-conjugate bound times its efficiency")
+    Z, F = intrinsic_impedance(plant, wave.omega, pto=name, params=params,
+                               direction=wave.direction)
+    g = drive.force_per_current
+    z_out = drive.winding_resistance + 1j * wave.omega * drive.winding_inductance + g * g / Z
+    v_oc = g * F * wave.amplitude / Z
+    current = -v_oc / (2 * z_out.real)
+    velocity = (F * wave.amplitude + g * current) / Z
+    power = np.abs(v_oc) ** 2 / (8 * z_out.real)
+    return {"power_W": float(power.sum()), "omega": wave.omega, "power_per_omega_W": power,
+            "load_impedance": -g * current / velocity,
+            "electrical_load": np.conj(z_out),
+            "mechanical_power_W": float(np.sum(-0.5 * (g * current * np.conj(velocity)).real))}
+
+
+def winding_coefficient(plant, pto: str) -> float | None:
+    """R / (gear kt')^2 (W per N^2 of PTO force) of a PTO's drivetrain; None without one."""
+    drive = next(p for p in plant.scene.ptos if p.name == pto).drivetrain
+    return None if drive is None else drive.winding_resistance / drive.force_per_current ** 2
+
+
 def closed_loop_stability(plant, damping: float, stiffness: float, *, pto: str | None = None,
                           params=None) -> tuple[bool, float]:
     """Is the linearised plant stable under u = -(damping v + stiffness x)? (stable, margin).
@@ -91,7 +130,7 @@ def margin_function(plant, name: str, params=None):
 
 
 def fd_statistics(Z, F, wave, damping, stiffness, *, efficiency: float | None = None,
-                  exceedance: float = 0.01) -> dict:
+                  exceedance: float = 0.01, winding: float | None = None) -> dict:
     """Linear-theory statistics of u = -(damping v + stiffness x) in `wave` (exp(+i omega t)).
 
     Z, F: intrinsic_impedance at wave.omega. damping (N s/m) and stiffness (N/m) broadcast
@@ -100,7 +139,9 @@ def fd_statistics(Z, F, wave, damping, stiffness, *, efficiency: float | None = 
 
     - power_W: mean absorbed power sum c |V_j|^2 / 2 (W);
     - electrical_W: mean electrical power with `efficiency` eta, eta P when absorbing and P /
-      eta when the PTO drives the body (as metrics.electrical_power); None: power_W. A regular
+      eta when the PTO drives the body (as metrics.electrical_power); with `winding` (a
+      drivetrain's R / (gear kt')^2, W/N^2) P less the mean winding loss sum winding |U_j|^2
+      / 2 instead; neither: power_W. A regular
       wave's P(t) = A + B cos(2 omega t) is split exactly; in a sea P = -u v with u and v jointly
       Gaussian, E|P| = s_u s_v (2 / pi)(sqrt(1 - r^2) + r asin r) (r their correlation);
     - stroke_peak (m), force_peak (N): a regular wave's amplitudes |X a|, |U a|; in a sea the
@@ -120,11 +161,11 @@ def fd_statistics(Z, F, wave, damping, stiffness, *, efficiency: float | None = 
     V = F * a / (Z + c - 1j * k / w)
     X = V / (1j * w)
     return phasor_statistics(V, X, -(c * V + k * X), c, wave, efficiency=efficiency,
-                             exceedance=exceedance)
+                             exceedance=exceedance, winding=winding)
 
 
 def phasor_statistics(V, X, U, c, wave, *, efficiency: float | None = None,
-                      exceedance: float = 0.01) -> dict:
+                      exceedance: float = 0.01, winding: float | None = None) -> dict:
     """fd_statistics' keys from one PTO's velocity, position and force phasors per wave
     component (V, X, U: (..., n_omega), m/s, m, N; either time convention, only moduli and
     c enter) and its damping c (N s/m, broadcast against V): see fd_statistics."""
@@ -150,7 +191,9 @@ def phasor_statistics(V, X, U, c, wave, *, efficiency: float | None = None,
             r = np.clip(np.where(s_u * s_v > 0, -power / (s_u * s_v), 0.0), -1, 1)
         mean_abs = s_u * s_v * (2 / np.pi) * (np.sqrt(1 - r ** 2) + r * np.arcsin(r))
         positive = 0.5 * (power + mean_abs)
-    if efficiency is None:
+    if winding is not None:             # a drivetrain: the current is the force / (gear kt')
+        electrical = power - winding * var["u"]
+    elif efficiency is None:
         electrical = power
     else:
         electrical = efficiency * positive + (power - positive) / efficiency

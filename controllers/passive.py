@@ -16,7 +16,7 @@ import numpy as np
 from .base import per_pto, signal_indices
 from .impedance import default_bounds
 from .limits import casadi_saturate, force_limits, limits_report, saturate
-from .tuning import constrained_tuning
+from .tuning import constrained_tuning, electrical_winding
 
 
 class Passive:
@@ -64,7 +64,7 @@ class Passive:
 
 def optimal_damping(plant, wave, *, pto: str | None = None, params=None, bounds=None,
                     force_max: float | None = None, stroke_max: float | None = None,
-                    exceedance: float = 0.01) -> tuple[float, float]:
+                    exceedance: float = 0.01, objective: str = "auto") -> tuple[float, float]:
     """PTO damping that maximises the mean absorbed power in `wave`: (damping, power W).
 
     Evaluated on the frequency-domain solution built straight from the BEM data (linear
@@ -80,13 +80,20 @@ def optimal_damping(plant, wave, *, pto: str | None = None, params=None, bounds=
     sea: the Rice level the record exceeds with probability <~ `exceedance`). The search is
     then a log grid over `bounds`, refined by Brent's method inside the feasible set or by
     bisection to its edge. A damper lowers the stroke and raises the force, so limits that
-    no damping meets raise ValueError. (A damper only absorbs, so its electrical power is
-    the PTO efficiency times this mechanical power: the optimum is the same for both.)
+    no damping meets raise ValueError. (A damper only absorbs, so with an efficiency alone its
+    electrical power is the efficiency times this mechanical power: the same optimum.)
+
+    objective: "auto" (the default) maximises the electrical power of a PTO with a
+    drivetrain (the mechanical power less the winding loss R |F|^2 / (gear kt')^2 / 2, whose
+    optimum is a lighter damper), else the mechanical power; "mechanical" or "electrical"
+    force one (tuning.electrical_winding). The power returned is the mechanical one.
     """
-    if force_max is not None or stroke_max is not None:
+    winding = electrical_winding(plant, pto, objective)
+    if force_max is not None or stroke_max is not None or winding is not None:
         c, _, power = constrained_tuning(plant, wave, pto=pto, params=params, passive=True,
                                          bounds=bounds, force_max=force_max,
-                                         stroke_max=stroke_max, exceedance=exceedance)
+                                         stroke_max=stroke_max, exceedance=exceedance,
+                                         winding=winding)
         return c, power
     from scipy.optimize import minimize_scalar
 

@@ -34,7 +34,7 @@ import numpy as np
 from .base import per_pto, signal_indices
 from .impedance import closed_loop_stability, intrinsic_impedance
 from .limits import casadi_saturate, force_limits, limits_report, saturate
-from .tuning import constrained_tuning, multistart
+from .tuning import constrained_tuning, electrical_winding, multistart
 
 
 class Reactive:
@@ -91,7 +91,7 @@ class Reactive:
 def reactive_tuning(plant, wave, pto: str | None = None, *, params=None,
                     min_margin: float = 1e-3, force_max: float | None = None,
                     stroke_max: float | None = None, efficiency: float | None = None,
-                    exceedance: float = 0.01) -> tuple[float, float, float]:
+                    exceedance: float = 0.01, objective: str = "auto") -> tuple[float, float, float]:
     """(damping N s/m, stiffness N/m, predicted mean power W) for `wave`, linear theory.
 
     Regular wave: complex-conjugate control at its frequency (damping = Re Z_i, stiffness =
@@ -105,12 +105,17 @@ def reactive_tuning(plant, wave, pto: str | None = None, *, params=None,
     amplitudes; sea: the Rice level exceeded with probability <~ `exceedance`), and efficiency
     (0..1) makes the objective the predicted mean electrical power instead (reactive power
     is bought back at 1 / efficiency, which moves the optimum towards a damper). Then the
-    search is constrained_tuning's; the power returned is still the mechanical one.
+    search is constrained_tuning's; the power returned is still the mechanical one. A PTO
+    with a drivetrain is tuned for electrical power by default (objective "auto"; see
+    passive.optimal_damping): the winding loss of the spring's reactive current moves the
+    optimum away from the complex conjugate.
     """
-    if force_max is not None or stroke_max is not None or efficiency is not None:
+    winding = electrical_winding(plant, pto, objective)
+    if force_max is not None or stroke_max is not None or efficiency is not None or winding:
         return constrained_tuning(plant, wave, pto=pto, params=params, force_max=force_max,
                                   stroke_max=stroke_max, efficiency=efficiency,
-                                  exceedance=exceedance, min_margin=min_margin)
+                                  exceedance=exceedance, min_margin=min_margin,
+                                  winding=winding)
 
     name = pto or plant.scene.ptos[0].name
     w, a = np.asarray(wave.omega, float), np.asarray(wave.amplitude, float)

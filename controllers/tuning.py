@@ -11,10 +11,11 @@ from .impedance import (base_params, default_bounds, fd_statistics, intrinsic_im
 def constrained_tuning(plant, wave, *, pto: str | None = None, params=None,
                        passive: bool = False, bounds=None, force_max: float | None = None,
                        stroke_max: float | None = None, efficiency: float | None = None,
-                       exceedance: float = 0.01,
-                       min_margin: float = 1e-3) -> tuple[float, float, float]:
+                       exceedance: float = 0.01, min_margin: float = 1e-3,
+                       winding: float | None = None) -> tuple[float, float, float]:
     """(damping, stiffness, predicted mean power W) maximising the predicted mean power
-    (electrical with `efficiency`, else mechanical) subject to fd_statistics' force and stroke
+    (electrical with `efficiency` or a drivetrain's `winding` coefficient, else mechanical;
+    impedance.fd_statistics) subject to fd_statistics' force and stroke
     peaks <= force_max (N) and stroke_max (m) (None: no limit) and, for a spring, a stable
     closed loop with margin >= min_margin (1/s).
 
@@ -37,10 +38,11 @@ def constrained_tuning(plant, wave, *, pto: str | None = None, params=None,
     s_max = np.inf if stroke_max is None else float(stroke_max)
     if not (f_max > 0 and s_max > 0):
         raise ValueError(f"limits must be > 0, got force_max={force_max}, stroke_max={stroke_max}")
-    key = "power_W" if efficiency is None else "electrical_W"
+    key = "power_W" if efficiency is None and winding is None else "electrical_W"
 
     def evaluate(c, k):
-        st = fd_statistics(Z, F, wave, c, k, efficiency=efficiency, exceedance=exceedance)
+        st = fd_statistics(Z, F, wave, c, k, efficiency=efficiency, exceedance=exceedance,
+                           winding=winding)
         feasible = (st["force_peak"] <= f_max) & (st["stroke_peak"] <= s_max)
         return st[key], feasible, st
 
@@ -105,6 +107,21 @@ def constrained_tuning(plant, wave, *, pto: str | None = None, params=None,
     if not np.isfinite(best.fun):
         raise ValueError(f"{plant.name}: no stable spring-damper meets the limits")
     return c, k, float(evaluate(c, k)[2]["power_W"])
+
+
+def electrical_winding(plant, pto: str | None, objective: str) -> float | None:
+    """The tuners' objective: "auto" (electrical power when the PTO has a drivetrain, else
+    mechanical), "electrical" or "mechanical". Returns the drivetrain's winding coefficient for
+    an electrical objective (impedance.winding_coefficient), None for a mechanical one."""
+    from .impedance import winding_coefficient
+    if objective not in ("auto", "electrical", "mechanical"):
+        raise ValueError(f"objective {objective!r}: expected auto, electrical or mechanical")
+    name = pto or plant.scene.ptos[0].name
+    winding = None if objective == "mechanical" else winding_coefficient(plant, name)
+    if objective == "electrical" and winding is None:
+        raise ValueError(f"objective 'electrical': PTO {name!r} has no [pto.drivetrain] "
+                         f"(give one, or an efficiency to the reactive tuner)")
+    return winding
 
 
 def multistart(cost, starts, *, xatol, fatol_rel, fatol_abs, maxiter):

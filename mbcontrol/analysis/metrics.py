@@ -91,12 +91,33 @@ def electrical_power(power, efficiency: float) -> np.ndarray:
     return np.where(power > 0, efficiency * power, power / efficiency)
 
 
+def _drivetrain_metrics(ds, name: str, steps, samples, power, drive) -> dict:
+    """With a drivetrain model: electrical power = the machine's absorbed power (from work,
+    as mean_power_W) less the winding loss of each step's held current; its mean, the mean
+    winding loss, the peak current (A) and voltage (V) and, with the scene's drivetrain, how
+    far they and the peak electrical power pass its current_max, voltage_max, power_max."""
+    loss = ds[f"{name}__winding_loss"].values[:-1][steps]
+    out = {"mean_electrical_power_W": float((power - loss).mean()),
+           "mean_winding_loss_W": float(loss.mean()),
+           "max_current_A": float(np.abs(ds[f"{name}__current"].values[samples]).max()),
+           "max_voltage_V": float(np.abs(ds[f"{name}__voltage"].values[samples]).max()),
+           "max_electrical_power_W": float(np.abs(power - loss).max())}
+    if drive is not None:
+        for key, limit in (("current", drive.current_max), ("voltage", drive.voltage_max),
+                           ("electrical_power", drive.power_max)):
+            peak = out["max_current_A" if key == "current" else "max_voltage_V"
+                       if key == "voltage" else "max_electrical_power_W"]
+            out[f"{key}_violation"] = float(max(peak - limit, 0.0))
+    return out
+
+
 def pto_metrics(ds, pto, start: float | None = None, end: float | None = None) -> dict:
     """Power, force and stroke metrics of one PTO over [start, end) s (default: the analysis
     window). `pto` is a scene Pto (its limits and efficiency are used) or a PTO name.
 
-    Keys: mean_power_W (mechanical, absorbed > 0, from work), mean_electrical_power_W (with
-    the PTO's efficiency), mean_abs_power_W, papr (peak |P| over mean P; inf when mean P <= 0),
+    Keys: mean_power_W (mechanical, absorbed > 0, from work), mean_electrical_power_W (from
+    the drivetrain model when the PTO has one, with mean_winding_loss_W, max_current_A and
+    max_voltage_V; else with the PTO's efficiency), mean_abs_power_W, papr (peak |P| over mean P; inf when mean P <= 0),
     p98_W (98th percentile of |P|), max_force, f98, max_stroke, z98 (98th percentiles of |F|
     and |x|), force_max / stroke_max (the PTO's limits), force_violation / stroke_violation
     (worst excess over the limit, 0 if none) and violation_fraction (share of samples outside
@@ -122,9 +143,13 @@ def pto_metrics(ds, pto, start: float | None = None, end: float | None = None) -
     stroke = np.abs(ds[f"{name}__position"].values[samples])
     mean = float(power.mean())
     outside = (force > force_max * (1 + 1e-9)) | (stroke > stroke_max * (1 + 1e-9))
+    electrical = _drivetrain_metrics(ds, name, steps, samples, power,
+                                     getattr(pto, "drivetrain", None)) \
+        if f"{name}__winding_loss" in ds else \
+        {"mean_electrical_power_W": float(electrical_power(power, efficiency).mean())}
     return {
         "mean_power_W": mean,
-        "mean_electrical_power_W": float(electrical_power(power, efficiency).mean()),
+        **electrical,
         "mean_abs_power_W": float(np.abs(power).mean()),
         "papr": float(np.abs(power).max() / mean) if mean > 0 else math.inf,
         "p98_W": float(np.percentile(np.abs(power), 98)),

@@ -90,6 +90,9 @@ def _print_design(plant, wave, result, command) -> None:
         constrained += f" - a REFERENCE, not a bound: {b['constrained_kind_reason']}"
     print(f"  bounds: complex-conjugate {_power(b['complex_conjugate_W'])}; constrained "
           f"({limits}) {constrained}")
+    if b.get("electrical_W") is not None:
+        print(f"  electrical bound (drivetrain model, linear theory, no limits): "
+              f"{_power(b['electrical_W'])}")
     if b.get("total_complex_conjugate_W") is not None:
         print(f"  bound on all PTOs together (multiport complex-conjugate): "
               f"{_power(b['total_complex_conjugate_W'])}")
@@ -102,9 +105,14 @@ def _print_design(plant, wave, result, command) -> None:
         kind = {"constrained": "reference" if b.get("constrained_kind") == "reference"
                 else "bound"}
         share = ", ".join(f"{v:.1f} % of the {k.replace('_', '-')} {kind.get(k, 'bound')}"
-                          for k, v in pct.items() if v is not None)
+                          for k, v in pct.items() if v is not None and k != "electrical")
         print(f"  simulated ({sim['duration_s']:.4g} s, dt {sim['dt_s']:.4g} s, nonlinear plant): "
               f"mean absorbed power {_power(m['mean_power_W'])} ({share})")
+        if "mean_winding_loss_W" in m:
+            print(f"    mean electrical power {_power(m['mean_electrical_power_W'])} "
+                  f"({pct['electrical']:.1f} % of the electrical bound), winding loss "
+                  f"{_power(m['mean_winding_loss_W'])}, peak current {m['max_current_A']:.4g} A, "
+                  f"peak voltage {m['max_voltage_V']:.4g} V")
         if "total_mean_power_W" in m:
             print(f"    all PTOs together: {_power(m['total_mean_power_W'])} "
                   f"({pct['total_complex_conjugate']:.1f} % of their bound)")

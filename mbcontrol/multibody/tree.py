@@ -132,6 +132,9 @@ class Tree:
             self.coordinate_names.extend(link.default_coordinate_names())
         self._check_names()
         self.n_q = self.n_s = len(self.coordinate_names)
+        # inertia on single generalised speeds (kg or kg m^2), e.g. a PTO drivetrain's
+        # gear_ratio^2 J on its joint: constant, so it adds no Coriolis terms
+        self.coordinate_inertia = np.zeros(self.n_s)
         self._joint_point = [as_casadi(link.joint_point, (3, 1)) for link in self.links]
         self._steps = [self._compile_steps(k) for k in range(len(self.links))]
         self._cog = [as_casadi(link.cog, (3, 1)) for link in self.links]
@@ -319,7 +322,8 @@ class Tree:
     def mass_matrix(self, q, added_mass_b=None):
         """M^g = P (M_RB^b + A^b) P^T, n_s x n_s (kg, kg m, kg m^2 entries)."""
         P = self.P(q)
-        return P @ self._body_mass(added_mass_b) @ P.T
+        M = P @ self._body_mass(added_mass_b) @ P.T
+        return M + ca.diag(ca.DM(self.coordinate_inertia)) if self.coordinate_inertia.any() else M
 
     def bias(self, q, s, added_mass_b=None):
         """C^g s = P M^b (Pdot^T s) + P C_RB^b(nu) nu, n_s (ERRATA G6, section 4).

@@ -40,10 +40,13 @@ def pto_forces(scene: Scene, topo: Topology, q, s, u, params: Parameters):
 
     Joint PTOs act on their coordinate; point-to-point PTOs along the line between their two
     points (x: change of distance, m; equal and opposite forces on the two bodies). The force
-    map takes a scalar PTO force to the generalised force (used for preloads).
+    map takes a scalar PTO force to the generalised force (used for preloads). A drivetrain
+    adds its friction here and its inertia to the tree's coordinate inertia (so every mass
+    matrix taken from the tree afterwards holds it); the force stays the machine's.
     """
     tau = ca.SX.zeros(topo.tree.n_s)
     signals = {}
+    topo.tree.coordinate_inertia[:] = 0.0           # set afresh by each call
     for i, pto in enumerate(scene.ptos):
         c = params.add(f"{pto.name}__damping", pto.damping)
         k = params.add(f"{pto.name}__stiffness", pto.stiffness)
@@ -55,6 +58,11 @@ def pto_forces(scene: Scene, topo: Topology, q, s, u, params: Parameters):
             direction[j] = 1.0
         force = -(c * v + k * x) + u[i]
         tau += direction * force
+        if pto.drivetrain is not None:        # the machine's friction, reflected through the gear
+            tau -= direction * pto.drivetrain.gear_ratio ** 2 * pto.drivetrain.friction * v
+            if pto.drivetrain.inertia:
+                topo.tree.coordinate_inertia[topo.coordinate_of_joint[pto.joint]] += \
+                    pto.drivetrain.gear_ratio ** 2 * pto.drivetrain.inertia
         signals[pto.name] = (x, v, force, direction)
     return tau, signals
 

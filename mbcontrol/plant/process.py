@@ -158,7 +158,7 @@ def assemble_plant(scene: Scene | str, hydro: HydroModel | None = None, *,
     x_dot = ca.vertcat(ca.mtimes(tree.K(q), s), s_dot, chi_dot)
     kinetic = 0.5 * ca.mtimes([s.T, M, s])
     power["energy"] = kinetic + potential
-    y, output_names = _outputs(scene, topo, q, s, pto_signals, power, tensions)
+    y, output_names = _outputs(scene, topo, q, s, pto_signals, power, tensions, s_dot)
     p = params.vector
 
     coords = list(tree.coordinate_names)
@@ -253,7 +253,7 @@ def dof_selector(topo: Topology, dofs: list[str]) -> np.ndarray:
     return select
 
 
-def _outputs(scene, topo: Topology, q, s, pto_signals, power, tensions):
+def _outputs(scene, topo: Topology, q, s, pto_signals, power, tensions, s_dot):
     tree = topo.tree
     q_rest = ca.DM.zeros(tree.n_q)
     values, names = [q, s], list(tree.coordinate_names) + [f"{c}__vel" for c in
@@ -262,9 +262,14 @@ def _outputs(scene, topo: Topology, q, s, pto_signals, power, tensions):
         displacement = tree.cog(q, k) - tree.cog(q_rest, k)
         values += [displacement, loads.euler_zyx(tree.rotation(q, k))]
         names += [f"{body}__{dof}" for dof in DOF_NAMES]
-    for pto, (position, velocity, force, _) in pto_signals.items():
+    drivetrains = {p.name: p.drivetrain for p in scene.ptos if p.drivetrain is not None}
+    for pto, (position, velocity, force, direction) in pto_signals.items():
         values += [position, velocity, force, -force * velocity]
         names += [f"{pto}__position", f"{pto}__velocity", f"{pto}__force", f"{pto}__power"]
+        if pto in drivetrains:
+            values += drivetrain_signals(drivetrains[pto], velocity, force,
+                                         ca.dot(direction, s_dot))
+            names += [f"{pto}__{kind}" for kind in DRIVETRAIN_SIGNALS]
     # energy audit: radiated (W, leaving the bodies), wave input (W), and the mechanical energy
     # (J): kinetic + hydrostatic, gravity (dry bodies), mooring and end-stop potentials; PTO
     # forces, springs included, are external: their power is <pto>__power
@@ -279,6 +284,25 @@ def _outputs(scene, topo: Topology, q, s, pto_signals, power, tensions):
 _BODY_UNITS = {"Surge": ("m", "N"), "Sway": ("m", "N"), "Heave": ("m", "N"),
                "Roll": ("rad", "N m"), "Pitch": ("rad", "N m"), "Yaw": ("rad", "N m")}
 _ENERGY_UNITS = {"radiated_power": "W", "excitation_power": "W", "energy": "J"}
+
+
+DRIVETRAIN_SIGNALS = {"current": "A", "voltage": "V", "winding_loss": "W", "friction_loss": "W",
+                      "electrical_power": "W", "mechanical_power": "W"}
+
+
+def drivetrain_signals(d, v, force, acceleration) -> list:
+    """A drivetrain's signals (DRIVETRAIN_SIGNALS, in order) from the PTO velocity v, the
+    machine's force (the PTO force) and the PTO acceleration: current F / (gear kt'), voltage
+    R I + kt' gear v (a current-controlled drive; the inductive L dI/dt, whose mean power is
+    zero, is left out), winding loss R I^2, friction loss gear^2 b v^2, electrical power
+    delivered -F v - R I^2, and the mechanical power the joint puts in,
+    -(F - gear^2 (J a + b v)) v = electrical + losses + d/dt(gear^2 J v^2 / 2)."""
+    current = force / d.force_per_current
+    winding = d.winding_resistance * current ** 2
+    friction = d.gear_ratio ** 2 * d.friction * v * v
+    shaft = d.gear_ratio ** 2 * (d.inertia * acceleration + d.friction * v)
+    return [current, d.winding_resistance * current + d.kt * d.gear_ratio * v, winding,
+            friction, -force * v - winding, -(force - shaft) * v]
 
 
 def _coordinate_unit(plant, name: str) -> str:
@@ -307,7 +331,7 @@ def _units(plant, signal: str) -> str:
             force = "N m" if coord == "rad" else "N"
             kind = "force" if base == pto.name else base.split("__")[-1]
             return {"position": coord, "velocity": f"{coord}/s", "force": force,
-                    "power": "W"}[kind]
+                    "power": "W", **DRIVETRAIN_SIGNALS}[kind]
     if signal.endswith("__tension"):
         return "N"
     if signal.endswith(("__span", "__height")):

@@ -6,10 +6,10 @@ section each), `checks` (field readers and whole-scene checks), `template` ([par
 repeat), `units` ("60 mm" -> 0.06), `load` (files and the catalogue).
 """
 from .load import catalogue_dir, list_models, load_scene, resolve
-from .model import (DOF_NAMES, JOINT_TYPES, Body, Drag, EndStop, Friction, Geometry, HydroSettings,
+from .model import (DOF_NAMES, JOINT_TYPES, Body, Drag, Drivetrain, EndStop, Friction, Geometry, HydroSettings,
                     Joint, Mooring, Obstacle, Pto, Scene, Water)
 from .parse import parse_scene
 
 __all__ = ["load_scene", "list_models", "catalogue_dir", "resolve", "parse_scene",
            "DOF_NAMES", "JOINT_TYPES", "Scene", "Water", "Geometry", "Body", "Joint", "Pto",
-           "Friction", "Mooring", "EndStop", "Drag", "HydroSettings", "Obstacle"]
+           "Friction", "Mooring", "EndStop", "Drag", "Drivetrain", "HydroSettings", "Obstacle"]

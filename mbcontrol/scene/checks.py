@@ -149,8 +149,8 @@ class Reader:
             self.fail(key, f"expected finite numbers, got {values}")
         return values
 
-    def nonnegative(self, key: str, default=_REQUIRED) -> float:
-        value = self.number(key, None, default)
+    def nonnegative(self, key: str, default=_REQUIRED, dimension: str | None = None) -> float:
+        value = self.number(key, dimension, default)
         if not value >= 0 or math.isinf(value):
             self.fail(key, f"expected a finite non-negative number, got {value}")
         return value

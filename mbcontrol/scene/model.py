@@ -96,10 +96,44 @@ class Pto:
     parent: str = "ground"
     parent_point: tuple[float, float, float] | None = None  # m, n-frame at rest
     preload: str = "none"          # "none" | "balance"
+    drivetrain: "Drivetrain | None" = None   # None: an ideal PTO (efficiency applies)
 
     @property
     def between_points(self) -> bool:
         return self.joint is None
+
+
+@dataclass(frozen=True)
+class Drivetrain:
+    """A PTO's gear and electric machine (`[pto.drivetrain]`), as WecOptTool's two-port.
+
+    The generator turns at gear_ratio x the PTO velocity (rad/s per m/s, or per rad/s). The
+    PTO force F (the controller's command, its limits) is the machine's: current
+    I = F / (gear_ratio kt'), kt' = torque_constant x sqrt(3/2) for a three-phase machine in dq
+    (phases = 3), torque_constant for phases = 1; voltage V = R I + L dI/dt + kt' gear_ratio v;
+    electrical power delivered -F v - R I^2. The machine's inertia and friction act on the
+    joint as gear_ratio^2 inertia and gear_ratio^2 friction.
+    """
+    gear_ratio: float = 1.0          # rad/s of the generator per m/s (or rad/s) of the PTO
+    torque_constant: float = 1.0     # N m/A (N/A for a linear machine with gear_ratio 1)
+    winding_resistance: float = 0.0  # ohm
+    winding_inductance: float = 0.0  # H
+    inertia: float = 0.0             # kg m^2 at the generator
+    friction: float = 0.0            # N m s/rad at the generator
+    phases: int = 3                  # 3: the sqrt(3/2) dq factor; 1: none
+    current_max: float = math.inf    # A
+    voltage_max: float = math.inf    # V
+    power_max: float = math.inf      # W
+
+    @property
+    def kt(self) -> float:
+        """The effective torque constant kt' (N m/A), dq factor included."""
+        return self.torque_constant * (math.sqrt(1.5) if self.phases == 3 else 1.0)
+
+    @property
+    def force_per_current(self) -> float:
+        """N (or N m) of PTO force per A: gear_ratio x kt'."""
+        return self.gear_ratio * self.kt
 
 
 @dataclass(frozen=True)

@@ -8,8 +8,8 @@ import numpy as np
 
 from .. import defaults
 from .checks import Reader, catenary_geometry, check_topology
-from .model import (DOF_NAMES, JOINT_TYPES, Body, Drag, EndStop, Friction, Geometry, HydroSettings,
-                    Joint, Mooring, Obstacle, Pto, Scene, Water)
+from .model import (DOF_NAMES, JOINT_TYPES, Body, Drag, Drivetrain, EndStop, Friction, Geometry,
+                    HydroSettings, Joint, Mooring, Obstacle, Pto, Scene, Water)
 from .template import expand
 from .units import JOINT_DIMENSIONS
 
@@ -123,7 +123,7 @@ def _joint(r: Reader) -> Joint:
 
 def _pto(r: Reader, kinds: dict) -> Pto:
     r.allow("name", "joint", "damping", "stiffness", "force_max", "stroke_max", "efficiency",
-            "body", "point", "parent", "parent_point", "preload")
+            "body", "point", "parent", "parent_point", "preload", "drivetrain")
     joint = r.string("joint", default=None)
     # limits in units of the joint's coordinate: "4 m" / "2 MN" (prismatic or between points),
     # "30 deg" / "5 MN m" (revolute); an unknown joint is named by the scene checks later
@@ -148,7 +148,32 @@ def _pto(r: Reader, kinds: dict) -> Pto:
                point=r.vector("point", "length", default=None),
                parent=r.string("parent", default="ground"),
                parent_point=r.vector("parent_point", "length", default=None),
-               preload=r.choice("preload", ("none", "balance"), default="none"))
+               preload=r.choice("preload", ("none", "balance"), default="none"),
+               drivetrain=_drivetrain(r.table("drivetrain", required=False), joint is None))
+
+
+def _drivetrain(r: Reader, between_points: bool) -> Drivetrain | None:
+    """[pto.drivetrain]: gear and electric machine (absent: an ideal PTO)."""
+    if r.empty:
+        return None
+    r.allow("gear_ratio", "torque_constant", "winding_resistance", "winding_inductance",
+            "inertia", "friction", "phases", "current_max", "voltage_max", "power_max")
+    phases = r._get("phases", 3, shape="1 or 3")
+    if phases not in (1, 3) or isinstance(phases, bool):
+        r.fail("phases", f"expected 1 or 3 (3: a three-phase machine in dq), got {phases!r}")
+    inertia = r.nonnegative("inertia", default=0.0)
+    if inertia > 0 and between_points:
+        r.fail("inertia", "a drivetrain inertia needs a PTO on a joint (between points the "
+                          "reflected inertia would depend on the pose); give 0 or use a joint")
+    limit = (lambda key, dim: r.positive(key, dim, default=math.inf, finite=False))
+    return Drivetrain(gear_ratio=r.positive("gear_ratio", None, default=1.0),
+                      torque_constant=r.positive("torque_constant", None),
+                      winding_resistance=r.nonnegative("winding_resistance", 0.0, "resistance"),
+                      winding_inductance=r.nonnegative("winding_inductance", 0.0, "inductance"),
+                      inertia=inertia, friction=r.nonnegative("friction", default=0.0),
+                      phases=int(phases), current_max=limit("current_max", "current"),
+                      voltage_max=limit("voltage_max", "voltage"),
+                      power_max=limit("power_max", "power"))
 
 
 def _friction(r: Reader) -> Friction:

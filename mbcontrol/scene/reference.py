@@ -29,6 +29,8 @@ SECTIONS = {
                 "mesh `file`)",
     "joint": "`[[joint]]`: the tree, rooted at `ground`, one joint per body",
     "pto": "`[[pto]]`: a power take-off on a joint, or between two body points",
+    "pto.drivetrain": "`[pto.drivetrain]`: the PTO's gear and electric machine (absent: an "
+                      "ideal PTO, `efficiency` applies); the PTO force is the machine's",
     "friction": "`[[friction]]`: joint friction",
     "end_stop": "`[[end_stop]]`: a stiff spring-damper stop on a joint coordinate",
     "mooring": "`[[mooring]]`: `type = \"linear\"` (springs in x, y, z) or `\"catenary\"`",
@@ -94,6 +96,21 @@ MEANING = {
                            "(revolute)",
     ("pto", "efficiency"): "drivetrain efficiency in (0, 1] (electrical power)",
     ("pto", "preload"): "`balance`: the constant force that makes rest an equilibrium",
+    ("pto", "drivetrain"): "gear and generator (`[pto.drivetrain]`): current, voltage, losses "
+                           "and electrical power as signals",
+    ("pto.drivetrain", "gear_ratio"): "generator rad/s per m/s (or rad/s) of the PTO",
+    ("pto.drivetrain", "torque_constant"): "N m/A (N/A for a linear machine with gear 1)",
+    ("pto.drivetrain", "winding_resistance"): "per phase (dq)",
+    ("pto.drivetrain", "winding_inductance"): "per phase; in the voltage's phasor, not in "
+                                              "the time-domain power (mean zero)",
+    ("pto.drivetrain", "inertia"): "rotor and gear inertia at the generator, kg m^2 (acts as "
+                                   "gear^2 x on the joint; joint PTOs only)",
+    ("pto.drivetrain", "friction"): "at the generator, N m s/rad (gear^2 x on the joint)",
+    ("pto.drivetrain", "phases"): "3: a three-phase machine, kt x sqrt(3/2) in dq; 1: none",
+    ("pto.drivetrain", "current_max"): "current limit (reported against; not yet imposed)",
+    ("pto.drivetrain", "voltage_max"): "voltage limit (reported against; not yet imposed)",
+    ("pto.drivetrain", "power_max"): "electrical power rating (reported against; not yet "
+                                     "imposed)",
     ("friction", "name"): "its name (default `<joint>_friction`)",
     ("friction", "joint"): "the joint it acts on",
     ("friction", "viscous"): "viscous coefficient (N s/m or N m s/rad)",
@@ -184,6 +201,15 @@ parent = "ground"
 child = "float"
 axis = [0, 0, 1]
 point = [0, 0, 0]
+[[pto]]
+name = "generator"
+joint = "heave"
+[pto.drivetrain]
+torque_constant = 1.0
+winding_inductance = "1 mH"
+current_max = "10 A"
+voltage_max = "400 V"
+power_max = "1 kW"
 [[end_stop]]
 joint = "heave"
 lower = -1

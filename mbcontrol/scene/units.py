@@ -21,6 +21,11 @@ UNITS: dict[str, dict[str, float]] = {
     "force": {"N": 1.0, "kN": 1e3, "MN": 1e6},
     "moment": {"N m": 1.0, "N*m": 1.0, "Nm": 1.0, "kN m": 1e3, "kN*m": 1e3, "kNm": 1e3,
                "MN m": 1e6, "MN*m": 1e6, "MNm": 1e6},
+    "current": {"A": 1.0, "mA": 1e-3, "kA": 1e3},
+    "voltage": {"V": 1.0, "mV": 1e-3, "kV": 1e3},
+    "resistance": {"ohm": 1.0, "mohm": 1e-3, "kohm": 1e3},
+    "inductance": {"H": 1.0, "mH": 1e-3, "uH": 1e-6},
+    "power": {"W": 1.0, "kW": 1e3, "MW": 1e6},
 }
 # a joint coordinate: a length (prismatic) or an angle (revolute), where the joint is not known
 UNITS["coordinate"] = {**UNITS["length"], **UNITS["angle"]}
@@ -30,7 +35,8 @@ JOINT_DIMENSIONS = {"prismatic": ("length", "force"), "revolute": ("angle", "mom
 SI_UNIT = {
     "length": "m", "mass": "kg", "angle": "rad", "time": "s", "frequency": "rad/s",
     "density": "kg/m^3", "acceleration": "m/s^2", "inertia": "kg*m^2", "coordinate": "m or rad",
-    "force": "N", "moment": "N m",
+    "force": "N", "moment": "N m", "current": "A", "voltage": "V", "resistance": "ohm",
+    "inductance": "H", "power": "W",
 }
 
 _QUANTITY = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(\S.*?)?\s*$")

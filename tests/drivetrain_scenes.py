@@ -1,0 +1,29 @@
+"""Catalogue scenes with a drivetrain added to their first PTO (tests only): written beside a
+copy that reads the catalogue's hydro data."""
+from pathlib import Path
+
+from mbcontrol.scene import catalogue_dir
+
+DRIVETRAIN = """
+[pto.drivetrain]
+gear_ratio = {gear}
+torque_constant = "{kt}"
+winding_resistance = "{resistance}"
+inertia = {inertia}
+friction = {friction}
+phases = 3
+"""
+
+
+def with_drivetrain(folder: Path, model: str, *, gear=12.0, kt=6.7, resistance="0.5 ohm",
+                    inertia=2.0, friction=1.0) -> Path:
+    """`folder/<model>_dt.toml`: the catalogue scene, its hydro file made absolute, with the
+    drivetrain table appended to its only PTO (it must be the file's last table)."""
+    text = (catalogue_dir() / f"{model}.toml").read_text()
+    text = text.replace('file = "', f'file = "{catalogue_dir()}/')
+    text = "\n".join(line for line in text.splitlines()
+                     if not line.startswith(("source =", "source_bodies")))
+    path = folder / f"{model}_dt.toml"
+    path.write_text(text + DRIVETRAIN.format(gear=gear, kt=kt, resistance=resistance,
+                                             inertia=inertia, friction=friction))
+    return path
