@@ -54,6 +54,7 @@ bench: $(VENV)/.installed-test
 	$(PY) benchmarks/identify.py --out $(OUT)/bench/identify
 	$(PY) benchmarks/sweep.py --out $(OUT)/bench/sweep
 	$(PY) benchmarks/sweep_light.py --out $(OUT)/bench/sweep_light
+	$(PY) benchmarks/wecopttool_electrical.py --out $(OUT)/bench/wecopttool
 
 clean:
 	rm -rf $(OUT) .pytest_cache

@@ -73,9 +73,10 @@ class DesignResult:
     JSON, `--set force_max=inf`); predicted_power_W: linear theory (None for
     switching and predictive control); bound: complex_conjugate_W, constrained_W (None with
     constrained_reason when skipped or infeasible), force_max, stroke_max, and electrical_W
-    for a PTO with a drivetrain (impedance.electrical_optimum: no limit in it, so it bounds
-    the limited runs too; percent_of_bound["electrical"] sets the simulated electrical power
-    against it); metrics:
+    for a PTO with a drivetrain (in a regular wave within the PTO's force and stroke limits,
+    analysis.electrical.electrical_bound; in a sea impedance.electrical_optimum, with no limit,
+    which bounds the limited runs too: electrical_within_limits says which;
+    percent_of_bound["electrical"] sets the simulated electrical power against it); metrics:
     metrics.pto_metrics of the designed PTO in closed loop (None if not simulated);
     percent_of_bound: 100 x simulated power / each bound; margins: controllers.margins.Margins
     (passive and reactive); tuner: what tuned it and what it reported; simulation: duration_s,
@@ -297,10 +298,17 @@ def _bounds(plant, wave, pto, limit_values, mode, params=None, whole=False) -> d
         out["constrained_reason"] = f"no bound: {exc}"
         return out
     out["complex_conjugate_W"] = cc.power
+    force_max, stroke_max = limit_values["force_max"], limit_values["stroke_max"]
     if next(p for p in plant.scene.ptos if p.name == pto).drivetrain is not None:
         from .impedance import electrical_optimum     # limits only lower it: still a bound
         out["electrical_W"] = electrical_optimum(plant, wave, pto=pto, params=params)["power_W"]
-    force_max, stroke_max = limit_values["force_max"], limit_values["stroke_max"]
+        out["electrical_within_limits"] = False
+        if wave.omega.size == 1 and (math.isfinite(force_max) or math.isfinite(stroke_max)):
+            from mbcontrol.analysis.electrical import electrical_bound   # within the limits
+            out["electrical_W"] = electrical_bound(
+                plant, wave, pto=pto, force_max=force_max, stroke_max=stroke_max, params=params,
+                omega_max=float(plant.hydro.omega[-1])).electrical_W
+            out["electrical_within_limits"] = True
     if not (math.isfinite(force_max) or math.isfinite(stroke_max)):
         out["constrained_W"] = cc.power
         out["constrained_reason"] = ("the PTO has no force or stroke limit: the "

@@ -42,6 +42,7 @@ TABLES = {
     "rm3, scene PTO, 1 h at dt 0.05 s": ("measured", "benchmarks/sweep_light.py"),
     "site": ("test", "tests/waves/test_annual_energy_pins.py"),
     "device": ("test", "tests/controllers/test_electrical.py"),
+    "optimum": ("measured", "benchmarks/wecopttool_electrical.py"),
     "data": ("measured", "benchmarks/radiation_fit.py"),
     "method": ("reference", "the integration methods by name"),
     "scenario": ("measured", "--stability"),

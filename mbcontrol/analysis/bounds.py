@@ -280,8 +280,8 @@ class PseudoSpectralProblem:
         if has_force:
             limits["force"] = cp.Parameter(nonneg=True)
             f = cp.Variable(self.time.size)
-            constraints += [f == self.force_map[1] @ z, f <= limits["force"],
-                            -f <= limits["force"]]
+            constraints += [f == self.force_map[1] @ z + self.force_map[0] / self.F0,
+                            f <= limits["force"], -f <= limits["force"]]
         if has_stroke:
             limits["stroke"] = cp.Parameter(nonneg=True)
             x = cp.Variable(self.time.size)

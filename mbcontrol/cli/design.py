@@ -91,7 +91,9 @@ def _print_design(plant, wave, result, command) -> None:
     print(f"  bounds: complex-conjugate {_power(b['complex_conjugate_W'])}; constrained "
           f"({limits}) {constrained}")
     if b.get("electrical_W") is not None:
-        print(f"  electrical bound (drivetrain model, linear theory, no limits): "
+        within = ("within the force and stroke limits" if b.get("electrical_within_limits")
+                  else "no limits")
+        print(f"  electrical bound (drivetrain model, linear theory, {within}): "
               f"{_power(b['electrical_W'])}")
     if b.get("total_complex_conjugate_W") is not None:
         print(f"  bound on all PTOs together (multiport complex-conjugate): "

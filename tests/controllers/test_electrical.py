@@ -140,3 +140,25 @@ def test_tuned_for_electricity_it_delivers_more_of_it(sphere):
     assert runs["mechanical"]["mean_power_W"] > runs["electrical"]["mean_power_W"]
     bound = electrical_optimum(sphere, wave)["power_W"]
     assert runs["electrical"]["mean_electrical_power_W"] <= bound
+
+
+def test_limited_bound_is_the_same_qp_with_the_loss_and_meets_the_closed_form(sphere):
+    """analysis.electrical.electrical_bound (the pseudo-spectral QP with the winding loss in
+    its quadratic) without limits equals the closed form; a force limit that binds lowers it;
+    limiting the force on the hull (machine force less the drivetrain's inertia and friction
+    forces, WecOptTool's PTO force) gives another figure, and its force series holds the limit."""
+    from mbcontrol.analysis.electrical import electrical_bound
+    wave = waves.regular(2.0, 9.0)
+    free = electrical_bound(sphere, wave, omega_max=6.0)
+    assert free.electrical_W == pytest.approx(electrical_optimum(sphere, wave)["power_W"],
+                                              rel=1e-5)
+    assert free.mechanical_W - free.winding_loss_W == pytest.approx(free.electrical_W)
+    limit = 0.5 * free.mechanical.max_force
+    machine = electrical_bound(sphere, wave, force_max=limit, omega_max=6.0)
+    hull = electrical_bound(sphere, wave, force_max=limit, omega_max=6.0, force_on="wec")
+    assert machine.electrical_W < free.electrical_W and hull.electrical_W < free.electrical_W
+    assert machine.mechanical.max_force == pytest.approx(limit, rel=1e-4)
+    assert hull.mechanical.max_force == pytest.approx(limit, rel=1e-4)   # its series: the hull's
+    assert abs(hull.electrical_W / machine.electrical_W - 1) > 1e-4   # 288 kg on 262 t
+    with pytest.raises(ValueError, match="force_on 'shaft'"):
+        electrical_bound(sphere, wave, force_on="shaft")
