@@ -38,6 +38,7 @@ import numpy as np
 from .base import per_pto, signal_indices
 from .impedance import intrinsic_impedance
 from .limits import force_limits, limits_report, saturate
+from .tuning import electrical_winding
 
 
 class _Switching:
@@ -180,14 +181,17 @@ def _port_inertia(plant, names) -> np.ndarray:
 # ------------------------------------------------------------------------------------------
 # tuning by simulation
 
-def mean_power(ds, pto: str, start: float = 0.0, end: float | None = None) -> float:
+def mean_power(ds, pto: str, start: float = 0.0, end: float | None = None,
+               key: str = "mean_power_W") -> float:
     """Mean absorbed power (W) over [start, end) s, from the work the PTO does
-    (mbcontrol.analysis.metrics.step_power). For an irregular sea use start = the ramp time."""
+    (mbcontrol.analysis.metrics.step_power); key "mean_electrical_power_W" for the electrical
+    one. For an irregular sea use start = the ramp time."""
     from mbcontrol.analysis import pto_metrics
-    return pto_metrics(ds, pto, start, end)["mean_power_W"]
+    return pto_metrics(ds, pto, start, end)[key]
 
 
-def steady_mean_power(ds, pto: str, period: float, skip_periods: int = 5) -> float:
+def steady_mean_power(ds, pto: str, period: float, skip_periods: int = 5,
+                      key: str = "mean_power_W") -> float:
     """Mean absorbed power (W) of a regular-wave run over whole periods after skip_periods:
     mean_power over [skip T, skip T + n T), n the most whole periods the record holds."""
     t = ds["time"].values
@@ -196,7 +200,7 @@ def steady_mean_power(ds, pto: str, period: float, skip_periods: int = 5) -> flo
     if n < 1:
         raise ValueError(f"record of {t[-1]:.4g} s too short to skip {skip_periods} periods of "
                          f"{period:.4g} s and average over one")
-    return mean_power(ds, pto, start, start + n * period)
+    return mean_power(ds, pto, start, start + n * period, key)
 
 
 def natural_period(plant, *, pto: str | None = None, params=None) -> float:
@@ -217,11 +221,15 @@ LATCH_SCAN_STEP = 0.01          # of the wave period: the scan step before refin
                                 # sphere's latching peak is about T / 40 wide at half height)
 
 
-def _simulated_power(plant, wave, controller, pto, dt, periods, skip) -> float:
+def _simulated_power(plant, wave, controller, pto, dt, periods, skip, objective) -> float:
+    """The tuners' objective, simulated: mean electrical power for a PTO with a drivetrain
+    (objective "auto" or "electrical", tuning.electrical_winding), else mechanical."""
     from mbcontrol.sim import simulate
     T = wave.period
     ds = simulate(plant, wave, duration=(skip + periods) * T, dt=dt, controller=controller)
-    return steady_mean_power(ds, pto, T, skip)
+    electrical = electrical_winding(plant, pto, objective) is not None
+    return steady_mean_power(ds, pto, T, skip,
+                             "mean_electrical_power_W" if electrical else "mean_power_W")
 
 
 def _search(objective, lo, hi, xatol):
@@ -255,8 +263,8 @@ def _regular(wave, what):
 
 def optimal_latch_time(plant, wave, *, damping: float | None = None, pto: str | None = None,
                        dt: float | None = None, skip: int = 8, periods: int = 3,
-                       tune_damping: bool = False,
-                       force_max=None) -> tuple[float, float, float]:
+                       tune_damping: bool = False, force_max=None,
+                       objective: str = "auto") -> tuple[float, float, float]:
     """(latch_time s, damping N s/m, simulated mean power W) for a regular wave of period T.
 
     Starts from the classical rule latch_time = (T - T_n) / 2 (released at the end of its
@@ -270,7 +278,8 @@ def optimal_latch_time(plant, wave, *, damping: float | None = None, pto: str | 
     tune_damping, 1-D searches in log damping (x 1/4..4) and in latch time in turn, twice.
     dt: simulation step, default T / 500. force_max: the simulated controllers' force limit
     (N or N m; None: the scene PTO's, as Latching's default), so the tuning sees the brake
-    the device has.
+    the device has. objective: "auto" maximises the simulated electrical power of a PTO with
+    a drivetrain (else the mechanical), "electrical" or "mechanical".
     """
     name = pto or plant.scene.ptos[0].name
     T = _regular(wave, "optimal_latch_time")
@@ -284,7 +293,7 @@ def optimal_latch_time(plant, wave, *, damping: float | None = None, pto: str | 
 
     def power(latch: float, c: float) -> float:
         return _simulated_power(plant, wave, Latching(c, latch, force_max=force_max), name, dt,
-                                periods, skip)
+                                periods, skip, objective)
 
     guess = 0.5 * (T - T_n)
     latch, best = _bracket_search(lambda x: power(x, damping), max(0.0, guess - 0.1 * T),
@@ -304,8 +313,8 @@ def optimal_latch_time(plant, wave, *, damping: float | None = None, pto: str | 
 
 def optimal_declutch(plant, wave, *, damping: float | None = None, pto: str | None = None,
                      dt: float | None = None, skip: int = 8, periods: int = 3,
-                     tune_damping: bool = False,
-                     force_max=None) -> tuple[float, float, float]:
+                     tune_damping: bool = False, force_max=None,
+                     objective: str = "auto") -> tuple[float, float, float]:
     """(declutch_time s, damping N s/m, simulated mean power W) for a regular wave of period T.
 
     A bounded 1-D search over declutch_time tau in [0, 0.45 T] on the simulated mean power (as
@@ -325,7 +334,7 @@ def optimal_declutch(plant, wave, *, damping: float | None = None, pto: str | No
 
     def power(tau: float, c: float) -> float:
         return _simulated_power(plant, wave, Declutching(c, tau, force_max=force_max), name,
-                                dt, periods, skip)
+                                dt, periods, skip, objective)
 
     tau, best = _bracket_search(lambda x: power(x, damping_at(x)), 0.0, 0.45 * T,
                                 LATCH_SCAN_STEP * T, dt)

@@ -59,6 +59,7 @@ from mbcontrol.results import jsonable
 from .base import per_pto, signal_indices
 from .control_plant import build_control_plant, device_frequency, pto_impedance
 from .estimation import ArPredictor, ExcitationKalman, excitation_error, wave_frequencies
+from .impedance import winding_coefficient
 from .limits import LINEAR_RANGE_SHARE, linear_range
 from .mpc_qp import CondensedQp
 
@@ -88,7 +89,9 @@ class Mpc:
     states (balanced truncation), None = full; force_penalty: r relative to the energy
     Hessian's largest eigenvalue; stroke_penalty: slack weights (w1 = w2 in scaled units);
     soft_stroke; measured: output names the Kalman filter reads (default: every joint
-    coordinate and rate); ar_order; measurement_noise (Kalman, relative).
+    coordinate and rate); ar_order; measurement_noise (Kalman, relative); objective: "auto"
+    (electrical power for PTOs with a drivetrain: each step's winding loss R F^2 dt /
+    (gear kt')^2 enters the QP), "electrical" or "mechanical".
     """
     name = "mpc"
 
@@ -98,11 +101,12 @@ class Mpc:
                  force_penalty: float = 1e-3, stroke_penalty: float = 100.0,
                  soft_stroke: bool = True, measured=None, ar_order: int = 8,
                  measurement_noise: float = 1e-3, efficiency=None,
-                 warm_up_s: float | None = None):
+                 warm_up_s: float | None = None, objective: str = "auto"):
         forecast = forecast or "ar"        # causal by default; the oracle only when asked
         _choice("forecast", forecast, ("known", "ar", "model", "none"))
         _choice("estimator", estimator, ("kalman", "state"))
         _choice("solver", solver, ("qpoases", "cvxpy"))
+        _choice("objective", objective, ("auto", "electrical", "mechanical"))
         if forecast == "known" and wave is None:
             raise ValueError("mpc: forecast 'known' needs the wave (wave=...)")
         if warm_up_s is not None and not warm_up_s >= 0:
@@ -116,7 +120,7 @@ class Mpc:
         self.order, self.force_penalty, self.stroke_penalty = order, force_penalty, stroke_penalty
         self.soft_stroke, self.measured, self.ar_order = soft_stroke, measured, ar_order
         self.measurement_noise = measurement_noise
-        self.efficiency = efficiency
+        self.efficiency, self.objective = efficiency, objective
         self.warm_up_setting = warm_up_s
         self.period = self.dt_s
         self.uses_state = estimator == "state"
@@ -146,7 +150,9 @@ class Mpc:
                           f"sea's own spectrum estimates the excitation better", RuntimeWarning,
                           stacklevel=3)
         omega = wave_frequencies(self.wave, self.device_omega)
-        self.qp = CondensedQp(cp, self.N, self.limits, efficiency=efficiency,
+        winding = [0.0 if self.objective == "mechanical" else winding_coefficient(plant, p.name)
+                   or 0.0 for p in ptos]            # a drivetrain's R / (gear kt')^2, W/N^2
+        self.qp = CondensedQp(cp, self.N, self.limits, efficiency=efficiency, winding=winding,
                               loss_damping=pto_impedance(cp, float(np.median(omega))),
                               force_penalty=self.force_penalty,
                               stroke_penalty=self.stroke_penalty, soft_stroke=self.soft_stroke,

@@ -15,7 +15,8 @@ class CondensedQp:
     """
 
     def __init__(self, cp, N: int, limits: dict, *, efficiency, loss_damping,
-                 force_penalty: float, stroke_penalty: float, soft_stroke: bool, solver: str):
+                 force_penalty: float, stroke_penalty: float, soft_stroke: bool, solver: str,
+                 winding=None):
         nu, nz = len(cp.ptos), cp.nz
         self.N, self.nu, self.solver = N, nu, solver
         # prediction of the positions at the ends of steps 1..N
@@ -54,6 +55,8 @@ class CondensedQp:
         loss_u, loss_v = b * cp.dt / c, b * c / cp.dt
         quad = 0.5 * (a[:, None] * G + (a[:, None] * G).T) + np.diag(loss_u) \
             + G.T @ (loss_v[:, None] * G) + r * np.eye(N * nu)
+        if winding is not None:            # a drivetrain's winding loss over each held step
+            quad += np.diag(np.tile(np.asarray(winding, float), N) * cp.dt)
         # scaled (objective / (F_s L_s)), clipped to PSD against round-off
         w, V = np.linalg.eigh(2 * Fs / Ls * quad)
         self.H_u = (V * np.clip(w, 2 * r * Fs / Ls * 1e-3, None)) @ V.T
