@@ -221,7 +221,8 @@ LATCH_SCAN_STEP = 0.01          # of the wave period: the scan step before refin
                                 # sphere's latching peak is about T / 40 wide at half height)
 
 
-def _simulated_power(plant, wave, controller, pto, dt, periods, skip, objective) -> float:
+def _simulated_power(plant, wave, controller, pto, dt, periods, skip,
+                     objective: str = "auto") -> float:
     """The tuners' objective, simulated: mean electrical power for a PTO with a drivetrain
     (objective "auto" or "electrical", tuning.electrical_winding), else mechanical."""
     from mbcontrol.sim import simulate
