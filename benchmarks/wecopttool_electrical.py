@@ -64,14 +64,13 @@ PEER = textwrap.dedent('''
                 return limit - jnp.abs(pto.force_on_wec(wec, x_wec, x_opt, wave, 4).flatten())
             constraints = [{"type": "ineq", "fun": bound}]
         wec = wot.WEC.from_bem(bem, constraints=constraints, f_add={"PTO": pto.force_on_wec})
-        start = time.perf_counter() if False else None
         res = wec.solve(waves, pto.average_power, 2 * nfreq, scale_x_wec=1e1, scale_x_opt=1e-3,
                         scale_obj=1e-2, optim_options={"maxiter": 1000})[0]
         x_wec, x_opt = wec.decompose_state(res.x)
         results[label] = {"power_W": -float(res.fun), "success": bool(res.success),
                           "mechanical_W": -float(pto.mechanical_average_power(wec, x_wec, x_opt, waves))}
     print(json.dumps(results))
-''').replace("start = time.perf_counter() if False else None\n        ", "")
+''')
 
 SCENE = '''name = "wavebot"
 description = "WecOptTool's tutorial-1 WaveBot in heave: its mesh, mass and electrical PTO"

@@ -95,12 +95,6 @@ def electrical_optimum(plant, wave, *, pto: str | None = None, params=None) -> d
             "mechanical_power_W": float(np.sum(-0.5 * (g * current * np.conj(velocity)).real))}
 
 
-def winding_coefficient(plant, pto: str) -> float | None:
-    """R / (gear kt')^2 (W per N^2 of PTO force) of a PTO's drivetrain; None without one."""
-    drive = next(p for p in plant.scene.ptos if p.name == pto).drivetrain
-    return None if drive is None else drive.winding_resistance / drive.force_per_current ** 2
-
-
 def closed_loop_stability(plant, damping: float, stiffness: float, *, pto: str | None = None,
                           params=None) -> tuple[bool, float]:
     """Is the linearised plant stable under u = -(damping v + stiffness x)? (stable, margin).

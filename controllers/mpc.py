@@ -54,12 +54,12 @@ import warnings
 
 import numpy as np
 
+from mbcontrol.analysis.electrical import winding_coefficient
 from mbcontrol.results import jsonable
 
 from .base import per_pto, signal_indices
 from .control_plant import build_control_plant, device_frequency, pto_impedance
 from .estimation import ArPredictor, ExcitationKalman, excitation_error, wave_frequencies
-from .impedance import winding_coefficient
 from .limits import LINEAR_RANGE_SHARE, linear_range
 from .mpc_qp import CondensedQp
 

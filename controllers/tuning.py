@@ -112,8 +112,9 @@ def constrained_tuning(plant, wave, *, pto: str | None = None, params=None,
 def electrical_winding(plant, pto: str | None, objective: str) -> float | None:
     """The tuners' objective: "auto" (electrical power when the PTO has a drivetrain, else
     mechanical), "electrical" or "mechanical". Returns the drivetrain's winding coefficient for
-    an electrical objective (impedance.winding_coefficient), None for a mechanical one."""
-    from .impedance import winding_coefficient
+    an electrical objective (analysis.electrical.winding_coefficient), None for a mechanical
+    one."""
+    from mbcontrol.analysis.electrical import winding_coefficient
     if objective not in ("auto", "electrical", "mechanical"):
         raise ValueError(f"objective {objective!r}: expected auto, electrical or mechanical")
     name = pto or plant.scene.ptos[0].name

@@ -23,13 +23,11 @@ class ElectricalBound:
     mechanical: PseudoSpectralBound   # the optimum's force, velocity, position, status ...
 
 
-def winding_coefficient(plant, pto: str) -> float:
-    """R / (gear kt')^2, W per N^2 (or per (N m)^2) of PTO force; ValueError without a
-    drivetrain."""
+def winding_coefficient(plant, pto: str) -> float | None:
+    """R / (gear kt')^2, W per N^2 (or per (N m)^2) of PTO force: the mean winding loss is
+    this times the mean square force. None for a PTO without a drivetrain."""
     drive = next(p for p in plant.scene.ptos if p.name == pto).drivetrain
-    if drive is None:
-        raise ValueError(f"PTO {pto!r} has no [pto.drivetrain]: no electrical bound")
-    return drive.winding_resistance / drive.force_per_current ** 2
+    return None if drive is None else drive.winding_resistance / drive.force_per_current ** 2
 
 
 def electrical_bound(plant, wave, *, pto: str | None = None, force_max: float = np.inf,
@@ -47,6 +45,8 @@ def electrical_bound(plant, wave, *, pto: str | None = None, force_max: float = 
     result's force series and max_force are then that force)."""
     name = _pto_name(plant, pto)
     winding = winding_coefficient(plant, name)
+    if winding is None:
+        raise ValueError(f"PTO {name!r} has no [pto.drivetrain]: no electrical bound")
     problem = PseudoSpectralProblem(plant, wave, pto=name, params=params, omega_max=omega_max)
     problem.rho = problem.rho + winding          # mean loss winding x sum(c_k^2 + s_k^2) / 2
     if force_on == "wec":
