@@ -9,14 +9,16 @@ runs again elsewhere. Both paths run the same function on the same cases: identi
 
 Light cases (rm3 for an hour at dt 0.05 s: 21 ms of stepping) are dominated by what surrounds
 the stepping, so a case without a controller skips the Dataset (`sim.light`), and a local
-cluster is started only when the sweep is long enough to pay for it (`execute`); on Linux
-its workers are forked from this process (imports, plant and compiled code inherited).
+cluster is started only when the sweep is long enough to pay for it (`execute`). Its workers
+are spawned (fresh interpreters): forking this process, which runs threads (Dask's event loop,
+the cluster's starter, progress bars, BLAS), can copy a lock another thread holds and hang the
+copy for ever; a CI run did. MBCONTROL_SWEEP_START=fork keeps the faster start for those who
+accept that, behind a start watchdog.
 """
 from __future__ import annotations
 
 import math
 import os
-import sys
 import time
 from collections import defaultdict
 
@@ -120,13 +122,16 @@ def groups(cases, per_task: int) -> list[list]:
 # cores with rm3. "spawn": fresh interpreters (LocalCluster of 2 processes 1.3-1.5 s, then
 # each worker's imports, plant and compiled code 1.6-2.6 s; closing 0.5-1.4 s). "fork":
 # copies of this process, its imports, plants and loaded code included (0.13-0.31 s to start,
-# 0.03-0.05 s to close); taken while this process is idle, so that no thread of ours is
-# inside a library when it is copied. A sweep starts a cluster only when its cases, timed
-# here, would take longer serially (`_cluster_pays`).
+# 0.03-0.05 s to close), opt-in only: a fork copies every lock of every thread (Dask's loop,
+# BLAS, tqdm's monitor) in whatever state it is, and one held lock hangs the copy; a CI run
+# hung 70 min that way. A sweep starts a cluster only when its cases, timed here, would take
+# longer serially (`_cluster_pays`); a start that has not finished in START_TIMEOUT_S is
+# abandoned with a warning and the cases run here.
 CLUSTER_COSTS = {"spawn": (3.0, 1.0), "fork": (0.5, 0.2)}
+START_TIMEOUT_S = 180.0
 CLOSE_MARGIN = 1.5          # the close counted 1.5 times: what the estimate leaves for noise
 CLUSTER_ENV = "MBCONTROL_SWEEP_CLUSTER"   # "always": start the local cluster whatever it costs
-START_ENV = "MBCONTROL_SWEEP_START"       # "fork" (the default on Linux) or "spawn"
+START_ENV = "MBCONTROL_SWEEP_START"       # "spawn" (the default) or "fork" (faster, may hang)
 # Dask starts workers with MALLOC_TRIM_THRESHOLD_=65536, which also turns off glibc's
 # adaptive mmap threshold: every array over 128 kB is then fresh pages from the kernel, and a
 # light case's NumPy work (records of 72,000 samples) ran 2-3x slower on a worker than here
@@ -143,8 +148,9 @@ def execute(cases, store, *, workers: int | None = None, scheduler: str | None =
     A local cluster is started only when it pays: the first cases run here, timed; when the
     rest would finish sooner serially than with the cluster's start and close
     (CLUSTER_COSTS), they run here too (a small or light sweep, or one worker). Workers are
-    forked from this process on Linux (MBCONTROL_SWEEP_START=spawn for fresh interpreters,
-    which start in the background while this process keeps running cases). Same cases, same
+    spawned in the background while this process keeps running cases
+    (MBCONTROL_SWEEP_START=fork: forked, faster to start, unsafe in a threaded process). A
+    cluster not started within START_TIMEOUT_S is abandoned (warning). Same cases, same
     function, same numbers wherever a case runs. Returns {"computed", "reused", "wall_time_s", "where"}: "serial",
     "cluster" or "scheduler"."""
     todo = [c for c in cases if not store.has(c.key)]
@@ -182,9 +188,7 @@ def execute(cases, store, *, workers: int | None = None, scheduler: str | None =
 
 def _start_method() -> str:
     chosen = os.environ.get(START_ENV, "")
-    if chosen in CLUSTER_COSTS:
-        return chosen
-    return "fork" if sys.platform.startswith("linux") else "spawn"
+    return chosen if chosen in CLUSTER_COSTS else "spawn"
 
 
 def _cluster_pays(serial_s: float, n_workers: int, method: str = "spawn") -> bool:
@@ -215,10 +219,16 @@ def _local(queue: list, save, n: int, per_task) -> str:
     starter = _ClusterStarter(n, (first.model, tuple(sorted(first.resolved()[1].items())),
                                   int(round(first.duration / first.dt)), first.method), method)
     starter.start()
+    deadline = time.perf_counter() + START_TIMEOUT_S
+    while queue and not forced and method == "spawn" and not starter.ready.is_set():
+        save([run_case(queue.pop(0))])      # while the workers start: nothing waits
+    if not starter.ready.wait(max(0.0, deadline - time.perf_counter())):
+        import warnings                     # its thread is a daemon: left behind, not joined
+        warnings.warn(f"sweep: the local Dask cluster ({method}) did not start within "
+                      f"{START_TIMEOUT_S:.0f} s; running the remaining {len(queue)} cases here",
+                      RuntimeWarning, stacklevel=3)
+        return "serial"
     try:
-        while queue and not forced and method == "spawn" and not starter.ready.is_set():
-            save([run_case(queue.pop(0))])  # while the workers start: nothing waits
-        starter.join()
         if starter.error is not None:
             import warnings
             warnings.warn(f"sweep: the local Dask cluster did not start ({starter.error}); "

@@ -41,13 +41,15 @@ def test_cluster_pays_only_for_long_sweeps():
         assert runner._cluster_pays(60.0, 2, method)
 
 
-@pytest.mark.parametrize("method", ["fork", "spawn"])
-def test_forked_and_spawned_workers_agree_with_serial(monkeypatch, method):
+def test_spawned_workers_agree_with_serial(monkeypatch):
+    # Forked workers are not run here: a fork of this threaded test process can copy a held
+    # lock and hang (one CI run hung 70 min on it); they are opt-in for users.
     cases = build_cases("rm3", grid([1.5, 3.0], [8.0, 11.0]), duration=200.0, dt=0.05)
     serial = CaseStore(None)
     runner.execute(cases, serial, workers=0, progress=False)
+    monkeypatch.delenv(runner.START_ENV, raising=False)
+    assert runner._start_method() == "spawn"
     monkeypatch.setenv(runner.CLUSTER_ENV, "always")
-    monkeypatch.setenv(runner.START_ENV, method)
     clustered = CaseStore(None)
     assert runner.execute(cases, clustered, workers=2, progress=False)["where"] == "cluster"
     for c in cases:
@@ -68,3 +70,23 @@ def test_small_sweep_on_workers_runs_here_and_forced_cluster_agrees(monkeypatch)
         a, b, d = serial.read(c.key), small.read(c.key), clustered.read(c.key)
         assert a["metrics"] == b["metrics"] == d["metrics"]
         assert a["valid"] == d["valid"]
+
+
+def test_a_cluster_that_never_starts_is_abandoned_and_the_cases_run_here(monkeypatch):
+    class Stuck:                            # a start that hangs, as a deadlocked fork does
+        def __init__(self, *args):
+            import threading
+            self.ready = threading.Event()
+
+        def start(self):
+            pass
+
+    monkeypatch.setattr(runner, "_ClusterStarter", Stuck)
+    monkeypatch.setattr(runner, "START_TIMEOUT_S", 0.5)
+    monkeypatch.setenv(runner.CLUSTER_ENV, "always")
+    cases = build_cases("sphere", grid([1.0], [8.0, 10.0]), duration=50.0, dt=0.1)
+    store = CaseStore(None)
+    with pytest.warns(RuntimeWarning, match="did not start within 0 s"):
+        result = runner.execute(cases, store, workers=2, progress=False)
+    assert result["where"] == "serial" and result["computed"] == 2
+    assert all(store.has(c.key) for c in cases)
