@@ -55,6 +55,8 @@ bench: $(VENV)/.installed-test
 	$(PY) benchmarks/sweep.py --out $(OUT)/bench/sweep
 	$(PY) benchmarks/sweep_light.py --out $(OUT)/bench/sweep_light
 	$(PY) benchmarks/wecopttool_electrical.py --out $(OUT)/bench/wecopttool
+	$(PY) benchmarks/export_qp.py
+	$(PY) benchmarks/export_step.py --out $(OUT)/bench/export
 
 clean:
 	rm -rf $(OUT) .pytest_cache

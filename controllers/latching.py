@@ -70,6 +70,16 @@ class _Switching:
         self._t_prev, self._v_prev, self._u_prev = None, np.zeros(n), np.zeros(n)
         self.holds: list[list[tuple[float, float]]] = [[] for _ in names]  # (on, off) samples
 
+    @property
+    def damping_per_pto(self) -> np.ndarray:
+        """The engaged damper per PTO, N s/m (or N m s/rad), scene order, after reset()."""
+        return self._c.copy()
+
+    @property
+    def saturation(self) -> np.ndarray:
+        """The command's limit per PTO, N or N m (inf: none), after reset()."""
+        return self._limits.copy()
+
     def casadi_law(self, plant):
         return None                   # a timer is state: runs in simulate's Python loop
 
@@ -131,6 +141,11 @@ class Latching(_Switching):
     def reset(self, plant) -> None:
         super().reset(plant)
         self._inertia = _port_inertia(plant, self._names)
+
+    @property
+    def brake_inertia(self) -> np.ndarray:
+        """The inertia the deadbeat brake assumes per PTO, kg or kg m^2, after reset()."""
+        return self._inertia.copy()
 
     def _hold_force(self, i: int, v: float, h: float) -> float:
         M = self._inertia[i]

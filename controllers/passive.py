@@ -49,6 +49,16 @@ class Passive:
     def __call__(self, t: float, y: np.ndarray) -> np.ndarray:
         return saturate(-self._gains * np.asarray(y)[self._velocity], self._limits)
 
+    @property
+    def damping_per_pto(self) -> np.ndarray:
+        """N s/m (or N m s/rad) per PTO, scene order, after reset()."""
+        return self._gains.copy()
+
+    @property
+    def saturation(self) -> np.ndarray:
+        """The command's limit per PTO, N or N m (inf: none), after reset()."""
+        return self._limits.copy()
+
     def casadi_law(self, plant):
         if self._law is None:
             y = ca.SX.sym("y", len(plant.outputs))

@@ -74,6 +74,21 @@ class Reactive:
         return saturate(-(self._c * y[self._velocity] + self._k * y[self._position]),
                         self._limits)
 
+    @property
+    def damping_per_pto(self) -> np.ndarray:
+        """N s/m (or N m s/rad) per PTO, scene order, after reset()."""
+        return self._c.copy()
+
+    @property
+    def stiffness_per_pto(self) -> np.ndarray:
+        """N/m (or N m/rad) per PTO, scene order, after reset()."""
+        return self._k.copy()
+
+    @property
+    def saturation(self) -> np.ndarray:
+        """The command's limit per PTO, N or N m (inf: none), after reset()."""
+        return self._limits.copy()
+
     def casadi_law(self, plant):
         if self._law is None:
             y = ca.SX.sym("y", len(plant.outputs))

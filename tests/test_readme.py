@@ -47,8 +47,11 @@ TABLES = {
     "method": ("reference", "the integration methods by name"),
     "scenario": ("measured", "--stability"),
     "model, sea, tol": ("measured", "fidelity_auto"),
+    "solver": ("measured", "benchmarks/export_qp.py"),
+    "model, controller": ("measured", "benchmarks/export_step.py"),
 }
 MODEL_TABLES = {"mbcontrol (method, dt, radiation tol)": ("measured", "benchmarks/speed.py"),
+                "C step median / p99 / max (us)": ("measured", "benchmarks/export_step.py"),
                 "what it is": ("reference", "the catalogue (tests/test_catalogue.py builds each)")}
 
 

@@ -13,6 +13,7 @@ Examples:
   mbcontrol design sphere --controller passive --wave jonswap --hs 2.5 --tp 8 --json
   mbcontrol bench rm3 --wave jonswap --hs 2.5 --tp 8 --stability
   mbcontrol fidelity sphere --wave jonswap --hs 2.5 --tp 9.67 --tol 0.01
+  mbcontrol export sphere --controller mpc --wave jonswap --hs 2 --tp 9 --out out/export
   mbcontrol identify flume_section --data ../shared/data/tank/scenario_c/5*.csv.xz --out out/id
 """
 from __future__ import annotations
@@ -29,6 +30,7 @@ from .commands import (run_bench, run_fidelity, run_hydro, run_linearize, run_mo
                        run_simulate)
 from .describe import default_help, run_defaults, run_keys
 from .design import run_design
+from .export import add_parser as add_export_parser
 from .identify import add_parser as add_identify_parser
 from .sweep import add_parser as add_sweep_parser
 
@@ -291,6 +293,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(run=run_linearize)
     add_identify_parser(sub)
     add_sweep_parser(sub)
+    add_export_parser(sub, _model_options, _wave_options)
     return parser
 
 

@@ -1,0 +1,134 @@
+/* An exported controller as an FMI 2.0 co-simulation FMU. Value references: the measured
+ * signals (inputs) 0..MBC_N_IN-1, the force commands (outputs) next, then the parameters.
+ * The outputs feed through: reading them after new inputs steps the controller at the
+ * current communication point (its own period gates what it does, as in Python), so a
+ * master sets the plant's outputs, reads the command and hands it to the plant's step. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "mbc_fmi2.h"
+#include "mbc_controller.h"
+#include "fmu_common.c"
+
+typedef struct {
+    MBC_CTX ctx;
+    double in[MBC_N_IN], out[MBC_NU], params[MBC_N_PARAMS > 0 ? MBC_N_PARAMS : 1];
+    double time;
+    int dirty, running;
+    const fmi2CallbackFunctions *functions;
+    char name[64];
+} Instance;
+
+#define VR_OUT MBC_N_IN
+#define VR_PARAM (MBC_N_IN + MBC_NU)
+
+MBC_API fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String guid,
+    fmi2String resources, const fmi2CallbackFunctions *functions, fmi2Boolean visible,
+    fmi2Boolean logging)
+{
+    Instance *s;
+    (void)resources; (void)visible; (void)logging;
+    if (type != fmi2CoSimulation || !guid || strcmp(guid, MBC_GUID) != 0) {
+        mbc_log(functions, name, "not this FMU's GUID, or not co-simulation");
+        return NULL;
+    }
+    s = (Instance *)mbc_alloc(functions, sizeof(Instance));
+    if (!s) return NULL;
+    memset(s, 0, sizeof(Instance));
+    s->functions = functions;
+    strncpy(s->name, name ? name : "", sizeof(s->name) - 1);
+    memcpy(s->params, MBC_PARAMS_DESIGNED, sizeof(double) * MBC_N_PARAMS);
+    return s;
+}
+
+MBC_API void fmi2FreeInstance(fmi2Component c)
+{
+    Instance *s = (Instance *)c;
+    if (s) mbc_free(s->functions, s);
+}
+
+MBC_API fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean tol_defined, fmi2Real tol,
+    fmi2Real start, fmi2Boolean stop_defined, fmi2Real stop)
+{
+    (void)tol_defined; (void)tol; (void)stop_defined; (void)stop;
+    ((Instance *)c)->time = start;
+    return fmi2OK;
+}
+
+MBC_API fmi2Status fmi2ExitInitializationMode(fmi2Component c)
+{
+    Instance *s = (Instance *)c;
+    if (MBC_FN(init)(&s->ctx, s->params) != 0) {
+        mbc_log(s->functions, s->name, "parameters refused by init (negative gain or time, "
+                "or a warm-up longer than the compiled buffer)");
+        return fmi2Error;
+    }
+    s->running = 1;
+    s->dirty = 1;
+    return fmi2OK;
+}
+
+MBC_API fmi2Status fmi2Reset(fmi2Component c)
+{
+    Instance *s = (Instance *)c;
+    s->running = 0;
+    s->time = 0.0;
+    memset(s->out, 0, sizeof(s->out));
+    return fmi2OK;
+}
+
+static fmi2Status compute(Instance *s)
+{
+    if (s->running && s->dirty) {
+        if (MBC_FN(step)(&s->ctx, s->in, s->time, s->out) != 0) return fmi2Error;
+        s->dirty = 0;
+    }
+    return fmi2OK;
+}
+
+MBC_API fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n,
+    const fmi2Real v[])
+{
+    Instance *s = (Instance *)c;
+    size_t i;
+    for (i = 0; i < n; ++i) {
+        if (vr[i] < VR_OUT) { s->in[vr[i]] = v[i]; s->dirty = 1; }
+        else if (vr[i] >= VR_PARAM && vr[i] < VR_PARAM + MBC_N_PARAMS && !s->running)
+            s->params[vr[i] - VR_PARAM] = v[i];
+        else return fmi2Error;
+    }
+    return fmi2OK;
+}
+
+MBC_API fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t n,
+    fmi2Real v[])
+{
+    Instance *s = (Instance *)c;
+    size_t i;
+    if (compute(s) != fmi2OK) return fmi2Error;
+    for (i = 0; i < n; ++i) {
+        if (vr[i] < VR_OUT) v[i] = s->in[vr[i]];
+        else if (vr[i] < VR_PARAM) v[i] = s->out[vr[i] - VR_OUT];
+        else if (vr[i] < VR_PARAM + MBC_N_PARAMS) v[i] = s->params[vr[i] - VR_PARAM];
+        else return fmi2Error;
+    }
+    return fmi2OK;
+}
+
+MBC_API fmi2Status fmi2DoStep(fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolean no_prior)
+{
+    Instance *s = (Instance *)c;
+    (void)no_prior;
+    s->time = t;
+    if (compute(s) != fmi2OK) return fmi2Error;   /* the controller sees every point */
+    s->time = t + h;
+    s->dirty = 1;
+    return fmi2OK;
+}
+
+MBC_API fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind k, fmi2Real *v)
+{
+    if (k != fmi2LastSuccessfulTime) return fmi2Discard;
+    *v = ((Instance *)c)->time;
+    return fmi2OK;
+}

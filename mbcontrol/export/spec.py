@@ -1,0 +1,215 @@
+"""What an exported controller is made of: its measured inputs, its parameters, its constant
+data and the C engine that runs it, read off a controller bound to its plant.
+
+Three engines (`csrc/`): "law" (passive, reactive: the CasADi-generated static law with its
+gains as parameters), "switching" (latching, declutching) and "mpc" (Kalman filter, AR
+forecast and the condensed QP, solved by the dual active-set solver of `csrc/mbc_qp.c`). Oracles
+cannot leave Python: an MPC with the true future wave or the plant's whole state would need
+what no device measures, so they are refused here. NMPC is not exported (its NLP solver,
+IPOPT, is not code-generatable).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import casadi as ca
+import numpy as np
+
+
+@dataclass
+class Parameter:
+    name: str
+    value: float
+    unit: str
+    description: str
+
+
+@dataclass
+class ControllerSpec:
+    """kind: "law", "switching" or "mpc"; inputs: plant output names the controller reads (in
+    order); outputs: the force commands (u__<pto>, N or N m); parameters: tunable after
+    export; defines: C macros (name -> text); arrays: C constant arrays (name -> (type,
+    values)); casadi: CasADi functions to generate into the sources; engine: csrc files."""
+    kind: str
+    name: str
+    inputs: list
+    outputs: list
+    parameters: list
+    defines: dict = field(default_factory=dict)
+    arrays: dict = field(default_factory=dict)
+    casadi: list = field(default_factory=list)
+    engine: list = field(default_factory=list)
+    context: str = ""                       # the C context struct's fields
+    settings: dict = field(default_factory=dict)
+
+
+def controller_spec(controller, plant) -> ControllerSpec:
+    """The spec of `controller` after controller.reset(plant) (called here)."""
+    controller.reset(plant)
+    name = controller.name
+    if name in ("passive", "reactive"):
+        return _law_spec(controller, plant)
+    if name in ("latching", "declutching"):
+        return _switching_spec(controller, plant)
+    if name == "mpc":
+        return _mpc_spec(controller, plant)
+    raise ValueError(f"export: controller {name!r} cannot be exported; exportable: passive, "
+                     f"reactive, latching, declutching, mpc (NMPC's solver, IPOPT, generates "
+                     f"no C)")
+
+
+def sparse_rows(A: np.ndarray):
+    """(row starts, columns, values) of A's nonzeros, row by row (compressed sparse rows)."""
+    A = np.asarray(A, float)
+    rows, cols = np.nonzero(A)
+    start = np.searchsorted(rows, np.arange(A.shape[0] + 1))
+    return start, cols, A[rows, cols]
+
+
+def _ptos(plant):
+    return [p.name for p in plant.scene.ptos]
+
+
+def _law_spec(c, plant) -> ControllerSpec:
+    names = _ptos(plant)
+    reactive = c.name == "reactive"
+    inputs = ([f"{n}__position" for n in names] if reactive else []) + \
+        [f"{n}__velocity" for n in names]
+    nu = len(names)
+    gains = c.damping_per_pto
+    stiffness = c.stiffness_per_pto if reactive else np.zeros(nu)
+    params = [Parameter(f"damping_{n}", float(v), "N s/m or N m s/rad", f"damping of PTO {n}")
+              for n, v in zip(names, gains)]
+    if reactive:
+        params += [Parameter(f"stiffness_{n}", float(v), "N/m or N m/rad",
+                             f"stiffness of PTO {n}") for n, v in zip(names, stiffness)]
+    params += [Parameter(f"force_max_{n}", float(v), "N or N m",
+                         f"saturation of PTO {n}'s command (inf: none)")
+               for n, v in zip(names, c.saturation)]
+    y = ca.SX.sym("y", len(inputs))
+    p = ca.SX.sym("p", len(params))
+    v = y[nu:] if reactive else y
+    x = y[:nu] if reactive else ca.SX.zeros(nu)
+    k = p[nu:2 * nu] if reactive else ca.SX.zeros(nu)
+    f_max = p[len(params) - nu:]
+    u = -(p[:nu] * v + k * x)
+    law = ca.Function("law", [y, p], [ca.fmin(ca.fmax(u, -f_max), f_max)])
+    return ControllerSpec("law", c.name, inputs, [f"u__{n}" for n in names], params,
+                          casadi=[law], engine=["mbc_law.c"],
+                          defines={"MBC_LAW": "MBC_CAT(MBC_PREFIX, law)",
+                                   "MBC_LAW_SZ_ARG": str(max(law.sz_arg(), 2)),
+                                   "MBC_LAW_SZ_RES": str(max(law.sz_res(), 1))},
+                          context=f"double params[{len(params)}];\n"
+                                  f"    casadi_int iw[{max(law.sz_iw(), 1)}];\n"
+                                  f"    double w[{max(law.sz_w(), 1)}];",
+                          settings=c.describe())
+
+
+def _switching_spec(c, plant) -> ControllerSpec:
+    names = _ptos(plant)
+    nu = len(names)
+    latching = c.name == "latching"
+    hold = c.latch_time if latching else c.declutch_time
+    inertia = c.brake_inertia if latching else np.ones(nu)
+    params = [Parameter(f"damping_{n}", float(v), "N s/m or N m s/rad",
+                        f"damping of PTO {n} while engaged")
+              for n, v in zip(names, c.damping_per_pto)]
+    params += [Parameter("latch_time" if latching else "declutch_time", float(hold), "s",
+                         "hold from each velocity zero crossing")]
+    params += [Parameter(f"force_max_{n}", float(v), "N or N m",
+                         f"saturation of PTO {n}'s command (inf: none)")
+               for n, v in zip(names, c.saturation)]
+    params += [Parameter(f"inertia_{n}", float(v), "kg or kg m^2",
+                         f"inertia the brake of PTO {n} assumes" if latching else "unused")
+               for n, v in zip(names, inertia)]
+    return ControllerSpec(
+        "switching", c.name, [f"{n}__velocity" for n in names], [f"u__{n}" for n in names],
+        params, engine=["mbc_switching.c"],
+        defines={"MBC_MOVES_WHILE_HELD": "0" if latching else "1"},
+        arrays={"MBC_VELOCITY_INDEX": ("int", list(range(nu)))},
+        context=f"double params[{len(params)}];\n"
+                f"    int held[{nu}], has_prev;\n"
+                f"    double release[{nu}], sign[{nu}], v_prev[{nu}], u_prev[{nu}], t_prev;",
+        settings=c.describe())
+
+
+def _mpc_spec(c, plant) -> ControllerSpec:
+    if c.forecast == "known" or c.uses_state:
+        raise ValueError("export: this MPC is an oracle (forecast 'known' or estimator "
+                         "'state'): it needs the future wave or the whole plant state, which a "
+                         "device does not measure; export a causal one (forecast 'ar')")
+    cp, qp, kal = c.cp, c.qp, c.kalman
+    outputs = list(plant.outputs)
+    names = list(cp.ptos)
+    nu, N = len(names), qp.N
+    kalman_inputs = [outputs[i] for i in cp.y_index]
+    velocity_inputs = [f"{n}__velocity" for n in names]
+    inputs = kalman_inputs + [v for v in velocity_inputs if v not in kalman_inputs]
+    nz, nd, nxi = cp.nz, cp.nd, kal.nxi
+    ar = c.ar
+    ar_order = ar.order if ar is not None else 1
+    window = ar.window if ar is not None else 1
+    nv = N * nu
+    forms = qp.forms
+    arrays = {
+        "MBC_KALMAN_INDEX": ("int", [inputs.index(n) for n in kalman_inputs]),
+        "MBC_VELOCITY_INDEX": ("int", [inputs.index(n) for n in velocity_inputs]),
+        "MBC_Y_REST": ("double", cp.y_rest), "MBC_PHI": ("double", kal.Phi),
+        "MBC_GAMMA": ("double", kal.Gamma), "MBC_K": ("double", kal.K),
+        "MBC_C": ("double", kal.C), "MBC_CXI": ("double", kal.C_xi),
+        "MBC_PHI_XI": ("double", kal.Phi_xi), "MBC_PPRED": ("double", qp.Phi),
+        "MBC_OM": ("double", qp.Om), "MBC_QZ": ("double", qp.Qz), "MBC_QD": ("double", qp.Qd),
+        "MBC_STROKE": ("double", qp.stroke), "MBC_RATE": ("double", qp.rate),
+        "MBC_FORCE_MAX": ("double", c.limits["force"]),
+    }
+    form_rows = []
+    for i, form in enumerate(forms):
+        start, col, val = sparse_rows(form.A)
+        arrays.update({f"MBC_F{i}_H": ("double", form.H), f"MBC_F{i}_ASTART": ("int", start),
+                       f"MBC_F{i}_ACOL": ("int", col), f"MBC_F{i}_AVAL": ("double", val)})
+        for part in ("lbx", "ubx", "g_slack"):
+            arrays[f"MBC_F{i}_{part.upper()}"] = ("double", getattr(form, part))
+        form_rows.append(f"{{{form.n_var}, {form.A.shape[0]}, {int(form.soft)}, "
+                         + ", ".join(f"MBC_F{i}_{p}" for p in
+                                     ("H", "ASTART", "ACOL", "AVAL", "LBX", "UBX", "G_SLACK"))
+                         + "}")
+    nv_max = max(f.n_var for f in forms)
+    na_max = max(max(f.A.shape[0] for f in forms), 1)
+    warm = [float(v) for v in c.warm_up_damping]
+    params = [Parameter(f"warm_up_damping_{n}", v, "N s/m or N m s/rad",
+                        f"passive damper of PTO {n} until the first AR fit")
+              for n, v in zip(names, warm)]
+    params += [Parameter("warm_up_s", float(c.warm_up_planned), "s",
+                         "planned warm-up (the AR fit waits for it)"),
+               Parameter("blend_s", float(c.blend_s), "s",
+                         "take-over from the damper to the MPC")]
+    window_max = max(window, int(math.ceil(4 * window)))   # room for a 4x longer warm-up
+    defines = {
+        "MBC_NU": str(nu), "MBC_NY": str(len(kalman_inputs)), "MBC_NK": str(kal.Phi.shape[0]),
+        "MBC_NZ": str(nz), "MBC_ND": str(nd), "MBC_NXI": str(nxi), "MBC_N": str(N),
+        "MBC_P": str(ar_order), "MBC_AR_WINDOW": str(window), "MBC_WINDOW_MAX": str(window_max),
+        "MBC_AR_REFIT": str(ar.refit if ar is not None else 1),
+        "MBC_AR_RIDGE": repr(ar.ridge if ar is not None else 0.0),
+        "MBC_FORECAST": {"none": "0", "ar": "1", "model": "2"}[c.forecast],
+        "MBC_DT": repr(c.dt_s), "MBC_FS": repr(qp.Fs), "MBC_LS": repr(qp.Ls),
+        "MBC_HAS_STROKE": str(int(qp.has_stroke)), "MBC_HAS_RATE": str(int(qp.has_rate)),
+        "MBC_NFORMS": str(len(forms)),
+    }
+    context = "\n    ".join([
+        f"double params[{len(params)}];",
+        f"double s[{kal.Phi.shape[0]}], u_prev[{nu}], last_t, warm_up_end;",
+        "int has_last, warm_done, has_plan, has_coef, last_form, last_status, qp_iterations;",
+        f"double hist[{window_max * max(nd, 1)}];",
+        "int hist_len, hist_start, since_fit, min_samples, window;",
+        f"double coef[{max(nd, 1) * ar_order}], maps[{max(nd, 1) * (N + 1) * ar_order}];",
+        f"double D[{max(N * nd, 1)}], plan[{nv}], q[{nv}], freep[{nv}];",
+        f"double g[{nv_max}], x[{nv_max}], lba[{na_max}], uba[{na_max}];",
+        f"mbc_qp qp[{len(forms)}];",
+        f"double J0[{len(forms)}][{nv_max * nv_max}];",
+        f"double qp_work[MBC_QP_WORK({nv_max}, {na_max})];",
+        f"int qp_iwork[MBC_QP_IWORK({nv_max}, {na_max})];",
+        "long solves, failures, soft_solves, ar_fits, ar_unstable_fits;"])
+    return ControllerSpec("mpc", "mpc", inputs, [f"u__{n}" for n in names], params,
+                          defines=defines, arrays=arrays, engine=["mbc_mpc.c", "mbc_qp.c"],
+                          context=context, settings={**c.describe(), "forms": form_rows})
