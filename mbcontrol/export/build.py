@@ -21,7 +21,7 @@ from .spec import ControllerSpec
 
 CFLAGS = ("-O3", "-std=c99", "-fPIC", "-Wall", "-Wno-unused-variable", "-Wno-unused-function")
 ENGINE_COMMON = ["mbc_bench.c"]
-FMU_FILES = ["fmu_common.c", "mbc_fmi2.h"]
+FMU_FILES = ["fmu_common.h", "mbc_fmi2.h"]
 HEADERS = ["mbc_qp.h"]
 
 

@@ -8,7 +8,7 @@
 #include <string.h>
 #include "mbc_fmi2.h"
 #include "mbc_controller.h"
-#include "fmu_common.c"
+#include "fmu_common.h"
 
 typedef struct {
     MBC_CTX ctx;
@@ -28,13 +28,8 @@ MBC_API fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String
 {
     Instance *s;
     (void)resources; (void)visible; (void)logging;
-    if (type != fmi2CoSimulation || !guid || strcmp(guid, MBC_GUID) != 0) {
-        mbc_log(functions, name, "not this FMU's GUID, or not co-simulation");
-        return NULL;
-    }
-    s = (Instance *)mbc_alloc(functions, sizeof(Instance));
+    s = (Instance *)mbc_instantiate(name, type, guid, MBC_GUID, functions, sizeof(Instance));
     if (!s) return NULL;
-    memset(s, 0, sizeof(Instance));
     s->functions = functions;
     strncpy(s->name, name ? name : "", sizeof(s->name) - 1);
     memcpy(s->params, MBC_PARAMS_DESIGNED, sizeof(double) * MBC_N_PARAMS);

@@ -12,7 +12,7 @@
 #include <string.h>
 #include "mbc_fmi2.h"
 #include "plant_config.h"
-#include "fmu_common.c"
+#include "fmu_common.h"
 
 typedef struct {
     double x[PLANT_NX], u[PLANT_NU], y[PLANT_NY], dt, wave_scale, time;
@@ -58,13 +58,8 @@ MBC_API fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String
 {
     Instance *s;
     (void)resources; (void)visible; (void)logging;
-    if (type != fmi2CoSimulation || !guid || strcmp(guid, PLANT_GUID) != 0) {
-        mbc_log(functions, name, "not this FMU's GUID, or not co-simulation");
-        return NULL;
-    }
-    s = (Instance *)mbc_alloc(functions, sizeof(Instance));
+    s = (Instance *)mbc_instantiate(name, type, guid, PLANT_GUID, functions, sizeof(Instance));
     if (!s) return NULL;
-    memset(s, 0, sizeof(Instance));
     s->functions = functions;
     strncpy(s->name, name ? name : "", sizeof(s->name) - 1);
     s->dt = PLANT_DT;

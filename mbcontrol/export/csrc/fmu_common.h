@@ -1,6 +1,7 @@
-/* The FMI 2.0 co-simulation functions every exported FMU answers the same way (included by
- * fmu_controller.c and fmu_plant.c): version, logging, the unsupported optional features
- * (FMU state, derivatives, asynchronous steps) and the non-real variables (there are none). */
+/* The FMI 2.0 co-simulation functions every exported FMU answers the same way (definitions,
+ * included once by each FMU wrapper, fmu_controller.c and fmu_plant.c): version, logging,
+ * the unsupported optional features (FMU state, derivatives, asynchronous steps) and the
+ * non-real variables (there are none). */
 #define MBC_API MBC_FMI2_EXPORT
 
 MBC_API const char *fmi2GetTypesPlatform(void) { return "default"; }
@@ -62,4 +63,20 @@ static void mbc_free(const fmi2CallbackFunctions *f, void *p)
 static void mbc_log(const fmi2CallbackFunctions *f, fmi2String name, fmi2String message)
 {
     if (f && f->logger) f->logger(f->componentEnvironment, name, fmi2Error, "logError", "%s", message);
+}
+
+/* The common part of fmi2Instantiate: this FMU's GUID and co-simulation, or NULL (logged);
+ * else a zeroed instance of `size` bytes from the environment's allocator. */
+static void *mbc_instantiate(fmi2String name, fmi2Type type, fmi2String guid,
+                             const char *expected, const fmi2CallbackFunctions *functions,
+                             size_t size)
+{
+    void *s;
+    if (type != fmi2CoSimulation || !guid || strcmp(guid, expected) != 0) {
+        mbc_log(functions, name, "not this FMU's GUID, or not co-simulation");
+        return NULL;
+    }
+    s = mbc_alloc(functions, size);
+    if (s) memset(s, 0, size);
+    return s;
 }
