@@ -23,9 +23,9 @@ class ExportedController:
 
 def export_controller(controller, plant, out_dir, *, model: str | None = None,
                       step: float | None = None) -> ExportedController:
-    """Write `controller` (bound to `plant`) as C (out_dir/c/) and as an FMU
-    (out_dir/<model>_<controller>.fmu). step: the FMU's default communication step, s (the
-    controller's period, or 0.01 s)."""
+    """Write `controller` (bound to `plant`) as C (out_dir/c/, replacing an earlier export's)
+    and as an FMU (out_dir/<model>_<controller>.fmu). step: the FMU's default communication
+    step, s (the controller's period, or 0.01 s)."""
     spec = controller_spec(controller, plant)
     ident = identifier(model or plant.name, spec.name)
     out_dir = Path(out_dir).resolve()
