@@ -99,14 +99,18 @@ def main() -> None:
               f"| {r['context_bytes']:,} | {r['library_bytes'] / 1e3:.0f} |")
     print("\n| model, controller | C vs Python: force, mean power | FMUs in fmpy vs Python: "
           "force, PTO position | Python vs itself from x0 + 1e-12: force, mean power "
-          "| mean power (W) |")
+          "| mean power (W), run's physics checks |")
     print("|---|---|---|---|---|")
     for r in rows:
         k, f, z = r["check"], r["check"]["fmu"], r["check"]["round_off_floor"]
         print(f"| {r['model']}, {r['controller']} | {k['max_rel_force_error']:.1e}, "
               f"{k['mean_power_rel_error']:.1e} | {f['max_rel_force_error']:.1e}, "
               f"{f['max_rel_position_error']:.1e} | {z['max_rel_force_error']:.1e}, "
-              f"{z['mean_power_rel_error']:.1e} | {k['python_mean_power_W']:.4g} |")
+              f"{z['mean_power_rel_error']:.1e} | {k['python_mean_power_W']:.4g}, "
+              f"{'valid' if k['python_run_valid'] else 'INVALID'} |")
+    for r in rows:
+        for reason in r["check"]["python_run_invalid_reasons"]:
+            print(f"{r['model']} {r['controller']}: {reason}")
     print(f"\n{rows[0]['c_us']['steps']:,} C steps per row, {args.python_steps:,} Python steps; "
           f"written to {out / 'export_step.json'}")
 

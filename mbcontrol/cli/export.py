@@ -120,6 +120,9 @@ def _print(r: dict) -> None:
         print(f"  closed loop, {check['duration_s']:g} s at dt {check['dt_s']:g} s: C against "
               f"Python force {check['max_rel_force_error']:.2g} (relative to the peak), mean "
               f"power {check['mean_power_rel_error']:.2g} ({check['python_mean_power_W']:.6g} W)")
+        if not check["python_run_valid"]:
+            print(f"  INVALID run (its mean power is not a result): "
+                  f"{'; '.join(check['python_run_invalid_reasons'])}")
         floor = check["round_off_floor"]
         print(f"  round-off floor (Python against itself from a start moved by 1e-12): force "
               f"{floor['max_rel_force_error']:.2g}, mean power {floor['mean_power_rel_error']:.2g}")

@@ -43,9 +43,13 @@ def closed_loop_check(plant, wave, controller, exported, *, duration: float, dt:
                       method="rk4", x0=x0)
     u_nudged = np.column_stack([nudged[k].values for k in commands])
     p_nudged = _mean_power(nudged, pto)
+    from mbcontrol.analysis import summary
+    verdict = summary(reference, plant)      # the run's physics checks (bound, energy, range)
     out = {"max_rel_force_error": force_error(u_ref, u_c),
            "mean_power_rel_error": abs(p_c - p_ref) / max(abs(p_ref), 1e-300),
            "python_mean_power_W": p_ref, "c_mean_power_W": p_c,
+           "python_run_valid": verdict["valid"],
+           "python_run_invalid_reasons": verdict["invalid_reasons"],
            "round_off_floor": {"max_rel_force_error": force_error(u_ref, u_nudged),
                                "mean_power_rel_error": abs(p_nudged - p_ref) / max(abs(p_ref),
                                                                                     1e-300),
