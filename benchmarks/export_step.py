@@ -43,7 +43,6 @@ def run_case(model, name, kind, steps, python_steps, folder):
     from mbcontrol.waves import irregular, regular
     plant = build_plant(load_scene(model))
     hs, tp = SEAS[model]
-    period = getattr(make(name), "period", None)
     parameters, _, _, extra = tune(plant, regular(hs, tp) if kind == "swell" else
                                    irregular(hs, tp, seed=0, duration=600.0), name,
                                    plant.scene.ptos[0], True, None, [])

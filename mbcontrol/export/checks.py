@@ -11,11 +11,6 @@ import numpy as np
 from .runtime import CController, force_error, step_statistics
 
 
-def _mean_power(ds, pto: str) -> float:
-    from mbcontrol.analysis import pto_metrics
-    return float(pto_metrics(ds, pto, 0.0)["mean_power_W"])
-
-
 def closed_loop_check(plant, wave, controller, exported, *, duration: float, dt: float,
                       plant_fmu=None) -> dict:
     """Force and mean-power differences of the exported controller against `controller`,
@@ -23,6 +18,7 @@ def closed_loop_check(plant, wave, controller, exported, *, duration: float, dt:
     Python run's peak force and |mean power|; beside them the round-off floor (the Python
     run against itself from a start moved by 1e-12). Returns the check and the Python record
     (the timing replays its measurements)."""
+    from mbcontrol.controllers.latching import mean_power
     from mbcontrol.sim import simulate
     period = getattr(controller, "period", None)
     reference = simulate(plant, wave, duration=duration, dt=dt, controller=controller,
@@ -33,7 +29,7 @@ def closed_loop_check(plant, wave, controller, exported, *, duration: float, dt:
     pto = commands[0][len("u__"):]
     u_ref = np.column_stack([reference[k].values for k in commands])
     u_c = np.column_stack([c_run[k].values for k in commands])
-    p_ref, p_c = _mean_power(reference, pto), _mean_power(c_run, pto)
+    p_ref, p_c = mean_power(reference, pto), mean_power(c_run, pto)
     # the floor: the Python controller against itself with the first state moved by 1e-12
     # (m or rad), what round-off alone does to this closed loop (an MPC whose QP switches
     # active sets amplifies it; a static law does not)
@@ -42,7 +38,7 @@ def closed_loop_check(plant, wave, controller, exported, *, duration: float, dt:
     nudged = simulate(plant, wave, duration=duration, dt=dt, controller=controller,
                       method="rk4", x0=x0)
     u_nudged = np.column_stack([nudged[k].values for k in commands])
-    p_nudged = _mean_power(nudged, pto)
+    p_nudged = mean_power(nudged, pto)
     from mbcontrol.analysis import summary
     verdict = summary(reference, plant)      # the run's physics checks (bound, energy, range)
     out = {"max_rel_force_error": force_error(u_ref, u_c),

@@ -10,7 +10,6 @@ IPOPT, is not code-generatable).
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 
 import casadi as ca
@@ -184,7 +183,7 @@ def _mpc_spec(c, plant) -> ControllerSpec:
                          "planned warm-up (the AR fit waits for it)"),
                Parameter("blend_s", float(c.blend_s), "s",
                          "take-over from the damper to the MPC")]
-    window_max = max(window, int(math.ceil(4 * window)))   # room for a 4x longer warm-up
+    window_max = 4 * window                  # room for a warm-up up to 4x longer
     defines = {
         "MBC_NU": str(nu), "MBC_NY": str(len(kalman_inputs)), "MBC_NK": str(kal.Phi.shape[0]),
         "MBC_NZ": str(nz), "MBC_ND": str(nd), "MBC_NXI": str(nxi), "MBC_N": str(N),
@@ -199,7 +198,7 @@ def _mpc_spec(c, plant) -> ControllerSpec:
     context = "\n    ".join([
         f"double params[{len(params)}];",
         f"double s[{kal.Phi.shape[0]}], u_prev[{nu}], last_t, warm_up_end;",
-        "int has_last, warm_done, has_plan, has_coef, last_form, last_status, qp_iterations;",
+        "int has_last, warm_done, has_plan, has_coef, last_form;",
         f"double hist[{window_max * max(nd, 1)}];",
         "int hist_len, hist_start, since_fit, min_samples, window;",
         f"double coef[{max(nd, 1) * ar_order}], maps[{max(nd, 1) * (N + 1) * ar_order}];",

@@ -1,7 +1,8 @@
 /* The FMI 2.0 co-simulation functions every exported FMU answers the same way (definitions,
  * included once by each FMU wrapper, fmu_controller.c and fmu_plant.c): version, logging,
  * the unsupported optional features (FMU state, derivatives, asynchronous steps) and the
- * non-real variables (there are none). */
+ * non-real variables (there are none), freeing an instance and its last successful time.
+ * Included after the wrapper's `Instance` type, which has `functions` and `time`. */
 #define MBC_API MBC_FMI2_EXPORT
 
 MBC_API const char *fmi2GetTypesPlatform(void) { return "default"; }
@@ -79,4 +80,17 @@ static void *mbc_instantiate(fmi2String name, fmi2Type type, fmi2String guid,
     s = mbc_alloc(functions, size);
     if (s) memset(s, 0, size);
     return s;
+}
+
+MBC_API void fmi2FreeInstance(fmi2Component c)
+{
+    Instance *s = (Instance *)c;
+    if (s) mbc_free(s->functions, s);
+}
+
+MBC_API fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind k, fmi2Real *v)
+{
+    if (k != fmi2LastSuccessfulTime) return fmi2Discard;
+    *v = ((Instance *)c)->time;
+    return fmi2OK;
 }

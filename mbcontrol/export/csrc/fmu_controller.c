@@ -8,7 +8,6 @@
 #include <string.h>
 #include "mbc_fmi2.h"
 #include "mbc_controller.h"
-#include "fmu_common.h"
 
 typedef struct {
     MBC_CTX ctx;
@@ -18,6 +17,8 @@ typedef struct {
     const fmi2CallbackFunctions *functions;
     char name[64];
 } Instance;
+
+#include "fmu_common.h"   /* after Instance: its functions use the type */
 
 #define VR_OUT MBC_N_IN
 #define VR_PARAM (MBC_N_IN + MBC_NU)
@@ -34,12 +35,6 @@ MBC_API fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String
     strncpy(s->name, name ? name : "", sizeof(s->name) - 1);
     memcpy(s->params, MBC_PARAMS_DESIGNED, sizeof(double) * MBC_N_PARAMS);
     return s;
-}
-
-MBC_API void fmi2FreeInstance(fmi2Component c)
-{
-    Instance *s = (Instance *)c;
-    if (s) mbc_free(s->functions, s);
 }
 
 MBC_API fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean tol_defined, fmi2Real tol,
@@ -118,12 +113,5 @@ MBC_API fmi2Status fmi2DoStep(fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boole
     if (compute(s) != fmi2OK) return fmi2Error;   /* the controller sees every point */
     s->time = t + h;
     s->dirty = 1;
-    return fmi2OK;
-}
-
-MBC_API fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind k, fmi2Real *v)
-{
-    if (k != fmi2LastSuccessfulTime) return fmi2Discard;
-    *v = ((Instance *)c)->time;
     return fmi2OK;
 }

@@ -12,7 +12,6 @@
 #include <string.h>
 #include "mbc_fmi2.h"
 #include "plant_config.h"
-#include "fmu_common.h"
 
 typedef struct {
     double x[PLANT_NX], u[PLANT_NU], y[PLANT_NY], dt, wave_scale, time;
@@ -22,6 +21,8 @@ typedef struct {
     const fmi2CallbackFunctions *functions;
     char name[64];
 } Instance;
+
+#include "fmu_common.h"   /* after Instance: its functions use the type */
 
 #define VR_Y PLANT_NU
 #define VR_DT (PLANT_NU + PLANT_NY)
@@ -67,12 +68,6 @@ MBC_API fmi2Component fmi2Instantiate(fmi2String name, fmi2Type type, fmi2String
     memcpy(s->x, PLANT_X0, sizeof(s->x));
     s->dirty = 1;
     return s;
-}
-
-MBC_API void fmi2FreeInstance(fmi2Component c)
-{
-    Instance *s = (Instance *)c;
-    if (s) mbc_free(s->functions, s);
 }
 
 MBC_API fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean tol_defined, fmi2Real tol,
@@ -164,12 +159,5 @@ MBC_API fmi2Status fmi2DoStep(fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boole
     }
     s->time = t + h;
     s->dirty = 1;
-    return fmi2OK;
-}
-
-MBC_API fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind k, fmi2Real *v)
-{
-    if (k != fmi2LastSuccessfulTime) return fmi2Discard;
-    *v = ((Instance *)c)->time;
     return fmi2OK;
 }

@@ -231,11 +231,7 @@ static int solve_qp(MBC_CTX *c)              /* the plan into c->plan; 0 when so
         const mbc_form *form = &MBC_FORMS[f];
         form_bounds(c, f);
         status = mbc_qp_solve(&c->qp[f], c->g, form->lbx, form->ubx, c->lba, c->uba, c->x);
-        c->qp_iterations = c->qp[f].iterations;
-        if (status != MBC_QP_SOLVED) {
-            if (status == MBC_QP_INFEASIBLE) c->last_status = 1;
-            continue;
-        }
+        if (status != MBC_QP_SOLVED) continue;     /* infeasible or out of iterations */
         {
             double slack = 0.0;
             for (k = NV; k < form->nv; ++k) slack = fmax(slack, c->x[k]);
@@ -286,7 +282,6 @@ void MBC_FN(reset)(MBC_CTX *ctx)
     ctx->last_form = 0;
     ctx->last_t = ctx->warm_up_end = 0.0;
     ctx->solves = ctx->failures = ctx->soft_solves = ctx->ar_fits = ctx->ar_unstable_fits = 0;
-    ctx->last_status = 0;
 }
 
 static void clip(double *u)
