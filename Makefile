@@ -49,6 +49,7 @@ bench: $(VENV)/.installed-test
 	$(PY) benchmarks/radiation_fit.py --file models/rm3_hydro.nc --omega-max 3.0 \
 	    --tols 0.1 0.05 0.02 0.01 --out $(OUT)/bench/radiation_rm3
 	$(PY) benchmarks/scaling.py --n 2 4 8 16 --out $(OUT)/bench/scaling
+	$(PY) benchmarks/array_scaling.py --n 2 3 4 5 --fit-tol 0.02 0.02 0.02 0.06 --out $(OUT)/bench/array_scaling
 	$(PY) benchmarks/mpc.py --out $(OUT)/bench/mpc
 	$(PY) benchmarks/nmpc.py --out $(OUT)/bench/nmpc
 	$(PY) benchmarks/identify.py --out $(OUT)/bench/identify

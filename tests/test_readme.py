@@ -49,6 +49,8 @@ TABLES = {
     "model, sea, tol": ("measured", "fidelity_auto"),
     "solver": ("measured", "benchmarks/export_qp.py"),
     "model, controller": ("measured", "benchmarks/export_step.py"),
+    "floats": ("measured", "benchmarks/array_scaling.py"),
+    "farm at PacWave South, 32 seas": ("measured", "--isolated n=1"),
 }
 MODEL_TABLES = {"mbcontrol (method, dt, radiation tol)": ("measured", "benchmarks/speed.py"),
                 "C step median / p99 / max (us)": ("measured", "benchmarks/export_step.py"),

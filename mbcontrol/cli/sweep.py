@@ -17,7 +17,13 @@ one per core; 0 runs them in this process) or on an existing one (--scheduler AD
 With --store DIR each finished case is kept in DIR/cases, so an interrupted sweep resumes
 where it stopped and a rerun with the same inputs computes nothing; DIR/sweep.nc holds the
 labelled result (xarray). --vary NAME=v1,v2 adds a dimension: NAME is a scene parameter,
-a plant parameter or a setting of the controller.
+a plant parameter, a setting of the controller, or `direction` (wave headings in degrees, among
+the hydro data's).
+
+A farm: --isolated NAME=VALUE (scene parameters that make one device out of the farm's scene,
+e.g. n=1 for array_grid) also runs the lone device over the same cases and reports the q-factor
+per sea, q = farm power / (devices x power of one device alone), and the same ratio of the annual
+energies (module mbcontrol.studies.farm).
 
 The --json summary is a contract: {"model", "cases", "computed", "reused", "wall_time_s",
 "valid_cases", "invalid_cases", "invalid": [{"hs", "tp", "seed", "reasons"}], "notes",
@@ -25,7 +31,9 @@ The --json summary is a contract: {"model", "cases", "computed", "reused", "wall
 "invalid_cases", ...}], "weighted_mean_power_W", "annual_energy_MWh",
 "annual_energy_coverage", "annual_energy_unchecked_MWh", "provenance":
 {"model", "version", "scene_sha256", "hydro_sha256", "radiation_sha256", "controller",
-"settings"}} (per sea, means over the valid seeds; lists over the varied values when --vary
+"settings"}, and with --isolated "farm": {"devices", "isolated_devices",
+"isolated_scene_params", "q_factor", "annual_energy_isolated_MWh", "q_annual",
+"isolated_invalid_cases", "isolated_wall_time_s"} and "q_factor" per sea} (per sea, means over the valid seeds; lists over the varied values when --vary
 is given; weighted figures only for a weighted --seas file; a sea with no valid case counts
 as producing nothing there, the share of the year that is valid is annual_energy_coverage,
 and annual_energy_unchecked_MWh is the figure the failed cases would have given).
@@ -41,6 +49,8 @@ scene, hydro data and radiation fit, and the package version) and refuses others
 Examples:
   mbcontrol sweep rm3 --hs 1 2 3 --tp 8 10 12 --duration 300 --store out/rm3 --plot pm.png
   mbcontrol sweep oswec --seas ../shared/data/sites/pacwave_cluster_32.csv --width 18 --json
+  mbcontrol sweep array_grid --scene-param n=3 --scene-param scale=25 --isolated n=1 \
+      --seas ../shared/data/sites/pacwave_cluster_32.csv --vary direction=0,45
 """
 
 
@@ -64,6 +74,8 @@ def add_parser(sub) -> None:
                    help="scene [parameters] value (repeatable)")
     p.add_argument("--vary", action="append", default=[], metavar="NAME=v1,v2,...",
                    help="a swept quantity (repeatable): one dimension per name")
+    p.add_argument("--isolated", action="append", default=[], metavar="NAME=VALUE",
+                   help="a farm: scene parameters of one device alone (repeatable); adds the q-factor")
     p.add_argument("--seeds", type=int, default=1, help="wave realisations per sea (1)")
     p.add_argument("--duration", type=float,
                    help=f"simulated time per case, s ({default_help('sweep.duration')})")
@@ -119,14 +131,17 @@ def run_sweep(args) -> int:
             raise ValueError(f"--vary {item}: expected NAME=v1,v2,... with numbers") from None
         if not vary[name.strip()]:
             raise ValueError(f"--vary {item}: expected NAME=v1,v2,... with at least one value")
-    ds, summary = sweep(
-        args.model, seas, seeds=args.seeds, vary=vary,
-        params=dict(_key_value(s, "--param") for s in args.param),
-        scene_params=dict(_key_value(s, "--scene-param") for s in args.scene_param),
-        controller=args.controller, settings=settings,
-        duration=args.duration, dt=args.dt, method=args.method, store=args.store,
-        workers=_workers(args.workers), scheduler=args.scheduler, width=args.width,
-        progress=not args.json)
+    common = dict(seeds=args.seeds, vary=vary, params=dict(_key_value(s, "--param") for s in args.param),
+                  controller=args.controller, settings=settings, duration=args.duration, dt=args.dt,
+                  method=args.method, store=args.store, workers=_workers(args.workers),
+                  scheduler=args.scheduler, width=args.width, progress=not args.json)
+    scene_params = dict(_key_value(s, "--scene-param") for s in args.scene_param)
+    if args.isolated:
+        from ..studies.farm import farm_sweep
+        ds, summary = farm_sweep(args.model, seas, scene_params=scene_params,
+                                 isolated=dict(_key_value(s, "--isolated") for s in args.isolated), **common)
+    else:
+        ds, summary = sweep(args.model, seas, scene_params=scene_params, **common)
     if args.plot:
         from ..studies.sweep.plots import plot_sweep
         plot_sweep(ds, summary, args.plot)
@@ -135,15 +150,19 @@ def run_sweep(args) -> int:
         return 0
     print(f"{summary['model']}: {summary['cases']} cases ({summary['computed']} computed, "
           f"{summary['reused']} reused) in {summary['wall_time_s']:.1f} s")
-    print(f"  {'Hs m':>6s} {'Tp s':>6s} {'weight':>8s} {'power kW':>10s} {'CW m':>8s} {'J kW/m':>8s}")
+    farm = summary.get("farm")
+    print(f"  {'Hs m':>6s} {'Tp s':>6s} {'weight':>8s} {'power kW':>10s} {'CW m':>8s} {'J kW/m':>8s}"
+          + (f" {'q':>6s}" if farm else ""))
     for row in summary["seas"]:
         power = row["mean_power_W"]
         text = f"{power / 1e3:10.4g}" if isinstance(power, float) else "  (varied)"
         cw = row["capture_width_m"]
         cw_text = f"{cw:8.3g}" if isinstance(cw, float) else "    -"
         weight = f"{row['weight']:8.4f}" if row["weight"] is not None else "       -"
+        q = row.get("q_factor")
+        q_text = "" if not farm else f" {q:6.3f}" if isinstance(q, float) else "  (varied)"
         print(f"  {row['hs']:6.3g} {row['tp']:6.3g} {weight} {text} {cw_text} "
-              f"{row['energy_flux_W_per_m'] / 1e3:8.3g}")
+              f"{row['energy_flux_W_per_m'] / 1e3:8.3g}{q_text}")
     for note in summary["notes"]:
         print(f"  note: {note}")
     for case in summary["invalid"][:10]:
@@ -155,6 +174,10 @@ def run_sweep(args) -> int:
               f"energy {summary['annual_energy_MWh']:.4g} MWh"
               + ("" if share == 1 else f" (valid seas only: {100 * share:.3g} % of the year; a "
                                        f"lower bound)"))
+    if farm and farm["q_annual"] is not None:
+        print(f"  farm of {farm['devices']} devices: annual energy {summary['annual_energy_MWh']:.4g} MWh "
+              f"against {farm['annual_energy_isolated_MWh']:.4g} MWh for as many devices alone: "
+              f"q = {farm['q_annual']:.3f}")
     if args.store:
         print(f"wrote {args.store}/sweep.nc", file=sys.stderr)
     return 0

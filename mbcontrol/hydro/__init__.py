@@ -9,14 +9,18 @@ time convention e^{-iωt}, excitation per unit wave amplitude at the n-frame ori
   ``added_mass_inf``, ``added_mass_zero``, ``hydrostatic_stiffness`` (radiating_dof, influenced_dof)
 - ``excitation_force`` = ``froude_krylov_force`` + ``diffraction_force`` (wave_direction, omega, influenced_dof)
 - ``displaced_volume``, ``waterplane_area``, ``mass`` (body); ``center_of_buoyancy``, ``cog`` (body, xyz)
+
+Arrays: a mirror-symmetric layout is solved on its planes (module array_bem); many bodies' radiation
+is fitted column by column (module array_fit, :func:`fit_radiation_columns`).
 """
 from ._io import read_netcdf, write_netcdf_atomic
 from .baseline import fit_radiation_hankel
 from .bem import cache_key, compute, matrix
 from .frames import dof_map, shift_matrix, skew, to_body_frames, zup_to_ned
 from .geometry import RIGID_DOFS, BemBody, hull_mesh, lid_mesh, validate_body
-from .model import HydroModel, fit_hydro_model, geometry_dict, load_hydro_data, load_hydro_model
+from .model import HydroModel, fit_hydro_model, fit_method, geometry_dict, load_hydro_data, load_hydro_model
 from .passivity import PassivityReport, absorbed_energy, enforce_passivity, passivity_test
+from .array_fit import fit_radiation_columns
 from .radiation import (RadiationModel, convolution_force, fit_radiation, impulse_response,
                         kernel_data)
 
@@ -24,7 +28,7 @@ __all__ = [
     "read_netcdf", "write_netcdf_atomic",
     "BemBody", "RIGID_DOFS", "compute", "cache_key", "matrix", "validate_body", "hull_mesh", "lid_mesh",
     "to_body_frames", "dof_map", "shift_matrix", "skew", "zup_to_ned",
-    "RadiationModel", "fit_radiation", "impulse_response", "convolution_force", "kernel_data",
+    "RadiationModel", "fit_radiation", "fit_radiation_columns", "impulse_response", "convolution_force", "kernel_data",
     "PassivityReport", "passivity_test", "enforce_passivity", "absorbed_energy", "fit_radiation_hankel",
-    "HydroModel", "load_hydro_model", "load_hydro_data", "fit_hydro_model", "geometry_dict",
+    "HydroModel", "load_hydro_model", "load_hydro_data", "fit_hydro_model", "fit_method", "geometry_dict",
 ]

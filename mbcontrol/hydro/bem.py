@@ -8,11 +8,13 @@ as netCDF, keyed by a hash of every input that changes them.
 """
 from __future__ import annotations
 
+import contextlib
 import datetime
 import hashlib
 import json
 import logging
 import math
+import sys
 from collections import defaultdict
 from pathlib import Path
 
@@ -24,6 +26,7 @@ from mbcontrol.errors import HydroError
 from ..cache import progress_bar
 from . import _io
 from .frames import to_body_frames
+from .array_bem import symmetric_array_body
 from .geometry import NED_TO_ZUP, RIGID_DOFS, BemBody, hull_mesh, lid_mesh, mirror_symmetric, validate_body
 from .obstacles import drop_seabed_faces, refine, remove_contact_faces
 
@@ -156,11 +159,13 @@ def _solve(solver, problems, *, progress: bool, n_jobs: int):
     """Solve ``problems`` (grouped by ω so each influence matrix is built and factorised once)."""
     if n_jobs != 1:
         return solver.solve_all(problems, n_jobs=n_jobs, progress_bar=progress)
-    try:  # Capytaine's resolution / depth / irregular-frequency warnings, once for the whole set
+    try:  # Capytaine's resolution / depth / irregular-frequency warnings, once for the whole set;
+        # its log handler writes to stdout, which `--json` keeps for the JSON alone
         from capytaine.bem import problems_checks as chk
-        for check in (chk._check_wavelength_and_mesh_resolution, chk._check_wavelength_and_water_depth,
-                      chk._check_wavelength_and_irregular_frequencies):
-            check(problems)
+        with contextlib.redirect_stdout(sys.stderr):
+            for check in (chk._check_wavelength_and_mesh_resolution, chk._check_wavelength_and_water_depth,
+                          chk._check_wavelength_and_irregular_frequencies):
+                check(problems)
     except (ImportError, AttributeError):  # private helpers: skip them if a release renames them
         pass
     groups = defaultdict(list)
@@ -170,7 +175,19 @@ def _solve(solver, problems, *, progress: bool, n_jobs: int):
     for w in progress_bar(iterable=sorted(groups), desc="BEM (per frequency)", unit="ω",
                           disable=not progress):
         results += solver.solve_all(groups[w], progress_bar=False, _check_wavelength=False)
+        _forget_symmetric_blocks()
     return results
+
+
+def _forget_symmetric_blocks():
+    """Capytaine 3.0 memoises each nested block-circulant matrix's conversion (an lru_cache of 128
+    on the method): with a nested symmetric mesh every frequency's matrices stay alive, 8.5 GB
+    for 16 floats over 66 frequencies. Done with a frequency, let them go."""
+    try:
+        from capytaine.tools.block_circulant_matrices import NestedBlockCirculantMatrix
+        NestedBlockCirculantMatrix.to_BlockCirculantMatrix.cache_clear()
+    except (ImportError, AttributeError):
+        pass
 
 
 def _failed(results):
@@ -275,7 +292,9 @@ def compute(bodies: list[BemBody], *, rho: float, g: float, depth: float, omegas
     import capytaine as cpt
 
     fbs, hydro, use_sym, removed = _capytaine_bodies(bodies, lid, depth)
-    mb = cpt.Multibody(fbs)
+    # an array whose layout is mirror-symmetric is solved as one body on the array's planes
+    array = None if use_sym else symmetric_array_body(bodies, lid)
+    mb = array[0] if array else cpt.Multibody(fbs)
     dof_names = [f"{b.name}__{d}" for b in bodies for d in RIGID_DOFS if d in b.dofs]
     if list(mb.dofs) != dof_names:  # Multibody keeps the order of rigid_body_dofs
         raise HydroError(f"internal: Capytaine DOF order {list(mb.dofs)} != {dof_names}")
@@ -319,13 +338,14 @@ def compute(bodies: list[BemBody], *, rho: float, g: float, depth: float, omegas
     ds["wave_direction"].attrs.update(units="rad", long_name="NED heading waves travel to, +x towards +y (starboard)")
     # Capytaine: 8 panel radii per wavelength. Its Multibody takes the least over the bodies;
     # the coarsest one (a CAD obstacle, say) limits the whole solve
-    lam_min = max(max(fb.minimal_computable_wavelength for fb in mb.bodies), 1e-12)
+    lam_min = max(max(fb.minimal_computable_wavelength for fb in getattr(mb, "bodies", [mb])), 1e-12)
     ds.attrs.update({
         "rho": rho, "g": g, "depth": depth, "frame": "NED body frames at CoG",
         "time_convention": "exp(-i omega t)",
         "excitation_reference": "unit wave amplitude, elevation positive up, at the n-frame origin",
         "matrix_layout": "X[radiating_dof, influenced_dof]; force_i = -sum_j X[j, i] * motion_j",
-        "source": f"capytaine {_capytaine_version()}", "lid": bool(lid), "mirror_symmetry_used": bool(use_sym),
+        "source": f"capytaine {_capytaine_version()}", "lid": bool(lid), "mirror_symmetry_used": bool(use_sym or array),
+        "array_symmetry_planes": list(array[1]) if array else [],
         "hull_panels": {k: int(fb.mesh.nb_faces) for k, fb in everything.items()},
         "lid_panels": {k: int(fb.lid_mesh.nb_faces) if fb.lid_mesh is not None else 0
                        for k, fb in everything.items()},

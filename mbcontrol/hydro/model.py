@@ -22,7 +22,7 @@ from ..cache import cache_dir, status
 from ..errors import HydroError
 from ..scene import DOF_NAMES, Scene
 from ..waves import Wave, excitation_series, interpolate_complex
-from . import fit_error, passive_order, passivity, radiation, sdp, vector_fit
+from . import array_fit, array_passivity, fit_error, passive_order, passivity, radiation, sdp, vector_fit
 from ._io import read_netcdf
 from .bem import compute
 from .geometry import BemBody
@@ -39,6 +39,7 @@ class HydroModel:
     source: str
     fit_omega_max: float = np.inf      # rad/s, the scene's radiation fit band limit
     response_band: tuple | None = None  # rad/s, where the fit is judged per frequency (scene)
+    fit_method: str = "coupled"        # "coupled" (module radiation) or "columns" (module array_fit)
 
     def _matrix(self, name: str) -> np.ndarray:
         """(..., influenced, radiating) array: rows are the DOFs the force acts on."""
@@ -111,6 +112,8 @@ class HydroModel:
         r = self.radiation
         order = [r.dofs.index(d) for d in self.dofs]
         B, C, D = r.B[:, order], r.C[order, :], r.D[np.ix_(order, order)]
+        if self.fit_method == "columns":   # already real block-diagonal, poles shared by columns
+            return r.A, B, C, D
         try:
             A, B, C = modal_form(r.A, B, C)
         except ValueError:
@@ -126,8 +129,9 @@ class HydroModel:
             raise HydroError(f"{self.source}: the plant moves {missing} but the hydro model "
                              f"only has {list(self.dofs)}")
         return HydroModel(dofs, self.data, _fit_cached(self.data, dofs, None, self.source,
-                                                       self.fit_omega_max, self.response_band),
-                          self.source, self.fit_omega_max, self.response_band)
+                                                       self.fit_omega_max, self.response_band,
+                                                       self.fit_method),
+                          self.source, self.fit_omega_max, self.response_band, self.fit_method)
 
     def frequency_domain_matrices(self, omega):
         """A(omega), B(omega) interpolated to omega (n, n_dof, n_dof), for FD solutions."""
@@ -140,7 +144,19 @@ def load_hydro_model(scene: Scene, dofs, tol: float | None = None) -> HydroModel
     """Body-frame data for `dofs` (from scene.hydro.file, or a cached BEM run) and its fit."""
     tol = scene.hydro.radiation_tol if tol is None else tol
     source, data = load_hydro_data(scene, dofs)
-    return fit_hydro_model(data, dofs, tol, source, scene.hydro.fit_omega_max, scene.hydro.response_band)
+    return fit_hydro_model(data, dofs, tol, source, scene.hydro.fit_omega_max, scene.hydro.response_band,
+                           fit_method(scene.hydro.radiation_fit, dofs))
+
+
+ARRAY_BODIES = 9   # "auto" fits column by column from this many bodies (module array_fit)
+
+
+def fit_method(setting: str, dofs) -> str:
+    """The radiation fit a scene's [hydro] radiation_fit asks for on ``dofs``: "coupled" or
+    "columns"; "auto" is "columns" when the DOFs belong to at least ARRAY_BODIES bodies."""
+    if setting != "auto":
+        return setting
+    return "columns" if len({str(d).split("__")[0] for d in dofs}) >= ARRAY_BODIES else "coupled"
 
 
 def load_hydro_data(scene: Scene, dofs) -> tuple[str, xr.Dataset]:
@@ -174,15 +190,15 @@ def _missing_file(scene: Scene) -> str:
 
 
 def fit_hydro_model(data: xr.Dataset, dofs, tol: float | None, source: str,
-                    fit_omega_max: float = np.inf, response_band=None) -> HydroModel:
+                    fit_omega_max: float = np.inf, response_band=None, method: str = "coupled") -> HydroModel:
     """A HydroModel of `data` on `dofs`, its radiation fitted to `tol` (cached on disk).
 
     For callers that change the data first (e.g. mbcontrol.plant.fidelity drops the coupling between
     bodies): the cache key is the data itself, so a changed dataset never serves an old fit.
     """
     _check_dofs(data, dofs, source)
-    fit = _fit_cached(data, tuple(dofs), tol, source, fit_omega_max, response_band)
-    return HydroModel(tuple(dofs), data, fit, source, fit_omega_max, response_band)
+    fit = _fit_cached(data, tuple(dofs), tol, source, fit_omega_max, response_band, method)
+    return HydroModel(tuple(dofs), data, fit, source, fit_omega_max, response_band, method)
 
 
 def _run_bem(scene: Scene, dofs):
@@ -253,8 +269,12 @@ def fit_band_limit(data: xr.Dataset, scene_limit: float = np.inf) -> float | Non
 FITS_SERVED: list = []      # the fit files asked for, in order (models/generate_hydro.py --ship-fits)
 
 
-def _fit_cached(data: xr.Dataset, dofs, tol, source: str, omega_max: float = np.inf, response_band=None):
-    """fit_radiation with an on-disk cache keyed by the data, the DOFs, the tolerance and the bands."""
+def _fit_cached(data: xr.Dataset, dofs, tol, source: str, omega_max: float = np.inf, response_band=None,
+                method: str = "coupled"):
+    """fit_radiation (``method`` "coupled") or fit_radiation_columns ("columns") with an on-disk
+    cache keyed by the data, the DOFs, the tolerance, the bands and the method."""
+    if method not in ("coupled", "columns"):
+        raise HydroError(f"radiation fit method {method!r}: expected 'coupled' or 'columns'")
     tol = 0.01 if tol is None else tol
     digest = hashlib.sha256()
     for var in ("added_mass", "radiation_damping", "added_mass_inf"):
@@ -265,6 +285,9 @@ def _fit_cached(data: xr.Dataset, dofs, tol, source: str, omega_max: float = np.
     band = fit_band_limit(data, omega_max)
     response_band = None if response_band is None else [float(x) for x in response_band]
     digest.update(json.dumps([list(dofs), tol, band] + ([response_band] if response_band else [])).encode())
+    if method == "columns":    # (the coupled fit's keys stay as they were: shipped fits still found)
+        for module in (array_fit, array_passivity):
+            digest.update(b"columns" + Path(module.__file__).read_bytes())
     name = f"radiation_{digest.hexdigest()[:20]}.npz"
     FITS_SERVED.append(name)
     shipped = shipped_fits_dir() / name
@@ -280,8 +303,9 @@ def _fit_cached(data: xr.Dataset, dofs, tol, source: str, omega_max: float = np.
             path.unlink(missing_ok=True)       # a stale or foreign file: refit
     started = time.perf_counter()
     status(f"fitting the radiation model of {Path(source).name} ({len(dofs)} DOFs, tolerance "
-           f"{tol:g}): typically 5-90 s, once; cached afterwards", __name__)
-    model = fit_radiation(data, dofs=list(dofs), tol=tol, omega_max=band, response_band=response_band)
+           f"{tol:g}, {method}): typically 5-90 s, once; cached afterwards", __name__)
+    fitter = fit_radiation if method == "coupled" else array_fit.fit_radiation_columns
+    model = fitter(data, dofs=list(dofs), tol=tol, omega_max=band, response_band=response_band)
     status(f"radiation model fitted in {time.perf_counter() - started:.1f} s: "
            f"{model.order} states, error {model.fit_error:.2%}", __name__)
     with atomic_path(path) as tmp, open(tmp, "wb") as fh:

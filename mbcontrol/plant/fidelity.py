@@ -25,7 +25,7 @@ import numpy as np
 import xarray as xr
 
 from ..errors import FidelityError
-from ..hydro import HydroModel, fit_hydro_model, load_hydro_data
+from ..hydro import HydroModel, fit_hydro_model, fit_method, load_hydro_data
 from ..multibody import build_topology
 from ..scene import DOF_NAMES, Scene, load_scene
 from .freeze import FREEZE_THRESHOLD, as_wave_list, freeze_report, frozen_scene
@@ -155,7 +155,8 @@ def _hydro_model(scene, frozen, fidelity, hydro, waves, notes) -> HydroModel | N
         notes["couplings"] = coupling_size(data, dofs, band)
         data = drop_couplings(data)
         source = f"{source} (couplings between bodies dropped)"
-    return fit_hydro_model(data, dofs, tol, source, limit, scene.hydro.response_band)
+    return fit_hydro_model(data, dofs, tol, source, limit, scene.hydro.response_band,
+                           fit_method(scene.hydro.radiation_fit, dofs))
 
 
 # ----------------------------------------------------------------------------- couplings

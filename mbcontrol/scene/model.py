@@ -202,6 +202,7 @@ class HydroSettings:
     headings: tuple[float, ...] = (0.0,)       # rad, NED wave directions
     lid: bool = True
     radiation_tol: float = 0.01                # radiation fit error (hydro.radiation, "Error")
+    radiation_fit: str = "auto"                # "coupled" | "columns" (hydro.array_fit) | "auto"
     fit_omega_max: float = math.inf            # rad/s: fit the radiation model below this
     response_band: tuple[float, float] | None = None  # rad/s: where the device moves (its seas
                                                # and modes); radiation fit judged per ω there

@@ -159,6 +159,9 @@ MEANING = {
     ("hydro", "dofs"): "the DOFs solved per body",
     ("hydro", "radiation_tol"): "radiation fit error tolerance (default: the 'hydro.radiation_tol' "
                                 "of `mbcontrol defaults`)",
+    ("hydro", "radiation_fit"): "`coupled` (one pole set per coupled group), `columns` (per "
+                                "column, symmetric columns shared: arrays and farms) or `auto` "
+                                "(columns from 9 bodies)",
     ("hydro", "fit_omega_max"): "highest frequency the radiation fit sees",
     ("hydro", "response_band"): "[low, high]: where the fit is judged per frequency",
     ("hydro", "hydrostatics"): "`large_angle`: buoyancy of the immersed primitive at its pose",

@@ -105,3 +105,20 @@ def test_compiled_code_is_keyed_by_structure_not_values(tmp_path, monkeypatch):
     monkeypatch.setattr(integ, "_CHUNKS", {})                  # a "new process"
     simulate(build_plant("sphere"), None, duration=51.2, dt=0.1, method="exp-rk4")
     assert sorted(p.name for p in (tmp_path / "compiled").glob("chunk_*.so")) == chunks
+
+
+@pytest.mark.parametrize("method", ["rk4", "exp-rk4"])
+def test_a_step_that_calls_f_equals_the_inlined_step(case, monkeypatch, method):
+    """Large plants (a farm) step with f called as one function (MX) instead of inlined at every
+    stage (SX), and map their outputs with unoptimised code: the same trajectory to round-off."""
+    from mbcontrol.sim import integrators
+    plant, wave, _ = case
+    inlined = simulate(plant, wave, duration=10.0, dt=0.05, method=method)
+    monkeypatch.setattr(integrators, "CALL_F_STATES", 0)
+    integrators._CHUNKS.clear()
+    integrators._OUTPUT_MAPS.clear()
+    called = simulate(plant, wave, duration=10.0, dt=0.05, method=method)
+    for name in ("heave", "heave__vel", "pto__force", "pto__power"):
+        a, b = called[name].values, inlined[name].values
+        assert np.abs(a - b).max() <= 1e-10 * np.abs(b).max(), name
+    assert np.array_equal(called["time"].values, inlined["time"].values)

@@ -18,6 +18,9 @@ from ...waves.sites import WEIGHT_SUM_TOLERANCE, SeaState, grid, read_seas  # no
 from ...waves.spectra import te_over_tp  # noqa: F401
 
 
+WAVE_DIRECTION = "direction"    # --vary direction=0,45: NED headings in degrees, of the hydro data
+
+
 @dataclass(frozen=True)
 class Case:
     """One closed-loop simulation of a sweep: its sea, seed, the values of the varied
@@ -51,8 +54,14 @@ class Case:
         """(plant params, scene params, controller settings) with the varied values in."""
         params, scene, settings = dict(self.params), dict(self.scene_params), dict(self.settings)
         for name, value in self.varied:
-            {"param": params, "scene": scene, "setting": settings}[self.roles[name]][name] = value
+            if self.roles[name] != "wave":
+                {"param": params, "scene": scene, "setting": settings}[self.roles[name]][name] = value
         return params, scene, settings
+
+    @property
+    def direction_deg(self) -> float | None:
+        """The wave direction varied for this case (degrees, NED heading), or None."""
+        return next((v for n, v in self.varied if self.roles.get(n) == "wave"), None)
 
 
 def build_cases(model: str, seas, *, seeds: int = 1, vary: dict | None = None, roles=None,
@@ -89,8 +98,10 @@ def roles_for(names, scene, plant_parameters, controller_class=None) -> dict:
         kinds = [k for k, pool in (("scene", set(scene.parameters)),
                                    ("param", set(plant_parameters)), ("setting", settings))
                  if name in pool]
+        if not kinds and name == WAVE_DIRECTION:
+            kinds = ["wave"]
         if not kinds:
-            raise ValueError(f"--vary {name}: not a scene parameter ({', '.join(scene.parameters) or 'none'}), "
+            raise ValueError(f"--vary {name}: not a wave direction (degrees), a scene parameter ({', '.join(scene.parameters) or 'none'}), "
                              f"plant parameter or controller setting of {scene.name}")
         if len(kinds) > 1:
             raise ValueError(f"--vary {name}: ambiguous, it is a {' and a '.join(kinds)}")

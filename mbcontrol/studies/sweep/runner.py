@@ -59,9 +59,12 @@ def run_case(case) -> dict:
     sea = case.sea
     headings = plant.hydro.data["wave_direction"].values
     omega = plant.hydro.omega
+    direction = float(headings[0]) if len(headings) == 1 else 0.0
+    if case.direction_deg is not None:
+        direction = math.radians(case.direction_deg)
     wave = waves.irregular(sea.hs, sea.tp, gamma=sea.gamma, seed=case.seed,
                            duration=case.duration, data_band=(float(omega[0]), float(omega[-1])),
-                           direction=float(headings[0]) if len(headings) == 1 else 0.0)
+                           direction=direction)
     controller = None
     if case.controller:
         cls = REGISTRY[case.controller]
