@@ -101,8 +101,9 @@ def roles_for(names, scene, plant_parameters, controller_class=None) -> dict:
         if not kinds and name == WAVE_DIRECTION:
             kinds = ["wave"]
         if not kinds:
-            raise ValueError(f"--vary {name}: not a wave direction (degrees), a scene parameter ({', '.join(scene.parameters) or 'none'}), "
-                             f"plant parameter or controller setting of {scene.name}")
+            raise ValueError(f"--vary {name}: not a scene parameter ({', '.join(scene.parameters) or 'none'}), "
+                             f"plant parameter or controller setting of {scene.name}, nor `direction` "
+                             "(wave headings, degrees)")
         if len(kinds) > 1:
             raise ValueError(f"--vary {name}: ambiguous, it is a {' and a '.join(kinds)}")
         roles[name] = kinds[0]
