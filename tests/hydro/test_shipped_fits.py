@@ -6,7 +6,7 @@ import pytest
 
 from mbcontrol.hydro import model as hydro_model
 from mbcontrol.plant import build_plant
-from mbcontrol.scene import list_models
+from mbcontrol.scene import list_models, load_scene
 
 
 @pytest.fixture
@@ -17,6 +17,9 @@ def empty_cache(tmp_path, monkeypatch):
 
 @pytest.mark.parametrize("name", list_models())
 def test_catalogue_plant_builds_from_shipped_fits(name, empty_cache, monkeypatch):
+    if not load_scene(name).hydro.file:     # array_grid: BEM and fit on first use, per layout
+        pytest.skip(f"{name} computes its hydrodynamics on first use: nothing is shipped")
+
     def no_fitting(*args, **kwargs):
         raise AssertionError(f"{name}: no shipped fit matches; run "
                              f"`python models/generate_hydro.py --ship-fits`")
