@@ -50,6 +50,7 @@ bench: $(VENV)/.installed-test
 	    --tols 0.1 0.05 0.02 0.01 --out $(OUT)/bench/radiation_rm3
 	$(PY) benchmarks/scaling.py --n 2 4 8 16 --out $(OUT)/bench/scaling
 	$(PY) benchmarks/array_scaling.py --n 2 3 4 5 --fit-tol 0.02 0.02 0.02 0.06 --out $(OUT)/bench/array_scaling
+	$(PY) benchmarks/interaction_cutoff.py --n 4 --radius 1.0 1.5 --out $(OUT)/bench/interaction_cutoff
 	$(PY) benchmarks/mpc.py --out $(OUT)/bench/mpc
 	$(PY) benchmarks/nmpc.py --out $(OUT)/bench/nmpc
 	$(PY) benchmarks/identify.py --out $(OUT)/bench/identify

@@ -85,7 +85,7 @@ def main(argv=None) -> int:
                     help="floats per side of the grids measured (2 3 4 5: 4, 9, 16, 25 floats)")
     ap.add_argument("--fit-tol", type=float, nargs="+", default=None,
                     help="radiation fit tolerance per grid (default 0.02 each; 25 floats reach "
-                         "passivity at 5.2 %%: give 0.06 there)")
+                         "passivity at 3.4 %%: give 0.06 there)")
     ap.add_argument("--cache", type=Path, default=None,
                     help="reuse this cache folder (warm runs) instead of a fresh one per grid")
     ap.add_argument("--out", type=Path, default=Path("out/bench/array_scaling"), help="output folder")

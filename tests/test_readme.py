@@ -51,6 +51,7 @@ TABLES = {
     "model, controller": ("measured", "benchmarks/export_step.py"),
     "floats": ("measured", "benchmarks/array_scaling.py"),
     "farm at PacWave South, 32 seas": ("measured", "--isolated n=1"),
+    "R": ("measured", "benchmarks/interaction_cutoff.py"),
 }
 MODEL_TABLES = {"mbcontrol (method, dt, radiation tol)": ("measured", "benchmarks/speed.py"),
                 "C step median / p99 / max (us)": ("measured", "benchmarks/export_step.py"),

@@ -10,14 +10,18 @@ Absorbed power ν^H ½(K + K^H) ν must be >= 0 at every ω:
   ``EXACT_TEST_STATES`` states the exact crossings of the Hamiltonian pencil (module passivity).
 - **Residue perturbation.** The worst point and every local minimum of a violation join a set of
   active frequencies; each pass linearises afresh at all of them (eigenvalues and vectors of the
-  current model) and changes the residues by the least data-weighted amount that lifts every
-  eigenvalue there to a small margin, K(0) = 0 kept: a QP whose Hessian is block-diagonal per
-  column class, solved through its dual (one NNLS in as many unknowns as constraints); a step
-  that makes the worst violation worse is halved.
-- **Shunt.** If ``RESIDUE_PASSES`` passes leave a violation (25 floats 1 m apart: above the data
-  band, at 23 rad/s, after 120 passes), what is left is covered exactly: adding δ(ω) I adds
-  δ to every eigenvalue, and δ is a non-negative sum of band-pass terms 2ζω_k s/(s² + 2ζω_k s +
-  ω_k²) (positive real, K(0) = 0) chosen by an LP that spends the least error in the data band.
+  current model) and changes the residues by the least amount that lifts every eigenvalue
+  there to a small margin, K(0) = 0 kept: a QP whose Hessian is block-diagonal per column
+  class, solved through its dual (one NNLS in as many unknowns as constraints); a step that
+  makes the worst violation worse is halved. The change is weighed on the data and, with
+  ``OUT_OF_BAND_WEIGHT``, two decades either side of them: on the data alone the changes they
+  barely see (fast poles' residues) are cheap, and at 25 floats one pass grew them 90-fold and
+  turned the asymptote ω → ∞ negative for good.
+- **Shunt.** If ``RESIDUE_PASSES`` passes leave a violation, what is left is covered exactly:
+  adding δ(ω) I adds δ to every eigenvalue, and δ is a non-negative sum of band-pass terms
+  2ζω_k s/(s² + 2ζω_k s + ω_k²) (positive real, K(0) = 0) chosen by an LP, on the check grid
+  and the asymptote, that spends the least error in the data band; centres from where their
+  poles are no slower than the fits' floor (SLOW_POLE) to 10 × the data's top frequency.
 """
 from __future__ import annotations
 
@@ -29,11 +33,12 @@ from scipy.optimize import nnls
 
 from .passivity import _crossings
 from .radiation import RadiationModel
-from .vector_fit import _basis, _poles_real_form
+from .vector_fit import SLOW_POLE, _basis, _poles_real_form
 
 EXACT_TEST_STATES = 600  # up to this many states the Hamiltonian crossings join the check grid
 MAX_PASSES = 44         # passivity correction passes in all
 RESIDUE_PASSES = 40     # of which residue perturbation; what it leaves, a diagonal shunt covers
+OUT_OF_BAND_WEIGHT = 1.0  # of a residue change's response outside the data band, against in it
 SHUNT_ZETA = 0.7        # damping ratio of the shunt's band-pass terms (broad: an octave or more)
 
 
@@ -121,22 +126,25 @@ def _shunt_terms(cols, C, grid, w):
     smallest eigenvalue to zero wherever it is negative on the grid (an LP). Adding δ(ω) I adds δ
     to every eigenvalue, so what residue perturbation leaves is covered exactly."""
     from scipy.optimize import linprog
-    grid = grid[np.isfinite(grid)]
     ev = _hermitian_eigs(cols, grid, C)[0]
-    scale = float(ev[:, -1].max())
+    fin = np.isfinite(grid)
+    scale = np.where(fin, float(ev[fin, -1].max()), np.abs(ev).max(axis=1))  # ω = ∞: its own units
     need = np.where(ev[:, 0] < -1e-9 * scale, -ev[:, 0] + 1e-6 * scale, 0.0)
     if not need.any():
         return []
     # centres up to 10x the data band (a faster term would set the time step: RK4 at 0.01 s is
-    # stable to 278 rad/s); above its centre a term still gives (2ζω_k)² b / ω²
+    # stable to 278 rad/s); above its centre a term still gives (2ζω_k)² b / ω², which is
+    # what covers the asymptote's row
     top = 10 * float(np.max(w))
-    centres = np.geomspace(grid.min(), top, int(8 * np.log10(top / grid.min())) + 1)
-    R = _bandpass(1j * grid[:, None], centres[None, :], SHUNT_ZETA).real
+    # ... and down to where a term's poles (Re = -ζω_k) are no slower than the fits' floor
+    lo = max(float(grid[fin].min()), SLOW_POLE * float(np.min(w)) / SHUNT_ZETA)
+    centres = np.geomspace(lo, top, int(8 * np.log10(top / lo)) + 1)
+    R = _bandpass(_jw(grid)[:, None], centres[None, :], SHUNT_ZETA).real
     cost = np.sqrt(np.mean(np.abs(_bandpass(1j * w[:, None], centres[None, :], SHUNT_ZETA)) ** 2, axis=0))
     res = linprog(cost, A_ub=-R[need > 0], b_ub=-need[need > 0], bounds=(0, None), method="highs")
     if not res.success:
         return []
-    return [(float(c), SHUNT_ZETA, float(b)) for c, b in zip(centres, res.x) if b > 1e-12 * scale]
+    return [(float(c), SHUNT_ZETA, float(b)) for c, b in zip(centres, res.x) if b > 1e-12 * scale[fin][0]]
 
 
 def _check_grid(fits, w):
@@ -160,7 +168,12 @@ def enforce_columns(fits, classes, n, dofs, wf, weight, w):
     cols = _Columns(fits, classes, n)
     C = {r: f[1].copy() for r, f in fits.items()}
     size = {r: sum(1 for q, _ in classes if q == r) for r in fits}
-    s = 1j * wf
+    # the change is weighed on the data and, with OUT_OF_BAND_WEIGHT, outside their band (two
+    # decades each way): changes the data barely see (fast poles' residues) would otherwise be
+    # cheap, and grow without bound there and at ω = ∞
+    s = 1j * np.concatenate([wf, np.geomspace(wf.min() / 100, wf.min(), 10, endpoint=False),
+                             np.geomspace(1.02 * wf.max(), 100 * wf.max(), 30)])
+    weight = np.concatenate([weight, np.full(40, OUT_OF_BAND_WEIGHT)])
     # per class: K(0) = 0 kept (ΔC = Z Y), Hessian of the data-weighted change of its columns
     Z, Hinv = {}, {}
     for r, f in fits.items():

@@ -7,6 +7,7 @@ temporary file and renamed.
 """
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 import time
@@ -27,6 +28,7 @@ from ._io import read_netcdf
 from .bem import compute
 from .geometry import BemBody
 from .isolated import compute_isolated
+from .neighbours import compute_within
 from .radiation import RadiationModel, fit_radiation
 from .ssforms import modal_form
 
@@ -216,10 +218,14 @@ def _run_bem(scene: Scene, dofs):
                                       panel_size=scene.hydro.panel_size, dofs=body_dofs))
     bodies += obstacle_bodies(scene)
     solve = compute if scene.hydro.interaction else compute_isolated
+    if scene.hydro.interaction_radius < np.inf:
+        solve = functools.partial(compute_within, radius=scene.hydro.interaction_radius)
     data = solve(bodies, rho=scene.water.rho, g=scene.water.g, depth=scene.water.depth,
                        omegas=np.array(scene.hydro.omega), headings=scene.hydro.headings,
                        lid=scene.hydro.lid, cache_dir=cache_dir())
     what = "BEM" if scene.hydro.interaction else "BEM, bodies solved alone,"
+    if scene.hydro.interaction_radius < np.inf:
+        what = f"BEM, each body with its neighbours within {scene.hydro.interaction_radius:g} m,"
     return f"{what} of {scene.path}", data
 
 

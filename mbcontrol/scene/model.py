@@ -212,6 +212,7 @@ class HydroSettings:
     source_bodies: tuple[str, ...] = ()        # scene body per body of the source, in order
     source_options: dict = field(default_factory=dict)   # reader/cleaning options, see below
     interaction: bool = True                   # False: each body solved alone (hydro.isolated)
+    interaction_radius: float = math.inf       # m: couple bodies only within it (hydro.neighbours)
     hydrostatics: str = "linear"               # "linear" | "large_angle" (box, cylinder, sphere)
 
 

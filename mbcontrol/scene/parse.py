@@ -252,13 +252,18 @@ def _hydro(r: Reader, path: Path) -> HydroSettings:
         return HydroSettings()
     r.allow("file", "panel_size", "omega", "headings", "lid", "radiation_tol", "dofs",
             "source", "source_bodies", "source_options", "fit_omega_max", "response_band", "interaction",
-            "hydrostatics", "radiation_fit")
+            "interaction_radius", "hydrostatics", "radiation_fit")
     band = r.finite_list("response_band", "frequency", default=()) or None
     if band is not None and not (len(band) == 2 and 0 <= band[0] < band[1]):
         r.fail("response_band", f"expected [low, high] in rad/s with 0 <= low < high, got {band}")
     source = r.string("source", default=None)
     file = r.string("file", default=None)
     omega = r.frequency_grid("omega")
+    interaction = r.boolean("interaction", default=True)
+    radius = r.positive("interaction_radius", "length", default=math.inf, finite=False)
+    if not interaction and radius < math.inf:
+        r.fail("interaction_radius", "expected either interaction = false (no coupling) or an "
+               "interaction_radius (coupling within it), not both")
     return HydroSettings(
         file=str(path.parent / file) if file else None,
         panel_size=r.positive("panel_size", "length", default=0.1),
@@ -274,7 +279,7 @@ def _hydro(r: Reader, path: Path) -> HydroSettings:
         source=str((path.parent / source).resolve()) if source else None,
         source_bodies=tuple(r.string_list("source_bodies", default=())),
         source_options=_source_options(r.table("source_options", required=False)),
-        interaction=r.boolean("interaction", default=True),
+        interaction=interaction, interaction_radius=radius,
         hydrostatics=r.choice("hydrostatics", ("linear", "large_angle"), default="linear"))
 
 

@@ -156,6 +156,8 @@ MEANING = {
     ("hydro", "panel_size"): "mesh panel size for primitives",
     ("hydro", "lid"): "a lid on each waterplane against irregular frequencies",
     ("hydro", "interaction"): "false: each body solved alone (no coupling)",
+    ("hydro", "interaction_radius"): ("m: bodies couple only within it, each solved among its "
+                                      "neighbours (mbcontrol.hydro.neighbours); inf: all coupled"),
     ("hydro", "dofs"): "the DOFs solved per body",
     ("hydro", "radiation_tol"): "radiation fit error tolerance (default: the 'hydro.radiation_tol' "
                                 "of `mbcontrol defaults`)",
