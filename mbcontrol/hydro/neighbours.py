@@ -57,6 +57,8 @@ def compute_within(bodies, radius: float, **kwargs) -> xr.Dataset:
         ds = solved[key]
         own = [f"{names[i]}__{d}" for d in body.dofs]
         part = ds.sel(body=[names[i]], radiating_dof=own, influenced_dof=own)
+        part.attrs.update({k: {names[i]: ds.attrs[k][names[i]]} for k in ("hull_panels", "lid_panels")
+                           if k in ds.attrs})      # the float's own panels, not its neighbours'
         parts.append(shifted(part, body, *centres[i]))
         clusters.append((i, near, names, ds))
     out = merge(parts)

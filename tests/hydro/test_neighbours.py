@@ -45,6 +45,7 @@ def test_a_radius_over_the_whole_layout_is_the_coupled_solve(dofs):
     for var in VARS:        # moved to the origin, renamed, phase restored: the same numbers
         _close(cut, full, var, rel=1e-6)
     assert cut_error(full, cut)["kernel"] < 1e-6
+    assert cut.attrs["hull_panels"] == full.attrs["hull_panels"]      # each float's own count
 
 
 def test_a_radius_below_the_spacing_is_the_isolated_solve():
