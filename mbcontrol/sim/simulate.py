@@ -26,6 +26,7 @@ from ..errors import SimulationError
 from ..plant import provenance
 from ..results import jsonable
 from . import diagnose, integrators, sampled
+from .held import HeldStepper
 from .moorings import mooring_report
 
 
@@ -214,16 +215,15 @@ def _run_fixed(plant, method, controller, law, embedded, x0, W_nodes, p, dt, n, 
         return integrators.run_fixed_step(plant, x0, np.zeros((n, nu)), W_nodes, p, dt, method,
                                           law=law, compiled=compiled, on_chunk=check)
     m = _steps_per_period(_period(controller, dt), dt)
+    stepper = HeldStepper(plant, method, m, p, dt, compiled)
     X, U = np.empty((n + 1, plant.nx)), np.empty((n, nu))
     X[0], u_prev = x0, np.zeros(nu)
     for i in range(0, n, m):
         k = min(m, n - i)
-        y = np.asarray(plant.h(X[i], u_prev, W_nodes[i, 0], p)).ravel()
+        y = stepper.outputs(X[i], u_prev, W_nodes[i, 0])
         u_prev = _command(controller, i * dt, y, X[i], nu)
         U[i:i + k] = u_prev
-        Xk, _ = integrators.run_fixed_step(plant, X[i], U[i:i + k], W_nodes[i:i + k], p, dt,
-                                           method, compiled=compiled)
-        X[i + 1:i + k + 1] = Xk[1:]
+        X[i + 1:i + k + 1] = stepper.advance(X[i], u_prev, W_nodes[i:i + k])
         check(i + k, X[:i + k + 1])
     return X, U
 

@@ -93,12 +93,35 @@ def test_auto_rm3_chooses_a_smaller_multibody_model():
 
 
 def test_tight_tolerance_keeps_the_full_model():
+    """At 1e-6 no looser radiation fit passes. Linear kinematics pass: for a sphere on one
+    vertical slider they are exact (error at round-off), and cost the same (instructions
+    within INSTRUCTION_TIES), so the tie goes to the lower error, the full model, whatever
+    the millisecond walls measured (they once vetoed the full model and flipped the choice)."""
     report = auto("sphere", _sphere_sea(), tol=1e-6, duration=22 * TP_SPHERE,
                   radiation_tols=(0.05, 0.2))
+    linear = next(c for c in report.candidates if c.label == "kinematics=linear")
+    assert linear.passed and linear.error < 1e-12          # exact on a slider
     assert report.fidelity == Fidelity()
     assert report.chosen is report.reference and report.error == 0.0
     # every looser fit changes the heave by far more than 1e-6
     assert all(not c.passed for c in report.candidates if c.fidelity.radiation_tol)
+
+
+def test_walls_within_noise_never_decide():
+    """The choice rule alone: two equal-cost models whose walls differ by 2x but by less than
+    WALL_NOISE_S tie (the lower error wins); a candidate slower by WALL_VETO and by more than
+    the noise floor is vetoed however few instructions it has."""
+    from mbcontrol.studies.fidelity_auto import WALL_NOISE_S, WALL_VETO, Candidate, _cheapest
+
+    def cand(label, error, wall, instructions):
+        return Candidate(label, Fidelity(), error, "x", wall, 10, instructions, True, "single",
+                         None)
+    full, equal = cand("full", 0.0, 0.0056, 112), cand("equal", 5e-16, 0.0027, 115)
+    assert _cheapest([full, equal]) is full
+    fast = cand("fast", 0.0, 1.0, 112)                    # a 1 s run
+    cheap_but_slow = cand("cheap", 1e-9, WALL_VETO * 1.0 + WALL_NOISE_S, 50)
+    assert _cheapest([fast, cheap_but_slow]) is fast
+    assert _cheapest([fast, cand("cheap", 1e-9, 1.9, 50)]).label == "cheap"
 
 
 # ----------------------------------------------------------------------------- kinematics
