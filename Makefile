@@ -32,12 +32,12 @@ $(VENV)/.installed-docs: pyproject.toml | $(VENV)/bin/python
 demo: $(VENV)/.installed
 	$(PY) -m mbcontrol.demo --out $(OUT)/demo
 
-# One worker per core (pytest-xdist); each module a unit, longest first (tests/conftest.py).
+# One worker per core (pytest-xdist); each file a unit, longest first (tests/conftest.py).
 # One BLAS/OpenMP thread per worker: two workers of two threads each on two cores made a
 # raft3 design test 2.6x slower (472 s) than it runs alone (181 s).
 test: $(VENV)/.installed-test
 	OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 MKL_NUM_THREADS=1 \
-	    $(PY) -m pytest -q -n auto --dist loadgroup --no-loadscope-reorder
+	    $(PY) -m pytest -q -n auto --dist loadfile --no-loadscope-reorder
 
 # Sphinx with warnings as errors; reuses the notebooks `make test` executed (out/notebooks)
 docs: $(VENV)/.installed-docs

@@ -30,3 +30,25 @@ def make(name: str, **settings) -> Controller:
     except TypeError as exc:
         raise KeyError(f"controller {name!r}: {exc}; its settings are "
                        f"{', '.join(accepted)}") from None
+
+
+# Laws whose power comes from their damping alone: with none (their default, so that a law is
+# never tuned by accident) they absorb nothing. A bare `--controller reactive` used to report
+# 0.0 W in all 32 PacWave seas, all "valid", with no word said.
+DAMPED_LAWS = ("passive", "reactive", "latching", "declutching")
+
+
+def absorbs_nothing(name: str | None, settings: dict | None, varied=()) -> str | None:
+    """Why controller `name` with `settings` absorbs no power, or None. The CLI's simulate
+    and sweep warn with it (the documented choice: a named controller runs as given, its
+    defaults included, and says so; `design` and `sweep --design` tune it for a sea)."""
+    if name not in DAMPED_LAWS or "damping" in varied:
+        return None
+    damping = (settings or {}).get("damping", 0.0)
+    values = damping.values() if isinstance(damping, dict) else [damping]
+    if any(float(v) != 0.0 for v in values):
+        return None
+    return (f"controller '{name}' with damping 0 absorbs no power (its defaults: no damping"
+            f"{', no stiffness' if name == 'reactive' else ''}): give it settings (--set "
+            f"damping=... ), or tune it for a sea with `mbcontrol design MODEL --controller "
+            f"{name}`")

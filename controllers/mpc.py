@@ -61,6 +61,7 @@ from .base import per_pto, signal_indices
 from .control_plant import build_control_plant, device_frequency, pto_impedance
 from .estimation import ArPredictor, ExcitationKalman, excitation_error, wave_frequencies
 from .limits import LINEAR_RANGE_SHARE, linear_range
+from .sampled import held_dampers
 from .mpc_qp import CondensedQp
 
 # warm-up before the first AR fit, in peak periods of the sea (or of the wave model without
@@ -263,17 +264,18 @@ class Mpc:
         """The warm-up damper per PTO, N s/m: optimal_damping for the sea (linear theory, the
         other PTOs free), or |Z_i| at the wave model's median frequency (the regular-wave
         optimum) without a wave or when the sea lies outside the hydro data."""
-        fallback = pto_impedance(cp, float(np.median(omega)))
-        if self.wave is None:
-            return fallback
-        from .passive import optimal_damping
-        out = fallback.copy()
-        for i, name in enumerate(cp.ptos):
-            try:
-                out[i] = optimal_damping(plant, self.wave, pto=name)[0]
-            except ValueError:
-                pass
-        return out
+        out = pto_impedance(cp, float(np.median(omega)))
+        if self.wave is not None:
+            from .passive import optimal_damping
+            for i, name in enumerate(cp.ptos):
+                try:
+                    out[i] = optimal_damping(plant, self.wave, pto=name)[0]
+                except ValueError:
+                    pass
+        # held over dt_s, as it is applied: a damper tuned in continuous time can destabilise
+        # the sampled loop (rm3, Tp >= 11.3 s, dt_s 0.2 s: the cause of its divergences)
+        held, self.warm_up_factor = held_dampers(plant, dict(zip(cp.ptos, out)), self.dt_s)
+        return np.array([held[name] for name in cp.ptos])
 
     def _known_forecast(self, t: float) -> np.ndarray:
         """d at the midpoints of the next N periods from the wave (cached in blocks)."""
@@ -362,6 +364,9 @@ class Mpc:
                 "warm_up": {"law": "passive damper u = -c v until the first AR fit"
                             if self.ar is not None else "passive damper u = -c v",
                             "damping": [float(c) for c in self.warm_up_damping],
+                            # < 1: the sea's damper scaled down to keep its loop held over
+                            # dt_s stable (controllers.sampled.held_dampers)
+                            "held_factor": float(self.warm_up_factor),
                             "planned_s": float(self.warm_up_planned),
                             "take_over_s": float(self.blend_s),
                             "completed": self.warm_up_end is not None}}

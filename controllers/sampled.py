@@ -197,3 +197,40 @@ def loop_response_margins(L):
                            bounds=(w[max(j - 1, 0)], w[min(j + 1, w.size - 1)]))
     sm, w_sm = min((float(np.abs(1 + H[j])), float(w[j])), (float(best.fun), float(best.x)))
     return float(gm), float(w_gm), pms, [float(x) for x in wcs], sm, w_sm
+
+
+# A damper held over a period must keep at least this share of the decay rate it has in
+# continuous time: rm3's sea-tuned warm-up damper (41 MN s/m at Tp 12.58 s) held over an MPC's
+# 0.2 s is unstable (the float and plate lock and ring), which diverged 17 of 32 PacWave seas.
+HELD_DECAY_SHARE = 0.5
+
+
+def held_dampers(plant, damping: dict, period: float, *, params=None) -> tuple[dict, float]:
+    """Dampers {pto: N s/m} scaled by the largest common factor f <= 1 whose joint loop, held
+    over `period` s, is stable and keeps HELD_DECAY_SHARE of the continuous loop's decay rate
+    (1/s) at the same dampers. Returns (dampers, f); f = 1 when they are kept as they are.
+    The plant is linearised and discretised once; each trial is one eigenvalue problem."""
+    names = [p.name for p in plant.scene.ptos]
+    sys = joint_plant(plant, params=params)
+    A, B, C = (np.asarray(M) for M in (sys.A, sys.B, sys.C))
+    Phi, Gamma = zoh_loop.zoh(A, B, float(period))
+
+    def acceptable(f):
+        G = gain_matrix({n: (f * damping.get(n, 0.0), 0.0) for n in names}, names)
+        continuous = -float(np.max(np.linalg.eigvals(A - B @ G @ C).real))
+        rho = float(np.max(np.abs(np.linalg.eigvals(Phi - Gamma @ G @ C))))
+        held = -np.log(rho) / period if rho > 0 else np.inf
+        return rho < 1 and held >= HELD_DECAY_SHARE * continuous
+
+    if acceptable(1.0):
+        return dict(damping), 1.0
+    bad, good = 1.0, 0.5
+    while not acceptable(good):              # down by halves to an acceptable damper
+        bad, good = good, good / 2
+        if good < 1e-6:
+            raise ValueError(f"{plant.name}: no damper on {', '.join(names)} held over "
+                             f"{period:g} s keeps its loop stable")
+    for _ in range(12):                      # then to 1/4096 of the bracket in ln f
+        mid = np.sqrt(bad * good)
+        bad, good = (bad, mid) if acceptable(mid) else (mid, good)
+    return {n: good * damping.get(n, 0.0) for n in names}, good

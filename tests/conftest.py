@@ -35,33 +35,25 @@ def pytest_runtest_makereport(item, call):
         report.outcome = "failed"
 
 
-# Parallel runs (make test: pytest-xdist, --dist loadgroup). A module is one unit of work, so
-# its module-scoped fixtures (a plant, a benchmark table) are built once, on one worker: split
-# by test, the WECCCOMP table (60 s) was built three times. Each notebook is a unit of its
-# own. Units start longest first (these, measured serially on a cold cache, 2-core machine;
-# the order only balances the workers, it changes no result), the rest in collection order.
+# Parallel runs (make test: pytest-xdist, --dist loadfile). A file is one unit of work, so its
+# module-scoped fixtures (a plant, a benchmark table) are built once, on one worker: split by
+# test, the WECCCOMP table (60 s) was built three times. (--dist loadgroup would let each
+# notebook be a unit, but xdist 3.8 marks its groups in a node attribute pytest 9 no longer
+# reads.) Files start longest first (these, measured on a cold cache on a 2-core machine; the
+# order only balances the workers, it changes no result), the rest in collection order.
 LONGEST_FIRST = (
-    "tests/controllers/test_joint.py", "tests/controllers/test_reactive_latching.py",
-    "tests/controllers/test_electrical.py", "tests/test_notebooks.py::identification_flume",
-    "tests/test_cli.py", "tests/test_notebooks.py::controllers_sphere",
-    "tests/controllers/test_wecccomp.py", "tests/export/test_export.py",
-    "tests/hydro/test_bem.py", "tests/test_readme.py", "tests/controllers/test_latching_logic.py",
-    "tests/hydro/test_neighbours.py", "tests/studies/identify/test_flume_data.py",
-    "tests/cli/test_identify.py", "tests/controllers/test_nmpc.py",
+    "tests/test_notebooks.py", "tests/controllers/test_joint.py", "tests/test_cli.py",
+    "tests/controllers/test_electrical.py", "tests/controllers/test_wecccomp.py",
+    "tests/controllers/test_reactive_latching.py", "tests/test_readme.py",
+    "tests/export/test_export.py", "tests/hydro/test_bem.py", "tests/hydro/test_neighbours.py",
+    "tests/cli/test_identify.py", "tests/studies/identify/test_flume_data.py",
+    "tests/controllers/test_nmpc.py", "tests/controllers/test_latching_logic.py",
     "tests/hydro/test_radiation.py", "tests/studies/identify/test_identify.py",
 )
-
-
-def _work_unit(item) -> str:
-    module = item.nodeid.split("::")[0]
-    if module == "tests/test_notebooks.py" and "[" in item.nodeid:
-        return f"{module}::{item.nodeid.split('[')[1].split('.ipynb')[0]}"
-    return module
 
 
 def pytest_collection_modifyitems(config, items):
     rank = {unit: i for i, unit in enumerate(LONGEST_FIRST)}
     position = {id(item): i for i, item in enumerate(items)}
-    for item in items:
-        item.add_marker(pytest.mark.xdist_group(_work_unit(item)))
-    items.sort(key=lambda item: (rank.get(_work_unit(item), len(rank)), position[id(item)]))
+    items.sort(key=lambda item: (rank.get(item.nodeid.split("::")[0], len(rank)),
+                                 position[id(item)]))

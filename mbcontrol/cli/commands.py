@@ -199,7 +199,20 @@ def _controller(args, wave=None):
     settings = parse_settings(args.set, signature)
     if wave is not None and cls is not None and "wave" in inspect.signature(cls).parameters:
         settings.setdefault("wave", wave)
+    _warn_if_absorbs_nothing(args.controller, settings)
     return make(args.controller, **settings)
+
+
+def _warn_if_absorbs_nothing(name, settings, varied=()) -> str | None:
+    """Warn on stderr (also under --json and -q: it explains a result) when a named law
+    absorbs nothing."""
+    import sys
+
+    from mbcontrol.controllers import absorbs_nothing
+    why = absorbs_nothing(name, settings, varied)
+    if why:
+        print(f"mbcontrol: warning: {why}", file=sys.stderr)
+    return why
 
 
 def parse_settings(items, signature) -> dict:

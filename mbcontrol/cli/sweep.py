@@ -26,9 +26,10 @@ per sea, q = farm power / (devices x power of one device alone), and the same ra
 energies (module mbcontrol.studies.farm).
 
 The --json summary is a contract: {"model", "cases", "computed", "reused", "wall_time_s",
-"valid_cases", "invalid_cases", "invalid": [{"hs", "tp", "seed", "reasons"}], "notes",
-"seas": [{"hs", "tp", "weight", "mean_power_W", "capture_width_m", "energy_flux_W_per_m",
-"invalid_cases", ...}], "weighted_mean_power_W", "annual_energy_MWh",
+"valid_cases", "invalid_cases", "invalid": [{"hs", "tp", "seed", "reasons"}], "failed_cases",
+"failed": [{"hs", "tp", "seed", "reasons"}], "notes", "seas": [{"hs", "tp", "weight",
+"mean_power_W", "capture_width_m", "energy_flux_W_per_m", "invalid_cases", "failed_cases",
+...}], "weighted_mean_power_W", "annual_energy_MWh",
 "annual_energy_coverage", "annual_energy_unchecked_MWh", "provenance":
 {"model", "version", "scene_sha256", "hydro_sha256", "radiation_sha256", "controller",
 "settings"}, and with --isolated "farm": {"devices", "isolated_devices",
@@ -40,7 +41,9 @@ and annual_energy_unchecked_MWh is the figure the failed cases would have given)
 
 Every case is checked like `simulate`'s results (power bound of its own wave, energy
 balance, linear-hydrodynamics range); a case that fails is counted and listed, never
-averaged. Controllers run causally: an MPC forecasts the excitation from what it measures
+averaged. A case whose run raises (a divergence, a solver that gave up) is a result too:
+counted in failed_cases with its sea, seed and reason, never averaged; the other cases run
+and the JSON and store are written. Controllers run causally: an MPC forecasts the excitation from what it measures
 (AR) unless --set forecast=known (an oracle: a non-causal upper bound, labelled so in
 provenance.settings). A store remembers the inputs it was made from (content hashes of the
 scene, hydro data and radiation fit, and the package version) and refuses others.
@@ -109,7 +112,7 @@ def run_sweep(args) -> int:
     from mbcontrol.controllers import REGISTRY
 
     from ..studies.sweep import grid, read_seas, sweep
-    from .commands import _key_value, parse_settings
+    from .commands import _key_value, _warn_if_absorbs_nothing, parse_settings
     if args.hs is not None:
         if not args.tp:
             raise ValueError("--hs needs --tp (the grid's peak periods)")
@@ -131,6 +134,7 @@ def run_sweep(args) -> int:
             raise ValueError(f"--vary {item}: expected NAME=v1,v2,... with numbers") from None
         if not vary[name.strip()]:
             raise ValueError(f"--vary {item}: expected NAME=v1,v2,... with at least one value")
+    _warn_if_absorbs_nothing(args.controller, settings, vary)
     common = dict(seeds=args.seeds, vary=vary, params=dict(_key_value(s, "--param") for s in args.param),
                   controller=args.controller, settings=settings, duration=args.duration, dt=args.dt,
                   method=args.method, store=args.store, workers=_workers(args.workers),
@@ -165,9 +169,10 @@ def run_sweep(args) -> int:
               f"{row['energy_flux_W_per_m'] / 1e3:8.3g}{q_text}")
     for note in summary["notes"]:
         print(f"  note: {note}")
-    for case in summary["invalid"][:10]:
-        print(f"  INVALID Hs {case['hs']:.3g} m, Tp {case['tp']:.3g} s, seed {case['seed']}: "
-              f"{case['reasons']}")
+    for label, key in (("INVALID", "invalid"), ("FAILED", "failed")):
+        for case in summary[key][:10]:
+            print(f"  {label} Hs {case['hs']:.3g} m, Tp {case['tp']:.3g} s, seed "
+                  f"{case['seed']}: {case['reasons']}")
     if summary["annual_energy_MWh"] is not None:
         share = summary["annual_energy_coverage"]
         print(f"  weighted mean power {summary['weighted_mean_power_W'] / 1e3:.4g} kW; annual "

@@ -10,10 +10,13 @@ Every library is checked before it is loaded: its size and SHA-256, recorded bes
 shared over a network file system) would otherwise crash the process in the loader with no
 message (a bus error); a mismatch is rebuilt, with a warning. Build folders left by a killed
 compile are removed once they are an hour old (a concurrent compile's are younger). Concurrent
-compiles of one function are safe: each builds in its own folder and renames into place.
+compiles of one function are safe: each builds in its own folder and renames into place; and
+where fcntl exists a per-library lock makes the second process wait for the first's library
+instead of compiling it again.
 """
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import os
 import shutil
@@ -128,6 +131,35 @@ def compile_function(fun: ca.Function, enabled: bool = True, optimise: bool = Tr
     library = folder / f"{fun.name()}_{key.hexdigest()[:20]}.so"
     if library.exists() and _verified(library):
         return ca.external(fun.name(), str(library))
+    with _build_lock(library):
+        if library.exists() and _verified(library):     # another process just built it
+            return ca.external(fun.name(), str(library))
+        return _build(fun, source, flags, cc, folder, library)
+
+
+@contextlib.contextmanager
+def _build_lock(library: Path):
+    """Held while `library` is built: a second process needing the same code (a test
+    worker, a sweep's Dask worker) waits for the first and loads its library instead of
+    compiling it again (two test workers compiling raft3's 275-state chunk at once each took
+    twice as long). An advisory lock (fcntl), released by the kernel if its holder dies; where
+    fcntl is missing, no lock: concurrent builds stay safe, only wasteful."""
+    try:
+        import fcntl
+    except ImportError:
+        yield
+        return
+    with open(library.with_suffix(".lock"), "a") as handle:
+        fcntl.flock(handle, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(handle, fcntl.LOCK_UN)
+
+
+def _build(fun, source, flags, cc, folder: Path, library: Path) -> ca.Function:
+    """Compile `source` into `library` (see compile_function); the interpreted `fun` on a
+    compiler error, with a warning."""
     _remove_stale_builds(folder)
     started = time.perf_counter()
     status(f"compiling {fun.name()} ({len(source) // 1000} kB of C): typically 2-60 s, cached "
@@ -140,7 +172,7 @@ def compile_function(fun: ca.Function, enabled: bool = True, optimise: bool = Tr
                                 capture_output=True, text=True)
         if result.returncode != 0:
             warnings.warn(f"C compilation failed ({result.stderr[:300]}); using "
-                          f"interpreted CasADi code", RuntimeWarning, stacklevel=2)
+                          f"interpreted CasADi code", RuntimeWarning, stacklevel=3)
             return fun
         status(f"compiled {fun.name()} in {time.perf_counter() - started:.1f} s", __name__)
         # the record first, then the library: a library is never there without its record

@@ -23,7 +23,8 @@ def test_sweep_json_contract_and_annual_energy(capsys, tmp_path):
     s = json.loads(out)
     assert set(s) >= {"model", "cases", "computed", "reused", "wall_time_s", "seas",
                       "weighted_mean_power_W", "annual_energy_MWh", "valid_cases",
-                      "invalid_cases", "invalid", "notes", "annual_energy_coverage",
+                      "invalid_cases", "invalid", "failed_cases", "failed", "notes",
+                      "annual_energy_coverage",
                       "annual_energy_unchecked_MWh", "provenance"}
     assert s["invalid_cases"] == 0 and s["annual_energy_coverage"] == 1.0
     assert set(s["provenance"]) >= {"version", "scene_sha256", "hydro_sha256",
@@ -92,3 +93,26 @@ def test_sweep_set_takes_words_and_records_the_forecast(capsys):
     assert code == 0, err
     settings = json.loads(out)["provenance"]["settings"]
     assert settings["oracle"] is True and "upper bound" in settings["label"]
+
+
+def test_a_bare_damped_law_warns_that_it_absorbs_nothing(capsys):
+    """The issue's case: `--controller reactive` with no settings ran at damping 0 and
+    stiffness 0 and reported 0.0 W everywhere, "valid", silently. It still runs as given (the
+    documented choice), and says so on stderr and in the summary's notes; with a damping
+    given, or the damping varied, it says nothing."""
+    argv = ("sweep", "sphere", "--hs", "1", "--tp", "8", "--duration", "60", "--dt", "0.1",
+            "--workers", "0", "--json", "--controller", "reactive")
+    code, out, err = run(capsys, *argv)
+    assert code == 0, err
+    s = json.loads(out)
+    assert s["seas"][0]["mean_power_W"] == 0.0
+    assert "absorbs no power" in err and "absorbs no power" in s["notes"][0]
+    for extra in (("--set", "damping=2e5"), ("--vary", "damping=1e5,2e5")):
+        code, out, err = run(capsys, *argv, *extra)
+        assert code == 0 and "absorbs no power" not in err + out
+
+
+def test_simulate_with_a_bare_damped_law_warns(capsys):
+    code, _, err = run(capsys, "simulate", "sphere", "--controller", "passive", "--wave",
+                       "regular", "--height", "1", "--period", "8", "--duration", "20")
+    assert code == 0 and "controller 'passive' with damping 0 absorbs no power" in err

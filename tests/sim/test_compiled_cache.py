@@ -69,3 +69,27 @@ def test_a_failed_compile_falls_back_and_caches_nothing(cache, monkeypatch):
         f = compiled.compile_function(_square())
     assert float(f(3.0)) == 10.0                        # the interpreted function
     assert not list(cache.glob("*.so")) and not list(cache.glob("build-*"))
+
+
+def test_two_processes_needing_the_same_code_compile_it_once(cache):
+    """Two processes start compiling one new function at once (as two test or sweep workers
+    on a cold cache do): the second waits on the build lock and loads the first's library.
+    The function is big enough (a 60-term polynomial chain, about a second of -O3) that the
+    two builds overlap: without the lock both compile (checked: 2 compiles). Counted from each
+    process's "compiled lock_test in" log line."""
+    code = ("import logging, sys, casadi as ca; from mbcontrol.sim import compiled\n"
+            "logging.basicConfig(level=logging.INFO, stream=sys.stdout, format='%(message)s')\n"
+            "x = ca.SX.sym('x', 40); y = x\n"
+            "for k in range(60): y = ca.sin(y) * y + k * ca.cos(y[::-1])\n"
+            "f = compiled.compile_function(ca.Function('lock_test', [x], [ca.sum1(y)]))\n"
+            "print('value', float(f(ca.DM.ones(40))))\n")
+    env = {**os.environ, "MBCONTROL_QUIET": "0"}
+    runs = [subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE,
+                             stderr=subprocess.STDOUT, text=True, env=env) for _ in range(2)]
+    outputs = [r.communicate(timeout=300)[0] for r in runs]
+    assert all(r.returncode == 0 for r in runs), outputs
+    compiles = sum(out.count("compiled lock_test in") for out in outputs)
+    assert compiles == 1, outputs
+    values = {line for out in outputs for line in out.splitlines() if line.startswith("value")}
+    assert len(values) == 1                          # both loaded the one library
+    assert len(list(cache.glob("lock_test_*.so"))) == 1

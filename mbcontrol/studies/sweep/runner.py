@@ -45,7 +45,8 @@ def run_case(case) -> dict:
     """Simulate one case in closed loop and measure it: {"case": key, "metrics": {name:
     value} (per PTO `<pto>__<metric>` as `mbcontrol.analysis.metrics.pto_metrics`, and the
     totals mean_power_W, mean_electrical_power_W), "valid", "invalid_reasons",
-    "wall_time_s"} (`case_record`). A case without a controller on a fixed-step method runs
+    "wall_time_s"} (`case_record`); a case whose run raises gives a `failed_record` instead.
+    A case without a controller on a fixed-step method runs
     through `mbcontrol.sim.light.simulate_arrays` (the arrays its metrics need, no Dataset),
     any other through `simulate`; both give the same record to rounding."""
     import inspect
@@ -72,14 +73,28 @@ def run_case(case) -> dict:
             settings.setdefault("wave", wave)
         controller = make(case.controller, **settings)
     start = time.perf_counter()
-    if light.can_run(plant, controller, case.method):
-        run = light.simulate_arrays(plant, wave, duration=case.duration, dt=case.dt,
-                                    method=case.method, params=params or None)
-        _LAST_RUN[:] = [run]     # the previous run is let go only now (see _LAST_RUN)
-    else:
-        run = simulate(plant, wave, duration=case.duration, dt=case.dt, controller=controller,
-                       method=case.method, params=params or None)
-    return case_record(case, plant, wave, run, start)
+    try:
+        if light.can_run(plant, controller, case.method):
+            run = light.simulate_arrays(plant, wave, duration=case.duration, dt=case.dt,
+                                        method=case.method, params=params or None)
+            _LAST_RUN[:] = [run]     # the previous run is let go only now (see _LAST_RUN)
+        else:
+            run = simulate(plant, wave, duration=case.duration, dt=case.dt,
+                           controller=controller, method=case.method, params=params or None)
+        return case_record(case, plant, wave, run, start)
+    except Exception as exc:       # noqa: BLE001 - a case that fails is a result (see below)
+        return failed_record(case, exc, start)
+
+
+def failed_record(case, exc: BaseException, start: float) -> dict:
+    """The record of a case whose run raised (a divergence, a solver that gave up, ...): no
+    metrics, not valid, `failed` with the error's type and message, so one bad sea neither
+    stops the sweep nor loses the others, and is never averaged. It is stored like any
+    record: the same case fails the same way again, so a resumed sweep does not rerun it."""
+    reason = f"{type(exc).__name__}: {exc}"
+    return {"case": case.key, "metrics": {}, "valid": False, "failed": True,
+            "failure": reason, "invalid_reasons": [f"run failed ({reason})"],
+            "wall_time_s": time.perf_counter() - start}
 
 
 def case_record(case, plant, wave, run, start: float) -> dict:

@@ -89,12 +89,16 @@ def assemble(cases, store: CaseStore, seas, vary: dict, seeds: int, attrs: dict)
     metrics = sorted({m for r in records.values() for m in r["metrics"]})
     dims = ("sea", "seed", *names)
     valid = np.ones(shape, bool)
+    failed = np.zeros(shape, bool)
     reasons = np.full(shape, "", dtype=object)
     for index, r in records.items():
         valid[index] = bool(r.get("valid", True))
+        failed[index] = bool(r.get("failed", False))
         reasons[index] = "; ".join(r.get("invalid_reasons", []))
     data = {"valid": (dims, valid, {"long_name": "the case passed its physics checks "
                                                  "(mbcontrol.analysis.validity)"}),
+            "failed": (dims, failed, {"long_name": "the case's run raised (diverged, ...): "
+                                                   "no metrics"}),
             "invalid_reasons": (dims, reasons.astype(str))}
     for m in metrics:
         a = np.full(shape, np.nan)

@@ -10,6 +10,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+import xarray as xr
 
 from ... import defaults
 from ...plant import provenance
@@ -78,6 +79,10 @@ def sweep(model: str, seas, *, seeds: int = 1, vary: dict | None = None, params=
         from ...hydro import write_netcdf_atomic
         write_netcdf_atomic(ds, Path(store) / "sweep.nc")
     summary = _summary(ds, seas, run, time.perf_counter() - start, len(cases))
+    from mbcontrol.controllers import absorbs_nothing
+    why = absorbs_nothing(controller, settings, vary)
+    if why:
+        summary["notes"].insert(0, why)
     summary["provenance"] = made_by
     return ds, summary
 
@@ -112,14 +117,16 @@ def _summary(ds, seas, run, wall, n_cases) -> dict:
     quantities are varied, per sea the values over them as lists in the sweep's order)."""
     power = ds["mean_power_W"].mean("seed")          # over the valid seeds (invalid: NaN)
     cw = ds["capture_width_m"].mean("seed")
-    invalid = ~ds["valid"]
+    failed = ds["failed"] if "failed" in ds else xr.zeros_like(ds["valid"])
+    invalid = ~ds["valid"] & ~failed             # ran, and failed its physics checks
     rows = []
     for k, s in enumerate(seas):
         p, c = power.isel(sea=k).values, cw.isel(sea=k).values
         row = {"hs": s.hs, "tp": s.tp, "weight": None if math.isnan(s.weight) else s.weight,
                "mean_power_W": _plain(p), "capture_width_m": _plain(c),
                "energy_flux_W_per_m": float(ds["energy_flux_W_per_m"].values[k]),
-               "invalid_cases": int(invalid.isel(sea=k).sum())}
+               "invalid_cases": int(invalid.isel(sea=k).sum()),
+               "failed_cases": int(failed.isel(sea=k).sum())}
         if not math.isnan(s.te):
             row["te"] = s.te
         if "capture_width_ratio" in ds:
@@ -140,28 +147,40 @@ def _summary(ds, seas, run, wall, n_cases) -> dict:
         aep = annual_energy_MWh(valid_power, weights)
         coverage = float(1.0 - weights[missing].sum())
         raw = ds.get("mean_power_W__unchecked", ds["mean_power_W"]).mean("seed")
-        unchecked = annual_energy_MWh(raw.values, weights)
+        # a case that failed to run has no number at all: it counts as nothing here too
+        unchecked = annual_energy_MWh(np.nan_to_num(raw.values, nan=0.0), weights)
         if missing.any():
             notes.append(f"annual energy {aep:.4g} MWh counts {int(missing.sum())} weighted "
                          f"seas ({100 * (1 - coverage):.3g} % of the year) with no valid case "
                          f"as producing nothing: a lower bound; their failed cases would "
                          f"have given {unchecked:.4g} MWh in all")
-    listed = []
-    for index in zip(*np.nonzero(invalid.values)):
-        entry = {"hs": float(ds["hs"].values[index[0]]), "tp": float(ds["tp"].values[index[0]]),
-                 "seed": int(index[1]),
-                 **{d: float(ds[d].values[i]) for d, i in zip(ds["valid"].dims[2:], index[2:])},
-                 "reasons": str(ds["invalid_reasons"].values[index])}
-        listed.append(entry)
+    listed, crashed = _cases_where(ds, invalid), _cases_where(ds, failed)
     if listed:
         notes.append(f"{len(listed)} of {n_cases} cases failed their physics checks and are "
                      f"left out of every mean, matrix and annual figure (listed in 'invalid')")
+    if crashed:
+        notes.append(f"{len(crashed)} of {n_cases} cases failed to run (diverged or raised) "
+                     f"and are left out of every mean, matrix and annual figure (listed in "
+                     f"'failed', with their sea, seed and reason)")
     return {"model": ds.attrs["model"], "cases": n_cases, "computed": run["computed"],
-            "reused": run["reused"], "wall_time_s": wall, "valid_cases": n_cases - len(listed),
-            "invalid_cases": len(listed), "invalid": listed, "notes": notes, "seas": rows,
+            "reused": run["reused"], "wall_time_s": wall,
+            "valid_cases": n_cases - len(listed) - len(crashed),
+            "invalid_cases": len(listed), "invalid": listed,
+            "failed_cases": len(crashed), "failed": crashed, "notes": notes, "seas": rows,
             "weighted_mean_power_W": weighted, "annual_energy_MWh": aep,
             "annual_energy_coverage": coverage if aep is not None else None,
             "annual_energy_unchecked_MWh": unchecked}
+
+
+def _cases_where(ds, mask) -> list[dict]:
+    """{hs, tp, seed, varied values..., reasons} of each case where `mask` holds."""
+    out = []
+    for index in zip(*np.nonzero(mask.values)):
+        out.append({"hs": float(ds["hs"].values[index[0]]),
+                    "tp": float(ds["tp"].values[index[0]]), "seed": int(index[1]),
+                    **{d: float(ds[d].values[i]) for d, i in zip(ds["valid"].dims[2:], index[2:])},
+                    "reasons": str(ds["invalid_reasons"].values[index])})
+    return out
 
 
 def _plain(values):

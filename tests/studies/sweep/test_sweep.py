@@ -119,3 +119,29 @@ def test_sweep_figure_on_real_axes(tmp_path):
     assert {f"{v:.3g}" for v in np.ravel(kw)} <= texts
     assert any(a.get_ylabel() == "mean power, kW" for a in fig.axes)
     assert (tmp_path / "sweep.png").stat().st_size > 10_000
+
+
+def test_a_case_that_diverges_is_a_result_not_a_crash(tmp_path):
+    """Reactive control of the sphere with a PTO spring of -1.5 MN/m against its 0.77 MN/m of
+    hydrostatics (net -0.73 MN/m: statically unstable, as test_reactive_latching's wrong-model
+    case) and no force limit diverges in every sea (pole +0.92 1/s); with no spring it runs. The diverging cases are
+    recorded with their sea, seed and reason, counted in failed_cases (not invalid_cases),
+    never averaged; the other cases are kept and the store written, and a rerun reuses both."""
+    store = tmp_path / "store"
+    run = dict(controller="reactive", settings={"damping": 4e5, "force_max": np.inf},
+               vary={"stiffness": [0.0, -1.5e6]}, store=store, workers=0, **SHORT)
+    ds, result = sweep("sphere", SEAS[:2], **run)
+    assert result["failed_cases"] == 2 and len(result["failed"]) == 2
+    for case in result["failed"]:
+        assert case["stiffness"] == -1.5e6 and case["seed"] == 0
+        assert "diverged" in case["reasons"], case["reasons"]
+    assert result["invalid_cases"] == 0 and result["valid_cases"] == 2
+    assert bool(ds["failed"].sel(stiffness=-1.5e6).all())
+    assert not bool(ds["failed"].sel(stiffness=0.0).any())
+    assert np.isnan(ds["mean_power_W"].sel(stiffness=-1.5e6)).all()      # never averaged
+    assert (ds["mean_power_W"].sel(stiffness=0.0) > 0).all()
+    assert [row["failed_cases"] for row in result["seas"]] == [1, 1]
+    json.dumps(result)                                  # the contract stays JSON
+    assert (store / "sweep.nc").exists()
+    _, again = sweep("sphere", SEAS[:2], **run)
+    assert again["computed"] == 0 and again["reused"] == 4 and again["failed_cases"] == 2
