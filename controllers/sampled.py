@@ -203,12 +203,14 @@ def loop_response_margins(L):
 # continuous time: rm3's sea-tuned warm-up damper (41 MN s/m at Tp 12.58 s) held over an MPC's
 # 0.2 s is unstable (the float and plate lock and ring), which diverged 17 of 32 PacWave seas.
 HELD_DECAY_SHARE = 0.5
+DECAY_ROUND_OFF = 1e-9   # 1/s: decay rates this close count as equal (rho = 1 +- 1e-15)
 
 
 def held_dampers(plant, damping: dict, period: float, *, params=None) -> tuple[dict, float]:
     """Dampers {pto: N s/m} scaled by the largest common factor f <= 1 whose joint loop, held
     over `period` s, is stable and keeps HELD_DECAY_SHARE of the continuous loop's decay rate
-    (1/s) at the same dampers. Returns (dampers, f); f = 1 when they are kept as they are.
+    (1/s) at the same dampers. Returns (dampers, f); f = 1 when they are kept as they are, f = 0
+    (no damper) when not even a millionth of them is acceptable.
     The plant is linearised and discretised once; each trial is one eigenvalue problem."""
     names = [p.name for p in plant.scene.ptos]
     sys = joint_plant(plant, params=params)
@@ -220,16 +222,16 @@ def held_dampers(plant, damping: dict, period: float, *, params=None) -> tuple[d
         continuous = -float(np.max(np.linalg.eigvals(A - B @ G @ C).real))
         rho = float(np.max(np.abs(np.linalg.eigvals(Phi - Gamma @ G @ C))))
         held = -np.log(rho) / period if rho > 0 else np.inf
-        return rho < 1 and held >= HELD_DECAY_SHARE * continuous
+        # a mode no damper moves (a free drift: rate 0 both ways) passes at round-off
+        return held >= HELD_DECAY_SHARE * continuous - DECAY_ROUND_OFF
 
     if acceptable(1.0):
         return dict(damping), 1.0
     bad, good = 1.0, 0.5
     while not acceptable(good):              # down by halves to an acceptable damper
         bad, good = good, good / 2
-        if good < 1e-6:
-            raise ValueError(f"{plant.name}: no damper on {', '.join(names)} held over "
-                             f"{period:g} s keeps its loop stable")
+        if good < 1e-6:                      # the plant alone fails the test: no damper
+            return {n: 0.0 for n in names}, 0.0
     for _ in range(12):                      # then to 1/4096 of the bracket in ln f
         mid = np.sqrt(bad * good)
         bad, good = (bad, mid) if acceptable(mid) else (mid, good)

@@ -57,3 +57,14 @@ def test_the_causal_mpc_runs_the_issues_sea(rm3):
     assert warm_up["completed"] and 0 < warm_up["held_factor"] < 1
     assert summary(ds, rm3)["ptos"]["pto"]["mean_power_W"] > 0
     assert np.all(np.isfinite(ds["pto__force"].values))
+
+
+def test_no_acceptable_damper_means_none_not_a_crash():
+    """A damper a million times too strong for a tank-scale raft (1e7 N m s/rad held over
+    0.2 s): not even a millionth of it is acceptable, so the warm-up gets no damper (f = 0)
+    rather than an MPC that cannot be reset; the held loop with none is the plant's own."""
+    raft = build_plant("hinged_raft")
+    names = [p.name for p in raft.scene.ptos]
+    held, factor = held_dampers(raft, {n: 1e7 for n in names}, 0.2)
+    assert factor == 0.0 and all(v == 0.0 for v in held.values())
+    assert not sampled_closed_loop(raft, {n: (10.0, 0.0) for n in names}, 0.2).stable
