@@ -41,7 +41,7 @@ DAMPED_LAWS = ("passive", "reactive", "latching", "declutching")
 def absorbs_nothing(name: str | None, settings: dict | None, varied=()) -> str | None:
     """Why controller `name` with `settings` absorbs no power, or None. The CLI's simulate
     and sweep warn with it (the documented choice: a named controller runs as given, its
-    defaults included, and says so; `design` and `sweep --design` tune it for a sea)."""
+    defaults included, and says so; `design` tunes it for a sea)."""
     if name not in DAMPED_LAWS or "damping" in varied:
         return None
     damping = (settings or {}).get("damping", 0.0)
