@@ -60,6 +60,7 @@ bench: $(VENV)/.installed-test
 	$(PY) benchmarks/identify.py --out $(OUT)/bench/identify
 	$(PY) benchmarks/sweep.py --out $(OUT)/bench/sweep
 	$(PY) benchmarks/sweep_light.py --out $(OUT)/bench/sweep_light
+	$(PY) benchmarks/sweep_design.py --out $(OUT)/bench/sweep_design
 	$(PY) benchmarks/wecopttool_electrical.py --out $(OUT)/bench/wecopttool
 	$(PY) benchmarks/export_qp.py
 	$(PY) benchmarks/export_step.py --out $(OUT)/bench/export

@@ -46,6 +46,7 @@ class ControlPlant:
     measured: list
     y_rest: np.ndarray            # measured outputs at rest
     y_index: list                 # indices of the measured outputs in plant.outputs
+    Ce: np.ndarray | None = None  # rows of `extra_outputs` (deviations from rest), or None
 
     @property
     def nz(self) -> int:
@@ -73,15 +74,19 @@ def default_measurements(plant) -> list[str]:
 
 
 def build_control_plant(plant, dt: float, *, ptos=None, measured=None, order=None,
-                        params=None) -> ControlPlant:
-    """Linearise, reduce (order: states kept, None = all) and discretise `plant` at dt s."""
+                        params=None, extra_outputs=None) -> ControlPlant:
+    """Linearise, reduce (order: states kept, None = all) and discretise `plant` at dt s.
+    extra_outputs: plant outputs the controller predicts besides the PTOs' (rows `Ce`, e.g.
+    a body's heave for its envelope); they may not depend directly on the inputs."""
     from mbcontrol.analysis import balanced_truncation, linearize
 
     ptos = list(ptos or [p.name for p in plant.scene.ptos])
     measured = list(measured or default_measurements(plant))
     signal_indices(plant, measured)
     base = {**controller_params(plant), **(params or {})}
-    outputs = [f"{n}__position" for n in ptos] + [f"{n}__velocity" for n in ptos] + measured
+    extra = list(extra_outputs or [])
+    outputs = ([f"{n}__position" for n in ptos] + [f"{n}__velocity" for n in ptos] + measured
+               + extra)
     sys = linearize(plant, params=base, inputs=[f"u__{n}" for n in ptos] + list(plant.disturbances),
                     outputs=outputs)
     nu, k = len(ptos), len(ptos)
@@ -90,6 +95,11 @@ def build_control_plant(plant, dt: float, *, ptos=None, measured=None, order=Non
         red = balanced_truncation(sys, order)
         sys, T = red.system, red.T
     A, B, C = (np.asarray(M, float) for M in (sys.A, sys.B, sys.C))
+    if extra and np.any(np.asarray(sys.D)[-len(extra):] != 0):
+        raise ValueError(f"{plant.name}: outputs {extra} depend directly on the inputs; the "
+                         f"control plant predicts only outputs of its state")
+    Ce = C[C.shape[0] - len(extra):] if extra else None
+    C = C[:C.shape[0] - len(extra)]
     if np.any(np.asarray(sys.D)[:, :nu] != 0):
         raise ValueError(f"{plant.name}: the PTO force feeds through to a position or velocity; "
                          f"the control-plant model expects a strictly proper plant")
@@ -102,7 +112,8 @@ def build_control_plant(plant, dt: float, *, ptos=None, measured=None, order=Non
     y_index = signal_indices(plant, measured)
     return ControlPlant(dt=dt, A=A, Bu_c=Bu_c, Bd_c=Bd_c, Ad=Ad, Bu=Bud[:, :nu],
                         Bd=Bud[:, nu:], Cp=C[:k], Cv=C[k:2 * k], Cm=C[2 * k:], S=S, T=T,
-                        ptos=ptos, measured=measured, y_rest=y_rest[y_index], y_index=y_index)
+                        ptos=ptos, measured=measured, y_rest=y_rest[y_index], y_index=y_index,
+                        Ce=Ce)
 
 
 def _disturbance_basis(Bw: np.ndarray, rtol: float = 1e-9):
@@ -145,3 +156,10 @@ def device_frequency(cp, band: tuple[float, float], n: int = 400) -> float:
     omega = np.geomspace(max(band[0], 1e-3), band[1], n)
     response = pto_admittance(cp, omega).max(axis=1)
     return float(omega[int(np.argmax(response))])
+
+
+def hydro_band(plant) -> tuple[float, float]:
+    """The frequencies the device's hydro data cover (rad/s); 0.1-10 rad/s without data."""
+    if plant.hydro is None:
+        return (0.1, 10.0)
+    return (float(plant.hydro.omega[0]), float(plant.hydro.omega[-1]))

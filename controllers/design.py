@@ -185,6 +185,13 @@ def design(plant, wave, name: str, *, pto: str | None = None, simulate_s: float 
         if not margins.stable:
             notes.append(f"{name}: the closed loop is unstable on the plant, so it was not "
                          f"simulated. {margins.message}")
+        from .robustness import robustness, share_explained
+        tuner["robustness"] = robustness(margins)
+        if margins.stable and not tuner["robustness"]["meets"]:
+            notes.append(f"{name}: below the robustness floors: "
+                         f"{tuner['robustness']['why']}")
+        if not many and plant.hydro is not None:
+            tuner["share"] = share_explained(plant, wave, pto_obj.name, predicted, name)
 
     duration = simulate_s if simulate_s is not None else _duration(wave, margins)
     # a sea on a uniform grid repeats every T_r: scored over its last whole repeat period,

@@ -8,7 +8,10 @@ import math
 
 from mbcontrol.results import jsonable
 
+from mbcontrol.analysis.envelope import ENVELOPE_SHARE
+
 from . import REGISTRY, make
+from .tuning import OutsideEnvelope
 
 # the tuned parameters of each controller (the contract of make(name, **parameters))
 CONTRACT = {"passive": ("damping",), "reactive": ("damping", "stiffness"),
@@ -59,14 +62,26 @@ def tune(plant, wave, name, pto_obj, limits, model_params, notes):
         kw = _limit_kwargs(tuner, finite, tuner.__name__, notes)
         if pto_obj.efficiency != 1 and _accepts(tuner, "efficiency"):
             kw["efficiency"] = float(pto_obj.efficiency)    # tune for electrical power
-        if name == "passive":
-            damping, predicted = tuner(plant, wave, pto=pto, params=model_params, **kw)
-            tuned = {"damping": damping}
-        else:
-            damping, stiffness, predicted = tuner(plant, wave, pto, params=model_params, **kw)
-            tuned = {"damping": damping, "stiffness": stiffness}
-        return ({**tuned, **own}, predicted, {"function": tuner.__name__, "settings": kw},
-                extra)
+        info = {"function": tuner.__name__, "settings": dict(kw)}
+        if limits:                # and the linear model's range (analysis.envelope)
+            kw["envelope"] = True
+            info["envelope"] = {"share": ENVELOPE_SHARE, "inside": True}
+        try:
+            if name == "passive":
+                damping, predicted = tuner(plant, wave, pto=pto, params=model_params, **kw)
+                stiffness = None
+            else:
+                damping, stiffness, predicted = tuner(plant, wave, pto, params=model_params,
+                                                      **kw)
+        except OutsideEnvelope as exc:     # flagged, with the damper that comes closest
+            damping, stiffness, predicted = exc.fallback
+            stiffness = None if name == "passive" else stiffness
+            info["envelope"].update(inside=False, ratio=exc.ratio, reason=str(exc))
+            notes.append(f"OUTSIDE ITS ENVELOPE: {exc}; the damper that comes closest is used")
+        tuned = {"damping": damping}
+        if stiffness is not None:
+            tuned["stiffness"] = stiffness
+        return {**tuned, **own}, predicted, info, extra
     if name in ("latching", "declutching"):
         from .latching import optimal_declutch, optimal_latch_time
         if model_params:

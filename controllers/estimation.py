@@ -168,15 +168,16 @@ class ArPredictor:
         self._maps = None
         self._since_fit = 0
 
-    def forecast(self, n: int):
-        """(n, nd): d over the next n periods (midpoints), or None before the first fit."""
+    def forecast(self, n: int, *, midpoints: bool = True):
+        """(n, nd): d over the next n periods (their midpoints; midpoints=False: the samples
+        1..n periods ahead), or None before the first fit."""
         if self.coefficients is None:
             return None
         if self._maps is None or self._maps.shape[1] != n + 1:
             self._maps = self._forecast_maps(n + 1)
         past = np.asarray(self.history[-self.order:])[::-1]          # newest first, (p, nd)
         out = np.einsum("ikp,pi->ki", self._maps, past)               # (n + 1, nd)
-        return 0.5 * (out[:-1] + out[1:])
+        return 0.5 * (out[:-1] + out[1:]) if midpoints else out[1:]
 
     def _forecast_maps(self, n: int) -> np.ndarray:
         """(nd, n, p): row k maps the last p samples (newest first) to the sample k steps

@@ -71,3 +71,19 @@ def linear_range(plant, pto: str) -> float:
         return math.inf
     drafts = [d for d in (mean_draft(data, str(b)) for b in data["body"].values) if d]
     return LINEAR_RANGE_SHARE * min(drafts) if drafts else math.inf
+
+
+def per_pto_values(plant, value, scene_values, what) -> np.ndarray:
+    """Per-PTO values of an MPC setting (limits, efficiency): the setting (a number, or a
+    dict by PTO name) or the scene's; > 0."""
+    if value is None:
+        out = np.asarray(scene_values, float)
+    elif isinstance(value, dict):    # the PTOs it names; the others keep the scene's value
+        names = [p.name for p in plant.scene.ptos][:len(scene_values)]
+        per_pto(plant, value, f"mpc {what}")                    # unknown names: KeyError
+        out = np.array([float(value.get(n, s)) for n, s in zip(names, scene_values)])
+    else:
+        out = per_pto(plant, value, f"mpc {what}")[:len(scene_values)]
+    if np.any(out <= 0):
+        raise ValueError(f"mpc: {what} must be > 0, got {out}")
+    return out

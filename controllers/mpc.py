@@ -45,6 +45,13 @@ describe()["stats"]["ar_unstable_fits"]). With no force limit (rm3's and the OSW
 scenes have none) the QP is regularised by force_penalty alone. A PTO whose scene sets no
 stroke limit gets a soft one at LINEAR_RANGE_SHARE of the range where the linear model
 holds (see LINEAR_RANGE_SHARE; reported in describe()["stroke_max_default"]).
+
+Envelope (envelope=True, the default): the quantities the physics checks measure, each
+body's heave relative to the surface (a probe measures the surface at the body; needs the
+wave) and its roll and pitch, are soft constraints at every step of the horizon, each within
+PEAK_SHARE of the check's limit (controllers.mpc_envelope; describe()["envelope"]). Without
+it the MPC rode PacWave's seas outside the linear model's range: sphere 28, rm3 17, OSWEC 10
+of 32 seas INVALID (200 s each); with it none.
 """
 from __future__ import annotations
 
@@ -57,11 +64,12 @@ import numpy as np
 from mbcontrol.analysis.electrical import winding_coefficient
 from mbcontrol.results import jsonable
 
-from .base import per_pto, signal_indices
-from .control_plant import build_control_plant, device_frequency, pto_impedance
+from .base import signal_indices
+from .control_plant import build_control_plant, device_frequency, hydro_band, pto_impedance
 from .estimation import ArPredictor, ExcitationKalman, excitation_error, wave_frequencies
-from .limits import LINEAR_RANGE_SHARE, linear_range
+from .limits import LINEAR_RANGE_SHARE, linear_range, per_pto_values
 from .sampled import held_dampers
+from .mpc_envelope import MpcEnvelope
 from .mpc_qp import CondensedQp
 
 # warm-up before the first AR fit, in peak periods of the sea (or of the wave model without
@@ -92,7 +100,8 @@ class Mpc:
     soft_stroke; measured: output names the Kalman filter reads (default: every joint
     coordinate and rate); ar_order; measurement_noise (Kalman, relative); objective: "auto"
     (electrical power for PTOs with a drivetrain: each step's winding loss R F^2 dt /
-    (gear kt')^2 enters the QP), "electrical" or "mechanical".
+    (gear kt')^2 enters the QP), "electrical" or "mechanical"; envelope: keep the linear
+    model's range (see the module docstring).
     """
     name = "mpc"
 
@@ -102,7 +111,8 @@ class Mpc:
                  force_penalty: float = 1e-3, stroke_penalty: float = 100.0,
                  soft_stroke: bool = True, measured=None, ar_order: int = 8,
                  measurement_noise: float = 1e-3, efficiency=None,
-                 warm_up_s: float | None = None, objective: str = "auto"):
+                 warm_up_s: float | None = None, objective: str = "auto",
+                 envelope: bool = True):
         forecast = forecast or "ar"        # causal by default; the oracle only when asked
         _choice("forecast", forecast, ("known", "ar", "model", "none"))
         _choice("estimator", estimator, ("kalman", "state"))
@@ -122,6 +132,7 @@ class Mpc:
         self.soft_stroke, self.measured, self.ar_order = soft_stroke, measured, ar_order
         self.measurement_noise = measurement_noise
         self.efficiency, self.objective = efficiency, objective
+        self.envelope = bool(envelope)
         self.warm_up_setting = warm_up_s
         self.period = self.dt_s
         self.uses_state = estimator == "state"
@@ -129,21 +140,23 @@ class Mpc:
     # -- set-up --------------------------------------------------------------------------
     def reset(self, plant) -> None:
         self.plant = plant
+        self.env = MpcEnvelope(plant, self.wave, on=self.envelope, forecast=self.forecast,
+                               dt=self.dt_s)
         self.cp = cp = build_control_plant(plant, self.dt_s, measured=self.measured,
-                                           order=self.order)
+                                           order=self.order, extra_outputs=self.env.outputs)
         ptos = [p for p in plant.scene.ptos if p.name in cp.ptos]
         strokes = [p.stroke_max if math.isfinite(p.stroke_max) else linear_range(plant, p.name)
                    for p in ptos]
         self.stroke_default = None if self.stroke_max is not None else {
             p.name: s for p, s in zip(ptos, strokes) if not math.isfinite(p.stroke_max)}
         self.limits = {
-            "force": _limits(plant, self.force_max, [p.force_max for p in ptos], "force_max"),
-            "stroke": _limits(plant, self.stroke_max, strokes, "stroke_max"),
-            "rate": _limits(plant, self.rate_max, [math.inf] * len(ptos), "rate_max"),
+            "force": per_pto_values(plant, self.force_max, [p.force_max for p in ptos], "force_max"),
+            "stroke": per_pto_values(plant, self.stroke_max, strokes, "stroke_max"),
+            "rate": per_pto_values(plant, self.rate_max, [math.inf] * len(ptos), "rate_max"),
         }
         self.N = int(round(self.horizon_s / self.dt_s))
-        efficiency = _limits(plant, self.efficiency, [p.efficiency for p in ptos], "efficiency")
-        self.device_omega = device_frequency(cp, _band(plant))
+        efficiency = per_pto_values(plant, self.efficiency, [p.efficiency for p in ptos], "efficiency")
+        self.device_omega = device_frequency(cp, hydro_band(plant))
         if self.wave is None:
             warnings.warn(f"mpc: no sea state given (wave=...): the Kalman wave model is centred "
                           f"on the device's resonance seen from its PTO ({self.device_omega:.3g} "
@@ -157,7 +170,7 @@ class Mpc:
                               loss_damping=pto_impedance(cp, float(np.median(omega))),
                               force_penalty=self.force_penalty,
                               stroke_penalty=self.stroke_penalty, soft_stroke=self.soft_stroke,
-                              solver=self.solver)
+                              solver=self.solver, envelope=self.env.rows(cp))
         if self.estimator == "kalman":
             self.kalman = ExcitationKalman(cp, omega,
                                            measurement_noise=self.measurement_noise)
@@ -170,6 +183,7 @@ class Mpc:
                                min_samples=int(math.ceil(self.warm_up_planned / self.dt_s - 1e-9))
                                + 1)
                    if self.forecast == "ar" else None)
+        self.env.forecast_like(self.ar)
         self._velocity = signal_indices(plant, [f"{n}__velocity" for n in cp.ptos])
         self.warm_up_damping = self._warm_up_damping(plant, cp, omega)
         self.warm_up_end = None           # s: when the MPC took over
@@ -200,6 +214,7 @@ class Mpc:
             self.history.append((t, self.kalman.d.copy()))
             if self.ar is not None:
                 self.ar.append(self.kalman.d)
+        self.env.measure(t)              # the surface probes: a measurement, now
         if self._warming_up(t):          # the tuned damper until the predictor has a fit
             u = -self.warm_up_damping * np.asarray(y, float)[self._velocity]
             self.u_prev = np.clip(u, -self.limits["force"], self.limits["force"])
@@ -207,7 +222,7 @@ class Mpc:
         known = self._known_forecast(t) if self.forecast == "known" else None
         D = self._forecast(known)
         start = time.perf_counter()
-        U, status = self.qp.solve(z, D, self.u_prev, self._plan)
+        U, status = self.qp.solve(z, D, self.u_prev, self._plan, self.env.offset(t, self.N))
         self.stats["solve_s"].append(time.perf_counter() - start)
         self.stats["solves"] += 1
         if U is None:
@@ -336,8 +351,11 @@ class Mpc:
                "label": self.label(),
                "estimator": self.estimator + (" (full-state oracle)" if self.uses_state else ""),
                "solver": self.solver, "order": self.order, "soft_stroke": self.soft_stroke,
+               "envelope_on": self.envelope,
                "period_s": self.period, "stats": stats}
         out.update(self._warm_up_report())
+        if "env" in self.__dict__ and self.envelope:
+            out["envelope"] = self.env.report()
         if self.__dict__.get("stroke_default"):
             out["stroke_max_default"] = {
                 "values": {k: float(v) for k, v in self.stroke_default.items()},
@@ -370,28 +388,6 @@ class Mpc:
                             "planned_s": float(self.warm_up_planned),
                             "take_over_s": float(self.blend_s),
                             "completed": self.warm_up_end is not None}}
-
-
-def _limits(plant, value, scene_values, what) -> np.ndarray:
-    """Per-PTO limits: the setting (number or dict by PTO name) or the scene's; > 0."""
-    if value is None:
-        out = np.asarray(scene_values, float)
-    elif isinstance(value, dict):    # the PTOs it names; the others keep the scene's value
-        names = [p.name for p in plant.scene.ptos][:len(scene_values)]
-        per_pto(plant, value, f"mpc {what}")                    # unknown names: KeyError
-        out = np.array([float(value.get(n, s)) for n, s in zip(names, scene_values)])
-    else:
-        out = per_pto(plant, value, f"mpc {what}")[:len(scene_values)]
-    if np.any(out <= 0):
-        raise ValueError(f"mpc: {what} must be > 0, got {out}")
-    return out
-
-
-def _band(plant) -> tuple[float, float]:
-    """The frequencies the device's hydro data cover (rad/s); 0.1-10 rad/s without data."""
-    if plant.hydro is None:
-        return (0.1, 10.0)
-    return (float(plant.hydro.omega[0]), float(plant.hydro.omega[-1]))
 
 
 def _choice(what, value, allowed):

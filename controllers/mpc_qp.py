@@ -2,7 +2,11 @@
 by qpOASES (real-time path) or cvxpy/Clarabel (prototyping path); see `controllers.mpc`."""
 from __future__ import annotations
 
+import contextlib
+
 import numpy as np
+
+from mbcontrol.cache import flush_c_stdio
 
 
 class CondensedQp:
@@ -10,26 +14,28 @@ class CondensedQp:
 
     Variables (scaled): U / F_s (N nu, step-major) and, with a finite stroke limit and
     soft_stroke, slacks s / L_s (N nu). F_s: the force limit (or L_s / lambda_max(G) if
-    unlimited); L_s: the stroke limit (or 1 m). solve(z0, D, u_prev, warm) -> (U (N, nu) or
-    None, status).
+    unlimited); L_s: the stroke limit (or 1 m). envelope: rows (ne, nz) of outputs of the
+    control plant, each scaled by its limit, kept within +-1 at the ends of steps 1..N with a
+    slack each (always soft: the sea alone may take a quantity beyond it); solve's offset
+    adds what no state holds (the forecast surface elevation). solve(z0, D, u_prev, warm,
+    offset) -> (U (N, nu) or None, status).
     """
 
     def __init__(self, cp, N: int, limits: dict, *, efficiency, loss_damping,
                  force_penalty: float, stroke_penalty: float, soft_stroke: bool, solver: str,
-                 winding=None):
+                 winding=None, envelope=None):
         nu, nz = len(cp.ptos), cp.nz
         self.N, self.nu, self.solver = N, nu, solver
         # prediction of the positions at the ends of steps 1..N
         powers = [np.eye(nz)]
         for _ in range(N):
             powers.append(cp.Ad @ powers[-1])
-        Phi = np.vstack([cp.Cp @ powers[k] for k in range(1, N + 1)])          # (N nu, nz)
-        Psi = np.zeros((N * nu, N * nu))
-        Om = np.zeros((N * nu, N * cp.nd))
-        for k in range(1, N + 1):
-            for j in range(k):
-                Psi[(k - 1) * nu:k * nu, j * nu:(j + 1) * nu] = cp.Cp @ powers[k - 1 - j] @ cp.Bu
-                Om[(k - 1) * nu:k * nu, j * cp.nd:(j + 1) * cp.nd] = cp.Cp @ powers[k - 1 - j] @ cp.Bd
+        Phi, Psi, Om = _predictions(cp, cp.Cp, powers, N)
+        # envelope rows (ne, nz): outputs each scaled by its limit, kept within +-1 (soft)
+        self.n_env = 0 if envelope is None else int(np.shape(envelope)[0])
+        if self.n_env:
+            self.Phi_e, self.Psi_e, self.Om_e = _predictions(cp, np.asarray(envelope, float),
+                                                             powers, N)
         L = np.eye(N * nu) - np.eye(N * nu, k=-nu)       # P -> increments
         E = np.zeros((N * nu, nu))
         E[:nu] = np.eye(nu)
@@ -74,15 +80,23 @@ class CondensedQp:
         # the exact L1 penalty makes the soft QP's solution the hard one's whenever the hard
         # QP is feasible: solve the hard QP (half the variables) and the soft one only when
         # it is infeasible
+        self.soft_stroke = soft_stroke
         self.forms = [_QpForm(self, soft=False, backend=backend)]
-        if soft_stroke and self.has_stroke:
+        if (soft_stroke and self.has_stroke) or self.n_env:
             self.forms.append(_QpForm(self, soft=True, backend=backend))
         self._last, self.soft_solves = 0, 0
 
-    def solve(self, z0, D, u_prev, warm=None):
-        """(U (N, nu) N or N m, status), or (None, status) when no form could be solved."""
+    def solve(self, z0, D, u_prev, warm=None, offset=None):
+        """(U (N, nu) N or N m, status), or (None, status) when no form could be solved.
+        offset (N, ne): what the envelope rows add that no state holds (minus the forecast
+        surface elevation over the limit, for a relative heave), None: nothing."""
         z0, D, u_prev = np.asarray(z0, float), np.asarray(D, float), np.asarray(u_prev, float)
-        free = (self.Phi @ z0 + self.Om @ D.reshape(-1)) / self.Ls   # positions with U = 0
+        free = []                                     # what each row block is with U = 0
+        if self.has_stroke:
+            free.append((self.Phi @ z0 + self.Om @ D.reshape(-1)) / self.Ls)
+        if self.n_env:
+            env = self.Phi_e @ z0 + self.Om_e @ D.reshape(-1)
+            free.append(env if offset is None else env + np.asarray(offset, float).reshape(-1))
         q = self.Qz @ z0 + self.Qd @ D.reshape(-1)
         status = "not solved"
         # start with the form that solved last time: the hard QP is infeasible for stretches
@@ -99,18 +113,30 @@ class CondensedQp:
 
 
 class _QpForm:
-    """One layout of the condensed QP: hard stroke limits (variables U) or soft (U, slack).
-    Rows: stroke (Psi U, or Psi U -/+ s), then force rate (differences of U)."""
+    """One layout of the condensed QP: hard limits (variables U) or soft ones (U, slacks).
+    Rows: stroke (Psi U, or Psi U -/+ s; soft in the soft form when soft_stroke), envelope
+    (always soft in the soft form), then force rate (differences of U)."""
 
     def __init__(self, qp, *, soft: bool, backend):
         N, nu = qp.N, qp.nu
         self.qp, self.soft, self.n_u = qp, soft, N * nu
-        n_s = N * nu if soft else 0
-        self.n_var = N * nu + n_s
-        rows = []
+        blocks = []                      # (matrix over U, soft), in row order
         if qp.has_stroke:
-            S = qp.Fs / qp.Ls * qp.Psi
-            rows += [np.hstack([S, -np.eye(n_s)]), np.hstack([S, np.eye(n_s)])] if soft else [S]
+            blocks.append((qp.Fs / qp.Ls * qp.Psi, soft and qp.soft_stroke))
+        if qp.n_env:
+            blocks.append((qp.Fs * qp.Psi_e, soft))
+        self.blocks = [is_soft for _, is_soft in blocks]
+        n_s = sum(M.shape[0] for M, is_soft in blocks if is_soft)
+        self.n_var = N * nu + n_s
+        rows, col = [], 0
+        for M, is_soft in blocks:
+            if is_soft:
+                I = np.zeros((M.shape[0], n_s))
+                I[:, col:col + M.shape[0]] = np.eye(M.shape[0])
+                rows += [np.hstack([M, -I]), np.hstack([M, I])]
+                col += M.shape[0]
+            else:
+                rows.append(np.hstack([M, np.zeros((M.shape[0], n_s))]))
         if qp.has_rate:
             Dr = np.eye(N * nu) - np.eye(N * nu, k=-nu)
             rows += [np.hstack([Dr, np.zeros((N * nu, n_s))])]
@@ -118,7 +144,7 @@ class _QpForm:
         self.H = np.zeros((self.n_var, self.n_var))
         self.H[:N * nu, :N * nu] = qp.H_u
         self.g_slack = np.zeros(self.n_var)
-        if soft:
+        if n_s:
             self.H[N * nu:, N * nu:] = 2 * qp.stroke_penalty * np.eye(n_s)
             self.g_slack[N * nu:] = qp.stroke_penalty
         self.lbx = np.concatenate([-qp.force, np.zeros(n_s)])
@@ -126,18 +152,21 @@ class _QpForm:
         self.backend = backend(self)
 
     def bounds(self, q, free, u_prev):
-        """(g, lba, uba) for the linear cost term q, the free positions and the last force."""
+        """(g, lba, uba) for the linear cost term q, the free outputs per block (scaled
+        positions, then envelope rows) and the last force."""
         qp, n = self.qp, self.n_u
         g = self.g_slack.copy()
         g[:n] += q
         lba, uba = [], []
-        if qp.has_stroke:
-            if self.soft:
-                lba += [np.full(n, -np.inf), -qp.stroke - free]
-                uba += [qp.stroke - free, np.full(n, np.inf)]
+        limits = ([qp.stroke] if qp.has_stroke else []) + ([1.0] if qp.n_env else [])
+        for is_soft, f, lim in zip(self.blocks, free, limits):
+            f = np.asarray(f, float)
+            if is_soft:
+                lba += [np.full(f.size, -np.inf), -lim - f]
+                uba += [lim - f, np.full(f.size, np.inf)]
             else:
-                lba += [-qp.stroke - free]
-                uba += [qp.stroke - free]
+                lba += [-lim - f]
+                uba += [lim - f]
         if qp.has_rate:
             first = np.zeros(n)
             first[:qp.nu] = u_prev / qp.Fs
@@ -177,7 +206,10 @@ class _QpoasesBackend:
             self.called = True
             out = _quiet(call)
         else:
-            out = call()
+            # and reports an infeasible QP (counted in the MPC's stats) through CasADi's
+            # stream, which writes to Python's sys.stdout: a --json reader got those lines
+            with contextlib.redirect_stdout(_DISCARD):
+                out = call()
         stats = self.solver.stats()
         if not stats.get("success", False):
             return None, str(stats.get("return_status", "failed"))
@@ -199,7 +231,10 @@ class _CvxpyBackend:
         if hi.any():
             cons.append(self.x[np.flatnonzero(hi)] <= form.ubx[hi])
         # which rows have finite bounds is fixed by the layout: probe it once
-        _, lba, uba = form.bounds(np.zeros(form.n_u), np.zeros(form.n_u), np.zeros(form.qp.nu))
+        qp = form.qp
+        free = ([np.zeros(form.n_u)] if qp.has_stroke else []) + \
+            ([np.zeros(qp.N * qp.n_env)] if qp.n_env else [])
+        _, lba, uba = form.bounds(np.zeros(form.n_u), free, np.zeros(qp.nu))
         self.lo_rows, self.hi_rows = np.flatnonzero(np.isfinite(lba)), np.flatnonzero(np.isfinite(uba))
         self.lba, self.uba = cp.Parameter(self.lo_rows.size), cp.Parameter(self.hi_rows.size)
         if self.lo_rows.size:
@@ -222,6 +257,34 @@ class _CvxpyBackend:
         return np.asarray(self.x.value).ravel(), "solved"
 
 
+def _predictions(cp, C, powers, N):
+    """(Phi, Psi, Om): outputs C z at the ends of steps 1..N, from the state (Phi, (N nc,
+    nz)), the held forces (Psi, (N nc, N nu)) and the held excitation (Om, (N nc, N nd))."""
+    nc, nu, nd = C.shape[0], cp.Bu.shape[1], cp.nd
+    Phi = np.vstack([C @ powers[k] for k in range(1, N + 1)])
+    Psi = np.zeros((N * nc, N * nu))
+    Om = np.zeros((N * nc, N * nd))
+    for k in range(1, N + 1):
+        for j in range(k):
+            step = C @ powers[k - 1 - j]
+            Psi[(k - 1) * nc:k * nc, j * nu:(j + 1) * nu] = step @ cp.Bu
+            Om[(k - 1) * nc:k * nc, j * nd:(j + 1) * nd] = step @ cp.Bd
+    return Phi, Psi, Om
+
+
+class _Discard:
+    """A text stream that keeps nothing."""
+
+    def write(self, text: str) -> int:
+        return len(text)
+
+    def flush(self) -> None:
+        pass
+
+
+_DISCARD = _Discard()
+
+
 def _quiet(call):
     """Run with output silenced: qpOASES prints a banner, through CasADi's stream (which
     CasADi hands to Python's sys.stdout) or straight to the process's stdout."""
@@ -239,16 +302,8 @@ def _quiet(call):
             os.dup2(null.fileno(), 2)
             return call()
     finally:
-        _flush_c_stdio()                # a pipe's C buffer would print after the restore
+        flush_c_stdio()                 # a pipe's C buffer would print after the restore
         os.dup2(saved[0], 1)
         os.dup2(saved[1], 2)
         for fd in saved:
             os.close(fd)
-
-
-def _flush_c_stdio() -> None:
-    import ctypes
-    try:
-        ctypes.CDLL(None).fflush(None)
-    except (OSError, AttributeError):
-        pass

@@ -66,6 +66,14 @@ class Passive:
             self._law = ca.Function("passive_law", [y], [u])
         return self._law
 
+    def casadi_law_parametric(self, plant):
+        """(law (y, damping per PTO) -> u, the dampings): the same law with its gains as
+        parameters, so compiled code serves every damping (sim.simulate embeds this one)."""
+        y = ca.SX.sym("y", len(plant.outputs))
+        c = ca.SX.sym("damping", len(self._gains))
+        u = casadi_saturate(-c * y[self._velocity], self._limits)
+        return ca.Function("passive_law_p", [y, c], [u]), self._gains.copy()
+
     def describe(self) -> dict:
         return {"name": self.name, "damping": self.damping, "period_s": self.period,
                 "saturation": "command clipped to +-force_max per PTO (null: none)",
@@ -74,7 +82,8 @@ class Passive:
 
 def optimal_damping(plant, wave, *, pto: str | None = None, params=None, bounds=None,
                     force_max: float | None = None, stroke_max: float | None = None,
-                    exceedance: float = 0.01, objective: str = "auto") -> tuple[float, float]:
+                    exceedance: float = 0.01, objective: str = "auto",
+                    envelope: bool = False) -> tuple[float, float]:
     """PTO damping that maximises the mean absorbed power in `wave`: (damping, power W).
 
     Evaluated on the frequency-domain solution built straight from the BEM data (linear
@@ -97,13 +106,17 @@ def optimal_damping(plant, wave, *, pto: str | None = None, params=None, bounds=
     drivetrain (the mechanical power less the winding loss R |F|^2 / (gear kt')^2 / 2, whose
     optimum is a lighter damper), else the mechanical power; "mechanical" or "electrical"
     force one (tuning.electrical_winding). The power returned is the mechanical one.
+
+    envelope: keep the predicted significant relative heave, roll and pitch within the linear
+    model's range (analysis.envelope; tuning.constrained_tuning, which raises OutsideEnvelope
+    with the closest damper when no damping can).
     """
     winding = electrical_winding(plant, pto, objective)
-    if force_max is not None or stroke_max is not None or winding is not None:
+    if force_max is not None or stroke_max is not None or winding is not None or envelope:
         c, _, power = constrained_tuning(plant, wave, pto=pto, params=params, passive=True,
                                          bounds=bounds, force_max=force_max,
                                          stroke_max=stroke_max, exceedance=exceedance,
-                                         winding=winding)
+                                         winding=winding, envelope=envelope)
         return c, power
     from scipy.optimize import minimize_scalar
 

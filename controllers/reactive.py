@@ -96,6 +96,16 @@ class Reactive:
             self._law = ca.Function("reactive_law", [y], [casadi_saturate(u, self._limits)])
         return self._law
 
+    def casadi_law_parametric(self, plant):
+        """(law (y, [damping, stiffness] per PTO) -> u, their values): the same law with its
+        gains as parameters, so compiled code serves every pair (sim.simulate embeds it)."""
+        n = len(self._c)
+        y = ca.SX.sym("y", len(plant.outputs))
+        g = ca.SX.sym("gains", 2 * n)
+        u = -(g[:n] * y[self._velocity] + g[n:] * y[self._position])
+        law = ca.Function("reactive_law_p", [y, g], [casadi_saturate(u, self._limits)])
+        return law, np.concatenate([self._c, self._k])
+
     def describe(self) -> dict:
         return {"name": self.name, "damping": self.damping, "stiffness": self.stiffness,
                 "period_s": self.period,
@@ -106,7 +116,8 @@ class Reactive:
 def reactive_tuning(plant, wave, pto: str | None = None, *, params=None,
                     min_margin: float = 1e-3, force_max: float | None = None,
                     stroke_max: float | None = None, efficiency: float | None = None,
-                    exceedance: float = 0.01, objective: str = "auto") -> tuple[float, float, float]:
+                    exceedance: float = 0.01, objective: str = "auto",
+                    envelope: bool = False) -> tuple[float, float, float]:
     """(damping N s/m, stiffness N/m, predicted mean power W) for `wave`, linear theory.
 
     Regular wave: complex-conjugate control at its frequency (damping = Re Z_i, stiffness =
@@ -123,14 +134,15 @@ def reactive_tuning(plant, wave, pto: str | None = None, *, params=None,
     search is constrained_tuning's; the power returned is still the mechanical one. A PTO
     with a drivetrain is tuned for electrical power by default (objective "auto"; see
     passive.optimal_damping): the winding loss of the spring's reactive current moves the
-    optimum away from the complex conjugate.
+    optimum away from the complex conjugate. envelope: as passive.optimal_damping's.
     """
     winding = electrical_winding(plant, pto, objective)
-    if force_max is not None or stroke_max is not None or efficiency is not None or winding:
+    if (force_max is not None or stroke_max is not None or efficiency is not None or winding
+            or envelope):
         return constrained_tuning(plant, wave, pto=pto, params=params, force_max=force_max,
                                   stroke_max=stroke_max, efficiency=efficiency,
                                   exceedance=exceedance, min_margin=min_margin,
-                                  winding=winding)
+                                  winding=winding, envelope=envelope)
 
     name = pto or plant.scene.ptos[0].name
     w, a = np.asarray(wave.omega, float), np.asarray(wave.amplitude, float)

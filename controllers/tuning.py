@@ -4,20 +4,35 @@ from __future__ import annotations
 
 import numpy as np
 
+from mbcontrol.analysis.envelope import ENVELOPE_SHARE, envelope_response
+
 from .impedance import (base_params, default_bounds, fd_statistics, intrinsic_impedance,
                         margin_function)
+
+
+class OutsideEnvelope(ValueError):
+    """No setting keeps the device inside its envelope in this sea. fallback: (damping,
+    stiffness, predicted power W) of the damper that comes closest; ratio: its largest
+    predicted significant motion over the limit."""
+
+    def __init__(self, message: str, *, fallback: tuple, ratio: float):
+        super().__init__(message)
+        self.fallback, self.ratio = fallback, ratio
 
 
 def constrained_tuning(plant, wave, *, pto: str | None = None, params=None,
                        passive: bool = False, bounds=None, force_max: float | None = None,
                        stroke_max: float | None = None, efficiency: float | None = None,
                        exceedance: float = 0.01, min_margin: float = 1e-3,
-                       winding: float | None = None) -> tuple[float, float, float]:
+                       winding: float | None = None,
+                       envelope: bool = False) -> tuple[float, float, float]:
     """(damping, stiffness, predicted mean power W) maximising the predicted mean power
     (electrical with `efficiency` or a drivetrain's `winding` coefficient, else mechanical;
     impedance.fd_statistics) subject to fd_statistics' force and stroke
     peaks <= force_max (N) and stroke_max (m) (None: no limit) and, for a spring, a stable
-    closed loop with margin >= min_margin (1/s).
+    closed loop with margin >= min_margin (1/s), and with `envelope` every quantity of the
+    linear model's range (analysis.envelope: relative heave against the mean draft, roll and
+    pitch against 30 deg) within ENVELOPE_SHARE of its limit, as predicted for this sea.
 
     passive: stiffness 0, a 1-D search: a log grid of 400 dampings over `bounds` (default
     impedance.default_bounds), then Brent's method between the best feasible point's neighbours
@@ -27,7 +42,10 @@ def constrained_tuning(plant, wave, *, pto: str | None = None, params=None,
     at least the median |omega Z_i|), the best stable feasible point and the constrained
     passive optimum as starts of a Nelder-Mead search in (log c, k / k_s) that scores any
     infeasible or unstable pair as infinitely bad, so the result is never below the passive
-    one in prediction. ValueError if no damping meets the limits.
+    one in prediction. ValueError if no damping meets the force and stroke limits;
+    OutsideEnvelope (a ValueError) if none also keeps the device inside its envelope: it
+    carries the damper that comes closest (`fallback`, `ratio`), for a caller that flags the
+    sea rather than stops.
     """
     from scipy.optimize import minimize_scalar
 
@@ -40,10 +58,20 @@ def constrained_tuning(plant, wave, *, pto: str | None = None, params=None,
         raise ValueError(f"limits must be > 0, got force_max={force_max}, stroke_max={stroke_max}")
     key = "power_W" if efficiency is None and winding is None else "electrical_W"
 
+    env = None
+    if envelope:
+        env = envelope_response(plant, wave, name, params=base_params(plant, name, params))
+    w = np.asarray(wave.omega, float)
+
     def evaluate(c, k):
         st = fd_statistics(Z, F, wave, c, k, efficiency=efficiency, exceedance=exceedance,
                            winding=winding)
         feasible = (st["force_peak"] <= f_max) & (st["stroke_peak"] <= s_max)
+        if env is not None:           # the PTO force phasors, exp(-i omega t) for the envelope
+            cc, kk = np.asarray(c, float)[..., None], np.asarray(k, float)[..., None]
+            force = -(cc - 1j * kk / w) * F * wave.amplitude / (Z + cc - 1j * kk / w)
+            st["envelope_ratio"] = env.ratio(np.conj(force))
+            feasible = feasible & (st["envelope_ratio"] <= ENVELOPE_SHARE)
         return st[key], feasible, st
 
     if bounds is None:
@@ -52,6 +80,19 @@ def constrained_tuning(plant, wave, *, pto: str | None = None, params=None,
         bounds = default_bounds(plant, wave, name, base)
     x = np.linspace(np.log(bounds[0]), np.log(bounds[1]), 400)
     objective, feasible, st = evaluate(np.exp(x), 0.0)
+    if env is not None and not feasible.any():
+        limited = (st["force_peak"] <= f_max) & (st["stroke_peak"] <= s_max)
+        if limited.any():            # the limits can be met, the envelope cannot
+            j = int(np.argmin(np.where(limited, st["envelope_ratio"], np.inf)))
+            c = float(np.exp(x[j]))
+            worst = env.report(np.conj(-c * F * wave.amplitude / (Z + c)))
+            raise OutsideEnvelope(
+                f"{plant.name}: no damping keeps the device inside its linear model's range "
+                f"in this sea: the closest ({c:.4g}) reaches "
+                + ", ".join(f"{r['name']} {r['significant']:.3g} ({100 * r['share']:.0f} % of "
+                            f"{r['limit']:.3g}, {r['source']})" for r in worst),
+                fallback=(c, 0.0, float(st["power_W"][j])),
+                ratio=float(st["envelope_ratio"][j]))
     if not feasible.any():
         raise ValueError(
             f"{plant.name}: no damping in {bounds[0]:.4g}..{bounds[1]:.4g} keeps the predicted "
@@ -79,7 +120,6 @@ def constrained_tuning(plant, wave, *, pto: str | None = None, params=None,
         return c_passive, 0.0, float(evaluate(c_passive, 0.0)[2]["power_W"])
 
     margin = margin_function(plant, name, params)
-    w = np.asarray(wave.omega, float)
     j = int(np.argmax(np.abs(F * wave.amplitude)))
     k_scale = max(abs(float(w[j] * Z[j].imag)), float(np.median(np.abs(w * Z))))
     log_c = np.linspace(np.log(bounds[0]), np.log(bounds[1]), 81)

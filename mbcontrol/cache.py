@@ -67,3 +67,13 @@ def progress_bar(**options):
     if defaults.get("log.quiet"):
         options["disable"] = True
     return tqdm(**options)
+
+
+def flush_c_stdio() -> None:
+    """Flush C's standard I/O buffers (a compiled library's printf to a pipe is buffered, and
+    would come out after the Python side has moved the descriptor it was meant for)."""
+    import ctypes
+    try:
+        ctypes.CDLL(None).fflush(None)
+    except (OSError, AttributeError):
+        pass

@@ -40,6 +40,10 @@ TABLES = {
     "candidate (added to the previous set: quadratic + linear roll damping, roll added mass, "
     "heave and sway rig damping)": ("measured", "--cross-validate"),
     "rm3, scene PTO, 1 h at dt 0.05 s": ("measured", "benchmarks/sweep_light.py"),
+    "rm3 at PacWave South, reactive, 32 seas × 600 s": ("measured",
+                                                        "benchmarks/sweep_design.py"),
+    "PacWave, 32 seas × 200 s, causal MPC": ("measured", "--controller mpc"),
+    "rm3 at Humboldt Bay, 127 seas × 600 s, designed per sea": ("measured", "--design"),
     "site": ("test", "tests/waves/test_annual_energy_pins.py"),
     "device": ("test", "tests/controllers/test_electrical.py"),
     "optimum": ("measured", "benchmarks/wecopttool_electrical.py"),

@@ -41,6 +41,15 @@ def port_responses(plant, omega, ptos, direction: float = 0.0, params=None):
     N, or rad/s per N m) and free velocities per unit wave amplitude (n_omega, n_pto) (m/s
     per m), straight from the BEM data at `omega` (rad/s). params: overrides as
     `linear_params`; the PTOs named in `ptos` are freed."""
+    return output_responses(plant, omega, ptos, [f"{name}__velocity" for name in ptos],
+                            direction, params)
+
+
+def output_responses(plant, omega, ptos, outputs, direction: float = 0.0, params=None):
+    """(G, H) for any plant outputs: G (n_omega, n_out, n_pto) per unit PTO force and H
+    (n_omega, n_out) per unit wave amplitude with the PTOs free (exp(-i omega t), straight
+    from the BEM data), so that with PTO forces F the outputs are G F + H A. params:
+    overrides as `linear_params`; the PTOs named in `ptos` are freed."""
     from ..waves import interpolate_complex
     from .frequency import mechanical_matrices
     from .linearize import jacobians
@@ -49,32 +58,33 @@ def port_responses(plant, omega, ptos, direction: float = 0.0, params=None):
         raise ValueError(f"{plant.name}: no hydrodynamic data, so no wave excitation")
     omega = np.atleast_1d(np.asarray(omega, float))
     if np.any(omega <= 0):
-        raise ValueError("port_responses: frequencies must be > 0 rad/s")
+        raise ValueError("output_responses: frequencies must be > 0 rad/s")
     p = plant.params(**linear_params(plant, ptos, params))
     mech = mechanical_matrices(plant, p)
     n_q, n_s = plant.n_q, plant.topology.tree.n_s
     _, Bu, _, _, Du, _ = (np.asarray(J) for J in jacobians(plant)(
         plant.x0(), np.zeros(len(plant.inputs)), np.zeros(len(plant.disturbances)), p))
     i_u = [plant.inputs.index(f"u__{name}") for name in ptos]
-    i_v = [plant.outputs.index(f"{name}__velocity") for name in ptos]
-    if np.any(Du[np.ix_(i_v, i_u)] != 0):
-        raise ValueError(f"{plant.name}: a PTO velocity depends directly on a PTO force")
+    i_y = [plant.outputs.index(name) for name in outputs]
+    if np.any(Du[np.ix_(i_y, i_u)] != 0):
+        raise ValueError(f"{plant.name}: an output of {outputs} depends directly on a PTO "
+                         f"force")
     # generalised force of unit PTO forces: s' = M_tot^-1 (... + b u), so b = M_tot ds'/du
     b = (mech.mass + mech.added_mass_inf) @ Bu[n_q:n_q + n_s][:, i_u]
-    c_q, c_s = mech.output_q[i_v], mech.output_s[i_v]
+    c_q, c_s = mech.output_q[i_y], mech.output_s[i_y]
     hyd, P = plant.hydro, mech.P_hydro
     A_w, B_w = hyd.frequency_domain_matrices(omega)
     F_exc = interpolate_complex(hyd.omega, hyd.excitation_coefficients(direction), omega)
     n = len(ptos)
-    Y = np.empty((omega.size, n, n), complex)
-    H = np.empty((omega.size, n), complex)
+    G = np.empty((omega.size, len(i_y), n), complex)
+    H = np.empty((omega.size, len(i_y)), complex)
     for k, w in enumerate(omega):
         Z = (-w**2 * (mech.mass + P @ A_w[k] @ P.T) - 1j * w * (mech.damping + P @ B_w[k] @ P.T)
              + mech.stiffness)
         X = np.linalg.solve(Z, np.column_stack([b, P @ F_exc[k]]))
-        V = c_q @ X + c_s @ (-1j * w * X)        # the velocity outputs' phasors
-        Y[k], H[k] = V[:, :n], V[:, n]
-    return Y, H
+        Y = c_q @ X + c_s @ (-1j * w * X)        # the outputs' phasors
+        G[k], H[k] = Y[:, :n], Y[:, n]
+    return G, H
 
 
 @dataclass(frozen=True)

@@ -195,18 +195,23 @@ def mean_draft(data, body: str):
 
 
 def _elevation_at(plant, wave, t, x: float, y: float) -> np.ndarray:
-    """Wave elevation (m, up) at the n-frame point (x, y): the origin's components delayed
-    by the phase k (x cos beta + y sin beta), k from the dispersion relation in the scene's
-    depth."""
+    """Wave elevation (m, up) at the n-frame point (x, y) at times t (s)."""
+    return wave_at(plant, wave, x, y).elevation(t)
+
+
+def wave_at(plant, wave, x: float, y: float):
+    """The wave as seen at the n-frame point (x, y): its elevation() is the surface there
+    (m, up): the origin's components delayed by the phase k (x cos beta + y sin beta), k from
+    the dispersion relation in the scene's depth."""
     from ..waves import wavenumber
     if x == 0.0 and y == 0.0:
-        return wave.elevation(t)
+        return wave
     water = plant.scene.water
     omega = np.atleast_1d(np.asarray(wave.omega, float))
     k = omega ** 2 / water.g if not math.isfinite(water.depth) else np.array(
         [wavenumber(float(w), water.depth, water.g) for w in omega])
     shift = k * (x * math.cos(wave.direction) + y * math.sin(wave.direction))
-    return dataclasses.replace(wave, phase=np.asarray(wave.phase) - shift).elevation(t)
+    return dataclasses.replace(wave, phase=np.asarray(wave.phase) - shift)
 
 
 def energy_record(plant, ds):

@@ -19,6 +19,7 @@ Examples:
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import sys
 import warnings
@@ -144,11 +145,52 @@ def _main(argv) -> int:
         parser.print_help()
         return 2
     try:
+        if getattr(args, "json", False):
+            with _stdout_for_json_only():
+                return args.run(args) or 0
         return args.run(args) or 0
     except (MbcontrolError, KeyError, ValueError) as exc:
         message = exc.args[0] if isinstance(exc, KeyError) and exc.args else exc
         print(f"mbcontrol: error: {message}", file=sys.stderr)
         return 1
+
+
+@contextlib.contextmanager
+def _stdout_for_json_only():
+    """--json output is a contract: while the command runs, whatever C libraries write to
+    the process's standard output (qpOASES reports an infeasible QP there whatever its print
+    level; compilers, solvers, Dask workers started meanwhile) goes to standard error, and
+    only the command's own Python prints reach standard output."""
+    sys.stdout.flush()
+    try:
+        real = os.dup(1)
+    except OSError:                  # no file descriptor 1 (an embedding host): nothing to guard
+        yield
+        return
+    swapped = None
+    try:
+        if _is_fd1(sys.stdout):      # the console or a pipe: Python's prints keep fd 1's target
+            swapped = sys.stdout
+            sys.stdout = os.fdopen(os.dup(real), "w", buffering=1, encoding=swapped.encoding,
+                                   errors=swapped.errors)
+        os.dup2(2, 1)
+        yield
+    finally:
+        from ..cache import flush_c_stdio
+        flush_c_stdio()              # C's buffered writes go where they were meant to
+        if swapped is not None:
+            sys.stdout.flush()
+            sys.stdout.close()
+            sys.stdout = swapped
+        os.dup2(real, 1)
+        os.close(real)
+
+
+def _is_fd1(stream) -> bool:
+    try:
+        return stream.fileno() == 1
+    except (AttributeError, OSError, ValueError):      # pytest's capture, a StringIO
+        return False
 
 
 def build_parser() -> argparse.ArgumentParser:

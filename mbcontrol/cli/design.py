@@ -82,6 +82,12 @@ def _print_design(plant, wave, result, command) -> None:
         print(f"  tuner's own simulation: {_power(result.tuner['simulated_power_W'])}")
     if result.margins is not None:
         print(f"  stability: {result.margins.message}")
+    if "robustness" in result.tuner:
+        print(f"  robustness (floors: gain margin {result.tuner['robustness']['floors']['gain_margin']:g}, "
+              f"phase margin {result.tuner['robustness']['floors']['phase_margin_deg']:g} deg): "
+              f"{result.tuner['robustness']['why']}")
+    if "share" in result.tuner:
+        print(f"  why this share: {result.tuner['share']['why']}")
     b = result.bound
     limits = f"|F| <= {b['force_max']:.4g} {F}, |x| <= {b['stroke_max']:.4g} {X}"
     constrained = (_power(b["constrained_W"]) if b["constrained_W"] is not None

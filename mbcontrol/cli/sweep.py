@@ -34,7 +34,9 @@ The --json summary is a contract: {"model", "cases", "computed", "reused", "wall
 {"model", "version", "scene_sha256", "hydro_sha256", "radiation_sha256", "controller",
 "settings"}, and with --isolated "farm": {"devices", "isolated_devices",
 "isolated_scene_params", "q_factor", "annual_energy_isolated_MWh", "q_annual",
-"isolated_invalid_cases", "isolated_wall_time_s"} and "q_factor" per sea} (per sea, means over the valid seeds; lists over the varied values when --vary
+"isolated_invalid_cases", "isolated_wall_time_s"} and "q_factor" per sea, and with
+--design per sea "settings" (the tuned values), "predicted_power_W", "bound_W",
+"percent_of_bound", "inside_envelope" and "meets_robustness_floors"} (per sea, means over the valid seeds; lists over the varied values when --vary
 is given; weighted figures only for a weighted --seas file; a sea with no valid case counts
 as producing nothing there, the share of the year that is valid is annual_energy_coverage,
 and annual_energy_unchecked_MWh is the figure the failed cases would have given).
@@ -49,9 +51,22 @@ provenance.settings). A store remembers the inputs it was made from (content has
 scene, hydro data and radiation fit, and the package version) and refuses others.
 --set values are numbers, true/false, none or words (--set forecast=ar).
 
+Per-sea design: with --design the controller is tuned for each sea state as `mbcontrol
+design` tunes it for one (passive, reactive: linear theory within the PTO's force and stroke
+limits and inside the linear model's envelope: each body's predicted significant heave
+relative to the surface within 90 % of its mean draft, roll and pitch within 90 % of 30 deg;
+latching, declutching: their simulated tuners; mpc: a horizon of one peak period). A sea where
+no setting stays inside is flagged (inside_envelope false; the closest setting runs). bound_W
+is the most any PTO force could absorb in that sea inside the same envelope (linear theory,
+mbcontrol.analysis.envelope), so percent_of_bound says how much a law leaves. --set values
+override the tuned ones. Without --design, a damped law named with no settings absorbs
+nothing, and says so on stderr.
+
 Examples:
   mbcontrol sweep rm3 --hs 1 2 3 --tp 8 10 12 --duration 300 --store out/rm3 --plot pm.png
   mbcontrol sweep oswec --seas ../shared/data/sites/pacwave_cluster_32.csv --width 18 --json
+  mbcontrol sweep rm3 --seas ../shared/data/sites/pacwave_cluster_32.csv --controller reactive \
+      --design --json
   mbcontrol sweep array_grid --scene-param n=3 --scene-param scale=25 --isolated n=1 \
       --seas ../shared/data/sites/pacwave_cluster_32.csv --vary direction=0,45
 """
@@ -79,6 +94,9 @@ def add_parser(sub) -> None:
                    help="a swept quantity (repeatable): one dimension per name")
     p.add_argument("--isolated", action="append", default=[], metavar="NAME=VALUE",
                    help="a farm: scene parameters of one device alone (repeatable); adds the q-factor")
+    p.add_argument("--design", action="store_true",
+                   help="tune the controller for each sea as `design` does (settings and "
+                        "bound_W per sea in the JSON)")
     p.add_argument("--seeds", type=int, default=1, help="wave realisations per sea (1)")
     p.add_argument("--duration", type=float,
                    help=f"simulated time per case, s ({default_help('sweep.duration')})")
@@ -95,6 +113,19 @@ def add_parser(sub) -> None:
     p.add_argument("--plot", metavar="FILE.png", help="power matrix, capture width, energy")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
     p.set_defaults(run=run_sweep)
+
+
+def _design_line(row: dict) -> str:
+    """A --design sea's tuned settings and its share of the bound, in one line."""
+    settings = ", ".join(f"{k} {v:.4g}" for k, v in (row["settings"] or {}).items()
+                         if isinstance(v, float))
+    bound = row["bound_W"]
+    share = (f"{row['percent_of_bound']:.0f} % of its bound {bound / 1e3:.4g} kW"
+             if row["percent_of_bound"] is not None else
+             f"bound {bound / 1e3:.4g} kW" if bound is not None else "no bound inside the envelope")
+    outside = "" if row["inside_envelope"] else "; OUTSIDE its envelope"
+    fragile = "" if row["meets_robustness_floors"] else "; below the robustness floors"
+    return f"designed: {settings}; {share}{outside}{fragile}"
 
 
 def _workers(given: int | None) -> int | None:
@@ -134,18 +165,23 @@ def run_sweep(args) -> int:
             raise ValueError(f"--vary {item}: expected NAME=v1,v2,... with numbers") from None
         if not vary[name.strip()]:
             raise ValueError(f"--vary {item}: expected NAME=v1,v2,... with at least one value")
-    _warn_if_absorbs_nothing(args.controller, settings, vary)
+    if not args.design:
+        _warn_if_absorbs_nothing(args.controller, settings, vary)
     common = dict(seeds=args.seeds, vary=vary, params=dict(_key_value(s, "--param") for s in args.param),
                   controller=args.controller, settings=settings, duration=args.duration, dt=args.dt,
                   method=args.method, store=args.store, workers=_workers(args.workers),
                   scheduler=args.scheduler, width=args.width, progress=not args.json)
     scene_params = dict(_key_value(s, "--scene-param") for s in args.scene_param)
     if args.isolated:
+        if args.design:
+            raise ValueError("--design with --isolated: not built (a farm's controllers are "
+                             "tuned per device); tune one device with --design instead")
         from ..studies.farm import farm_sweep
         ds, summary = farm_sweep(args.model, seas, scene_params=scene_params,
                                  isolated=dict(_key_value(s, "--isolated") for s in args.isolated), **common)
     else:
-        ds, summary = sweep(args.model, seas, scene_params=scene_params, **common)
+        ds, summary = sweep(args.model, seas, scene_params=scene_params, design=args.design,
+                            **common)
     if args.plot:
         from ..studies.sweep.plots import plot_sweep
         plot_sweep(ds, summary, args.plot)
@@ -167,6 +203,8 @@ def run_sweep(args) -> int:
         q_text = "" if not farm else f" {q:6.3f}" if isinstance(q, float) else "  (varied)"
         print(f"  {row['hs']:6.3g} {row['tp']:6.3g} {weight} {text} {cw_text} "
               f"{row['energy_flux_W_per_m'] / 1e3:8.3g}{q_text}")
+        if "bound_W" in row:
+            print(f"         {_design_line(row)}")
     for note in summary["notes"]:
         print(f"  note: {note}")
     for label, key in (("INVALID", "invalid"), ("FAILED", "failed")):

@@ -138,6 +138,12 @@ def _mpc_spec(c, plant) -> ControllerSpec:
         raise ValueError("export: this MPC is an oracle (forecast 'known' or estimator "
                          "'state'): it needs the future wave or the whole plant state, which a "
                          "device does not measure; export a causal one (forecast 'ar')")
+    if c.qp.n_env:
+        raise ValueError("export: this MPC keeps the linear model's envelope (relative heave "
+                         "against a surface probe, angles), which the C engine does not hold "
+                         "yet; export one without it (--set envelope=false, "
+                         "make('mpc', ..., envelope=False)) and keep the device in range "
+                         "another way")
     cp, qp, kal = c.cp, c.qp, c.kalman
     outputs = list(plant.outputs)
     names = list(cp.ptos)

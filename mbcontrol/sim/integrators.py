@@ -37,18 +37,42 @@ CALL_F_STATES = 300
 
 # --- one step -------------------------------------------------------------------------------
 
-def _symbols(plant, n_nodes):
+def _symbols(plant, n_nodes, n_theta: int = 0):
     nx, nu, nw, npar = plant.nx, len(plant.inputs), len(plant.disturbances), len(plant.p0)
     sym = ca.MX.sym if nx > CALL_F_STATES else ca.SX.sym
-    return sym("x", nx), sym("u", nu), sym("W", nw, n_nodes), sym("p", npar), sym("h")
+    return (sym("x", nx), sym("u", nu), sym("W", nw, n_nodes), sym("p", npar + n_theta),
+            sym("h"))
+
+
+def law_parameters(law) -> int:
+    """How many gains a law takes besides the outputs: a Function (y, theta) -> u keeps its
+    gains theta symbolic, so that compiled code does not depend on their values (they ride
+    at the end of the parameter vector p); a Function y -> u has none."""
+    return 0 if law is None or law.n_in() == 1 else int(law.sparsity_in(1).numel())
+
+
+def embedded_law(controller, plant):
+    """(law, gains): the controller's law with its gains as parameters (casadi_law_parametric:
+    a Function (y, theta) -> u and theta's values) where it offers one, else its plain
+    casadi_law (gains None); (None, None) without a controller."""
+    if controller is None:
+        return None, None
+    parametric = getattr(controller, "casadi_law_parametric", None)
+    if parametric is not None:
+        law, gains = parametric(plant)
+        return law, np.asarray(gains, float)
+    return controller.casadi_law(plant), None
 
 
 def _held_input(plant, law, x, u, W, p):
-    """With `law` (a CasADi Function y -> u), u comes from the outputs at the start of the step
-    and is held over it (zero-order hold at the step); otherwise the u input is used."""
+    """With `law` (a CasADi Function y -> u, or (y, theta) -> u with theta the end of p), u
+    comes from the outputs at the start of the step and is held over it (zero-order hold at
+    the step); otherwise the u input is used."""
     if law is None:
         return u
-    return law(plant.h(x, ca.DM.zeros(len(plant.inputs)), W[:, 0], p))
+    n = len(plant.p0)
+    y = plant.h(x, ca.DM.zeros(len(plant.inputs)), W[:, 0], p[:n])
+    return law(y) if law.n_in() == 1 else law(y, p[n:])
 
 
 def step_function(plant, method_name: str = "rk4", law=None) -> ca.Function:
@@ -62,12 +86,13 @@ def step_function(plant, method_name: str = "rk4", law=None) -> ca.Function:
     if not m.fixed_step:
         raise ValueError(f"{method_name!r} is adaptive: it has no fixed step")
     tab = m.tableau
-    x, u, W, p, h = _symbols(plant, len(tab.nodes))
+    x, u, W, p, h = _symbols(plant, len(tab.nodes), law_parameters(law))
     u_held = _held_input(plant, law, x, u, W, p)
     column = {c: i for i, c in enumerate(tab.nodes)}
+    p_plant = p[:len(plant.p0)]
 
     def f(xs, c):
-        return plant.f(xs, u_held, W[:, column[c]], p)
+        return plant.f(xs, u_held, W[:, column[c]], p_plant)
 
     if m.kind == "explicit":
         k, zero = [], type(x)(0)
@@ -131,7 +156,8 @@ def chunk_symbolic(plant, method_name, law, length: int) -> ca.Function:
     """`length` steps as one Function (x, U, W, p, h, *extras) -> (X, U_applied), not compiled.
 
     U (nu x length), W (nw x nodes*length), X (nx x length): step k's columns are k, or
-    k*nodes .. k*nodes + nodes - 1; p, h and extras are shared by all steps.
+    k*nodes .. k*nodes + nodes - 1; p (the plant's parameters, then a law's gains: see
+    law_parameters), h and extras are shared by all steps.
     """
     step = step_function(plant, method_name, law)
     # mapaccum feeds x_next back as x; the other inputs are given per step (or broadcast)
@@ -139,7 +165,7 @@ def chunk_symbolic(plant, method_name, law, length: int) -> ca.Function:
     n_nodes = len(METHODS[method_name].nodes)
     x, U = ca.MX.sym("x", plant.nx), ca.MX.sym("U", len(plant.inputs), length)
     W = ca.MX.sym("W", len(plant.disturbances), n_nodes * length)
-    p, h = ca.MX.sym("p", len(plant.p0)), ca.MX.sym("h")
+    p, h = ca.MX.sym("p", step.sparsity_in(3).numel()), ca.MX.sym("h")
     # repeated inside the function so that callers pass them once (the zero-copy buffer
     # interface needs full inputs)
     extras = [ca.MX.sym(f"e{i}", step.sparsity_in(5 + i)) for i in range(step.n_in() - 5)]

@@ -68,8 +68,9 @@ def simulate(plant, wave=None, *, duration: float, dt: float | None = None, cont
     why = diagnose.explainer(plant, wave, controller, p, x0, dt, method, duration, simulate)
     check = _divergence_check(plant, dt, method, bar, why)
 
-    # a controller with a CasADi law held for one step runs inside the compiled code
-    law = controller.casadi_law(plant) if controller is not None and spec.fixed_step else None
+    # a controller with a CasADi law held for one step runs inside the compiled code, its
+    # gains (when it offers them as parameters) at the end of p: new gains, no new code
+    law, gains = integrators.embedded_law(controller, plant) if spec.fixed_step else (None, None)
     embedded = controller is None or (law is not None and _period(controller, dt) == dt)
     if spec.fixed_step:                  # compile first: wall_time_s excludes it
         steps = n if embedded else _steps_per_period(_period(controller, dt), dt)
@@ -77,8 +78,9 @@ def simulate(plant, wave=None, *, duration: float, dt: float | None = None, cont
     start = time.perf_counter()
     if spec.fixed_step:
         W_nodes = integrators.excitation_at_nodes(plant, wave, n, dt, spec.nodes)
+        p_run = np.concatenate([p, gains]) if embedded and gains is not None else p
         X, U = _run_fixed(plant, method, controller, law if embedded else None, embedded, x0,
-                          W_nodes, p, dt, n, compiled, check)
+                          W_nodes, p_run, dt, n, compiled, check)
     else:
         X, U = _run_cvodes(plant, wave, controller, x0, p, dt, n, rtol, check, method)
     wall = time.perf_counter() - start

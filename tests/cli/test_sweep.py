@@ -116,3 +116,76 @@ def test_simulate_with_a_bare_damped_law_warns(capsys):
     code, _, err = run(capsys, "simulate", "sphere", "--controller", "passive", "--wave",
                        "regular", "--height", "1", "--period", "8", "--duration", "20")
     assert code == 0 and "controller 'passive' with damping 0 absorbs no power" in err
+
+
+def test_design_tunes_every_sea_and_reports_its_bound(capsys, tmp_path):
+    """`sweep --design`: each sea's reactive law is the one `design` tunes for that sea (the
+    same tuner called directly on the same wave), its power is at most the bound inside the
+    same envelope (+1 %), the share is reported, and a bare reactive law no longer warns.
+    A rerun from the store computes nothing and reports the same settings."""
+    from mbcontrol import build_plant, load_scene, waves
+    from mbcontrol.controllers.sea_design import design_for_sea
+    argv = ("sweep", "rm3", "--hs", "1.5", "3.5", "--tp", "9", "--duration", "300", "--dt", "0.1",
+            "--workers", "0", "--controller", "reactive", "--design", "--store",
+            str(tmp_path / "store"), "--json")
+    code, out, err = run(capsys, *argv)
+    assert code == 0, err
+    s = json.loads(out)
+    assert "absorbs no power" not in err + out
+    assert s["valid_cases"] == 2 and s["provenance"]["settings"]["designed_per_sea"] is True
+    plant = build_plant(load_scene("rm3"))
+    omega = plant.hydro.omega
+    for row in s["seas"]:
+        wave = waves.irregular(row["hs"], row["tp"], seed=0, duration=300.0,
+                               data_band=(float(omega[0]), float(omega[-1])))
+        direct = design_for_sea(plant, wave, "reactive")
+        assert row["settings"]["damping"] == pytest.approx(direct["settings"]["damping"], rel=1e-9)
+        assert row["settings"]["stiffness"] == pytest.approx(direct["settings"]["stiffness"],
+                                                             rel=1e-9)
+        assert row["bound_W"] == pytest.approx(direct["bound_W"], rel=1e-6)
+        assert 0 < row["mean_power_W"] <= 1.01 * row["bound_W"]
+        assert row["percent_of_bound"] == pytest.approx(100 * row["mean_power_W"] / row["bound_W"])
+        assert row["inside_envelope"] is True
+        assert row["meets_robustness_floors"] is direct["robustness"]["meets"]
+    code, again, err = run(capsys, *argv)
+    assert code == 0, err
+    again = json.loads(again)
+    assert again["computed"] == 0 and [r["settings"] for r in again["seas"]] == [
+        r["settings"] for r in s["seas"]]
+
+
+def test_design_needs_a_controller_with_a_tuner(capsys):
+    code, _, err = run(capsys, "sweep", "sphere", "--hs", "1", "--tp", "8", "--workers", "0",
+                       "--design")
+    assert code == 1 and "--design tunes a controller for each sea" in err
+
+
+def test_json_output_is_only_json_whatever_c_code_prints(capfd):
+    """qpOASES reports an infeasible QP on the process's standard output whatever its print
+    level, which broke `sweep --controller mpc --json` (a JSON reader got the error lines
+    first). Under --json such writes go to standard error; the JSON alone to standard out."""
+    import os
+
+    from mbcontrol.cli import _stdout_for_json_only
+    with _stdout_for_json_only():
+        os.write(1, b"->ERROR: Premature homotopy termination\n")
+        print('{"json": true}')
+    out, err = capfd.readouterr()
+    assert json.loads(out) == {"json": True}
+    assert "homotopy" in err and "homotopy" not in out
+
+
+def test_a_designed_mpc_runs_on_the_sweeps_step(capsys):
+    """The MPC designed for a sea has a period of Tp / 40 (0.225 s at Tp 9 s), not a whole
+    number of the sweep's 0.05 s steps: every Humboldt Bay case failed that way until the
+    period was rounded to whole steps."""
+    code, out, err = run(capsys, "sweep", "sphere", "--hs", "1.5", "--tp", "9", "--duration",
+                         "60", "--dt", "0.05", "--workers", "0", "--controller", "mpc",
+                         "--design", "--json")
+    assert code == 0, err
+    s = json.loads(out)
+    assert s["failed_cases"] == 0, s["failed"]
+    period = s["seas"][0]["settings"]["dt_s"]
+    steps = period / 0.05
+    assert steps == pytest.approx(round(steps)) and abs(period - 9.0 / 40) <= 0.025 + 1e-12
+    assert s["seas"][0]["settings"]["horizon_s"] == 9.0

@@ -28,9 +28,10 @@ SETTINGS = {                               # period (about 5 s); the sea for the
     "reactive": ({"damping": 5e4, "stiffness": -2e5, "force_max": 4e5}, SEA),
     "latching": ({"damping": 5e4, "latch_time": 2.0}, SWELL),
     "declutching": ({"damping": 5e4, "declutch_time": 1.0}, SWELL),
-    "mpc": ({"horizon_s": 8.0, "dt_s": 0.2, "wave": SEA}, SEA),
+    "mpc": ({"horizon_s": 8.0, "dt_s": 0.2, "wave": SEA, "envelope": False}, SEA),
     # the other causal forecast: the Kalman wave model's free motion, and a rate limit
     "mpc-model-forecast": ({"horizon_s": 8.0, "dt_s": 0.2, "wave": SEA, "forecast": "model",
+                            "envelope": False,
                             "rate_max": 2e6}, SEA),
 }
 
@@ -84,7 +85,7 @@ def test_plant_fmu_run_by_fmpy_reproduces_simulate(sphere, plant_fmus):
 def test_mpc_with_unstable_ar_fits_matches_python(sphere, tmp_path):
     """No warm-up: the first AR fit comes during the wave's ramp and is unstable (the Mpc
     docstring's rm3 story), so the C code's root reflection runs; it must match numpy's."""
-    controller = make("mpc", horizon_s=8.0, dt_s=0.2, wave=SEA, warm_up_s=0.0)
+    controller = make("mpc", horizon_s=8.0, dt_s=0.2, wave=SEA, warm_up_s=0.0, envelope=False)
     exported = export_controller(controller, sphere, tmp_path)
     checked = closed_loop_check(sphere, SEA, controller, exported, duration=60.0, dt=DT)
     assert controller.describe()["stats"]["ar_unstable_fits"] > 0   # the path ran
@@ -113,6 +114,9 @@ def test_two_ptos(tmp_path):
 def test_oracles_and_nmpc_are_refused_with_the_reason(sphere, tmp_path):
     with pytest.raises(ValueError, match="oracle"):
         export_controller(make("mpc", wave=SEA, forecast="known"), sphere, tmp_path)
+    # the envelope's surface probe is not in the C engine: refused, not silently dropped
+    with pytest.raises(ValueError, match="envelope=False"):
+        export_controller(make("mpc", wave=SEA), sphere, tmp_path)
     with pytest.raises(ValueError, match="IPOPT"):
         export_controller(make("nmpc", wave=SEA), sphere, tmp_path)
 
@@ -155,12 +159,14 @@ def test_mpc_with_a_drivetrain_keeps_its_winding_loss(tmp_path):
     from drivetrain_scenes import with_drivetrain
     plant = build_plant(with_drivetrain(tmp_path, "sphere", gear=12.0, kt=670.0,
                                         resistance="20 ohm", inertia=2.0, friction=1.0))
-    electrical = make("mpc", horizon_s=8.0, dt_s=0.2, wave=SEA, objective="auto")
+    electrical = make("mpc", horizon_s=8.0, dt_s=0.2, wave=SEA, objective="auto",
+                      envelope=False)
     exported = export_controller(electrical, plant, tmp_path / "e")
     check = closed_loop_check(plant, SEA, electrical, exported, duration=90.0, dt=DT)["check"]
     assert check["max_rel_force_error"] <= 1e-6
     mechanical = export_controller(make("mpc", horizon_s=8.0, dt_s=0.2, wave=SEA,
-                                        objective="mechanical"), plant, tmp_path / "m")
+                                        objective="mechanical", envelope=False), plant,
+                                   tmp_path / "m")
     runs = [simulate(plant, SEA, duration=90.0, dt=DT, method="rk4",
                      controller=CController.from_export(e, period=0.2))
             for e in (exported, mechanical)]

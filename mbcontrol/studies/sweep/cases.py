@@ -39,6 +39,7 @@ class Case:
     method: str = "rk4"
     roles: dict = field(default_factory=dict, compare=False)   # varied name -> its kind
     inputs: tuple = ()                  # content hashes of what made the plant ((name, sha), ...)
+    design: bool = False                # tune the controller for the case's sea (--design)
 
     @property
     def key(self) -> str:
@@ -47,6 +48,8 @@ class Case:
         package version; `mbcontrol.plant.provenance`), so an edited scene never reuses a
         stored result."""
         record = {k: v for k, v in asdict(self).items() if k not in ("index", "roles")}
+        if not self.design:              # the keys of stores made before --design existed
+            record.pop("design")
         text = json.dumps(record, sort_keys=True, default=float)
         return hashlib.sha256(text.encode()).hexdigest()[:20]
 
@@ -67,10 +70,12 @@ class Case:
 def build_cases(model: str, seas, *, seeds: int = 1, vary: dict | None = None, roles=None,
                 params=None, scene_params=None, controller=None, settings=None,
                 duration: float | None = None, dt: float | None = None,
-                method: str | None = None, inputs: dict | None = None) -> list[Case]:
+                method: str | None = None, inputs: dict | None = None,
+                design: bool = False) -> list[Case]:
     """Every sea x seed x combination of the varied values. roles: varied name -> "param",
     "scene" or "setting" (see `roles_for`); inputs: the plant's provenance (content hashes),
-    part of every case's key. duration, dt and method left out: the "sweep.*" defaults."""
+    part of every case's key. duration, dt and method left out: the "sweep.*" defaults.
+    design: each case's controller is tuned for its sea (controllers.sea_design)."""
     duration = defaults.resolve("sweep.duration", duration)
     dt, method = defaults.resolve("sweep.dt", dt), defaults.resolve("sweep.method", method)
     vary = dict(vary or {})
@@ -84,7 +89,8 @@ def build_cases(model: str, seas, *, seeds: int = 1, vary: dict | None = None, r
                           tuple(sorted((params or {}).items())),
                           tuple(sorted((scene_params or {}).items())), controller,
                           tuple(sorted((settings or {}).items())), float(duration), float(dt),
-                          method, dict(roles or {}), tuple(sorted((inputs or {}).items()))))
+                          method, dict(roles or {}), tuple(sorted((inputs or {}).items())),
+                          bool(design)))
     return cases
 
 

@@ -70,16 +70,19 @@ def _scattered(fig, ax, ds):
 
 
 def plot_sweep(ds, summary: dict, path=None):
-    """Three panels on the same axes, peak period Tp (s) across and Hs (m) up: the power
+    """Panels on the same axes, peak period Tp (s) across and Hs (m) up: the power
     matrix (mean power, kW, cells on the real Hs and Tp values, a colourbar), capture width
-    (or its ratio) against Tp coloured by Hs, and, for a weighted list, each sea state's
-    annual energy (MWh) as a bubble at its Hs and Tp. Returns the figure, written to path when
+    (or its ratio) against Tp coloured by Hs, for a weighted list each sea state's
+    annual energy (MWh) as a bubble at its Hs and Tp, and for a --design sweep each sea's
+    mean power as a share of its bound inside the envelope (%). Returns the figure, written to path when
     given."""
     import matplotlib.pyplot as plt
 
     from ...plotting import save
     weighted = summary.get("annual_energy_MWh") is not None
-    fig, axes = plt.subplots(1, 3 if weighted else 2, figsize=(16 if weighted else 10.5, 4.4))
+    designed = "bound_W" in ds
+    n = 2 + weighted + designed
+    fig, axes = plt.subplots(1, n, figsize=(5.3 * n, 4.4))
     period = "tp"
     try:
         table = power_matrix(ds, period=period) / 1e3
@@ -118,7 +121,32 @@ def plot_sweep(ds, summary: dict, path=None):
         ax.grid(alpha=0.3)
         ax.set_title(f"annual energy {summary['annual_energy_MWh']:.4g} MWh: each sea state's "
                      f"share (area)", fontsize=9)
+    if designed:
+        _share_of_bound(fig, axes[-1], ds)
     fig.tight_layout()
     if path is not None:
         save(fig, path)
     return fig
+
+
+def _share_of_bound(fig, ax, ds):
+    """--design: each sea's mean power over its bound inside the envelope (%), a dot at its
+    Hs and Tp; seas where no setting stayed inside ringed in red."""
+    over = [d for d in ds["mean_power_W"].dims if d != "sea"]
+    share = 100 * (ds["mean_power_W"].mean(over) / ds["bound_W"].mean(over)).values
+    ok = np.isfinite(share)
+    dots = ax.scatter(ds["tp"].values[ok], ds["hs"].values[ok], c=share[ok], cmap="cividis",
+                      vmin=0, vmax=100, s=60, edgecolor="k", lw=0.3)
+    for tp, hs, v in zip(ds["tp"].values[ok], ds["hs"].values[ok], share[ok]):
+        ax.annotate(f"{v:.0f}", (tp, hs), textcoords="offset points", xytext=(0, 5),
+                    ha="center", fontsize=6)
+    outside = ~ds["inside_envelope"].all(over).values
+    if outside.any():
+        ax.scatter(ds["tp"].values[outside], ds["hs"].values[outside], s=140, facecolor="none",
+                   edgecolor="C3", lw=1.2, label="no setting inside the envelope")
+        ax.legend(fontsize=7, loc="upper left")
+    fig.colorbar(dots, ax=ax, label="mean power / bound inside the envelope, %")
+    ax.set_xlabel("peak period Tp, s")
+    ax.set_ylabel("significant wave height Hs, m")
+    ax.grid(alpha=0.3)
+    ax.set_title("designed per sea: share of the bound", fontsize=9)

@@ -66,13 +66,20 @@ def run_case(case) -> dict:
     wave = waves.irregular(sea.hs, sea.tp, gamma=sea.gamma, seed=case.seed,
                            duration=case.duration, data_band=(float(omega[0]), float(omega[-1])),
                            direction=direction)
-    controller = None
+    controller, designed = None, None
+    start = time.perf_counter()
+    if case.design:      # tuned for this sea; settings given with --set take precedence
+        from mbcontrol.controllers.sea_design import design_for_sea
+        try:
+            designed = design_for_sea(plant, wave, case.controller, dt=case.dt)
+        except Exception as exc:   # noqa: BLE001 - a sea the tuner cannot serve is a result
+            return failed_record(case, exc, start)
+        settings = {**designed["settings"], **settings}
     if case.controller:
         cls = REGISTRY[case.controller]
         if "wave" in inspect.signature(cls).parameters:
             settings.setdefault("wave", wave)
         controller = make(case.controller, **settings)
-    start = time.perf_counter()
     try:
         if light.can_run(plant, controller, case.method):
             run = light.simulate_arrays(plant, wave, duration=case.duration, dt=case.dt,
@@ -81,9 +88,12 @@ def run_case(case) -> dict:
         else:
             run = simulate(plant, wave, duration=case.duration, dt=case.dt,
                            controller=controller, method=case.method, params=params or None)
-        return case_record(case, plant, wave, run, start)
+        record = case_record(case, plant, wave, run, start)
     except Exception as exc:       # noqa: BLE001 - a case that fails is a result (see below)
-        return failed_record(case, exc, start)
+        record = failed_record(case, exc, start)
+    if designed is not None:
+        record["design"] = designed
+    return record
 
 
 def failed_record(case, exc: BaseException, start: float) -> dict:

@@ -86,7 +86,9 @@ def assemble(cases, store: CaseStore, seas, vary: dict, seeds: int, attrs: dict)
     names = list(vary)
     shape = (len(seas), seeds) + tuple(len(vary[n]) for n in names)
     records = {c.index: store.read(c.key) for c in cases}
-    metrics = sorted({m for r in records.values() for m in r["metrics"]})
+    # the totals always exist, NaN where no case ran (a sweep whose every case failed)
+    metrics = sorted({m for r in records.values() for m in r["metrics"]}
+                     | {"mean_power_W", "mean_electrical_power_W"})
     dims = ("sea", "seed", *names)
     valid = np.ones(shape, bool)
     failed = np.zeros(shape, bool)
@@ -112,6 +114,8 @@ def assemble(cases, store: CaseStore, seas, vary: dict, seeds: int, attrs: dict)
         data[m] = (dims, a)
         if not valid.all() and m in ("mean_power_W", "mean_electrical_power_W"):
             data[f"{m}__unchecked"] = (dims, raw)
+    if any("design" in r for r in records.values()):
+        data.update(_design_variables(records, shape, dims))
     coords = {"sea": np.arange(len(seas)), "seed": np.arange(seeds),
               "hs": ("sea", [s.hs for s in seas]), "tp": ("sea", [s.tp for s in seas]),
               "te": ("sea", [s.te for s in seas]), "gamma": ("sea", [s.gamma for s in seas]),
@@ -122,3 +126,34 @@ def assemble(cases, store: CaseStore, seas, vary: dict, seeds: int, attrs: dict)
                      for k, v in attrs.items() if v is not None and not
                      (isinstance(v, float) and math.isnan(v))})
     return ds
+
+
+def _design_variables(records: dict, shape: tuple, dims: tuple) -> dict:
+    """--design: per case its tuned settings (JSON), linear theory's power, the bound inside
+    the same envelope (W) and whether the tuner kept the device inside its envelope."""
+    settings = np.full(shape, "", dtype=object)
+    bound, predicted = np.full(shape, np.nan), np.full(shape, np.nan)
+    inside = np.ones(shape, bool)
+    robust = np.ones(shape, bool)
+    for index, r in records.items():
+        d = r.get("design")
+        if d is None:
+            continue
+        robust[index] = (d.get("robustness") or {}).get("meets", True)
+        settings[index] = json.dumps(d["settings"], sort_keys=True)
+        bound[index] = np.nan if d["bound_W"] is None else d["bound_W"]
+        predicted[index] = np.nan if d["predicted_W"] is None else d["predicted_W"]
+        inside[index] = d["envelope"].get("inside") is not False
+    return {"design_settings": (dims, settings.astype(str),
+                                {"long_name": "the settings tuned for the case's sea (JSON)"}),
+            "bound_W": (dims, bound, {"long_name": "the most any PTO force absorbs inside the "
+                                                   "same envelope (linear theory)",
+                                      "units": "W"}),
+            "predicted_power_W": (dims, predicted, {"long_name": "the tuned law's mean power "
+                                                                 "in linear theory",
+                                                    "units": "W"}),
+            "inside_envelope": (dims, inside, {"long_name": "the tuner found settings inside "
+                                                            "the linear model's envelope"}),
+            "meets_robustness_floors": (dims, robust, {
+                "long_name": "the tuned linear law's gain and phase margins meet "
+                             "controllers.robustness' floors (true where not checked)"})}

@@ -25,14 +25,16 @@ def sweep(model: str, seas, *, seeds: int = 1, vary: dict | None = None, params=
           scene_params=None, controller: str | None = None, settings=None,
           duration: float | None = None, dt: float | None = None, method: str | None = None,
           store=None, workers: int | None = 0, scheduler: str | None = None,
-          width: float | None = None, progress: bool = True):
+          width: float | None = None, progress: bool = True, design: bool = False):
     """Run a sweep and return (Dataset, summary).
 
     seas: SeaStates (`cases.grid`, `cases.read_seas`); vary: name -> values (scene
     parameter, plant parameter or controller setting); workers: 0 serial, None one Dask
     worker per core, N workers; scheduler: a Dask scheduler address; store: a folder (resume:
     finished cases are not run again; `<store>/sweep.nc` holds the Dataset); width: the
-    characteristic width (m) for the capture width ratio. duration, dt (s) and method left out
+    characteristic width (m) for the capture width ratio. design: the controller is tuned for
+    each sea (controllers.sea_design; per sea "settings", "bound_W", "percent_of_bound" in the
+    summary). duration, dt (s) and method left out
     take the defaults "sweep.duration" (600 s), "sweep.dt" (0.05 s) and "sweep.method"
     (mbcontrol.defaults)."""
     from mbcontrol.controllers import REGISTRY
@@ -46,6 +48,11 @@ def sweep(model: str, seas, *, seeds: int = 1, vary: dict | None = None, params=
     scene = load_scene(model, scene_params or None)
     if controller is not None and controller not in REGISTRY:
         raise ValueError(f"--controller {controller}: expected one of {', '.join(REGISTRY)}")
+    if design:
+        from mbcontrol.controllers.sea_design import DESIGNABLE
+        if controller not in DESIGNABLE:
+            raise ValueError(f"--design tunes a controller for each sea: give --controller, one "
+                             f"of {', '.join(DESIGNABLE)} (got {controller})")
     plant = build_plant(scene)
     _PLANTS[(model, tuple(sorted((scene_params or {}).items())))] = plant   # serial path: reuse
     roles = roles_for(vary, scene, plant.parameters, REGISTRY.get(controller))
@@ -56,12 +63,15 @@ def sweep(model: str, seas, *, seeds: int = 1, vary: dict | None = None, params=
     inputs = {"model": scene.name, **provenance(plant)}
     cases = build_cases(model, seas, seeds=seeds, vary=vary, roles=roles, params=params,
                         scene_params=scene_params, controller=controller, settings=settings,
-                        duration=duration, dt=dt, method=method, inputs=inputs)
+                        duration=duration, dt=dt, method=method, inputs=inputs,
+                        design=design)
     case_store = CaseStore(store, inputs)
     run = execute(cases, case_store, workers=workers, scheduler=scheduler, progress=progress)
     depth, rho, g = scene.water.depth, scene.water.rho, scene.water.g
     made_by = {**inputs, "controller": controller,
                "settings": resolved_settings(controller, settings, vary, roles)}
+    if design:
+        made_by["settings"] = {"designed_per_sea": True, "given": dict(settings or {})}
     attrs = {"model": scene.name, "controller": controller, "settings": dict(settings or {}),
              "provenance": made_by,
              "params": dict(params or {}), "scene_params": dict(scene_params or {}),
@@ -80,7 +90,7 @@ def sweep(model: str, seas, *, seeds: int = 1, vary: dict | None = None, params=
         write_netcdf_atomic(ds, Path(store) / "sweep.nc")
     summary = _summary(ds, seas, run, time.perf_counter() - start, len(cases))
     from mbcontrol.controllers import absorbs_nothing
-    why = absorbs_nothing(controller, settings, vary)
+    why = None if design else absorbs_nothing(controller, settings, vary)
     if why:
         summary["notes"].insert(0, why)
     summary["provenance"] = made_by
@@ -129,6 +139,8 @@ def _summary(ds, seas, run, wall, n_cases) -> dict:
                "failed_cases": int(failed.isel(sea=k).sum())}
         if not math.isnan(s.te):
             row["te"] = s.te
+        if "bound_W" in ds:                 # --design: the sea's settings and its bound
+            row.update(_designed_row(ds, k))
         if "capture_width_ratio" in ds:
             row["capture_width_ratio"] = _plain(ds["capture_width_ratio"].mean("seed")
                                                 .isel(sea=k).values)
@@ -154,6 +166,8 @@ def _summary(ds, seas, run, wall, n_cases) -> dict:
                          f"seas ({100 * (1 - coverage):.3g} % of the year) with no valid case "
                          f"as producing nothing: a lower bound; their failed cases would "
                          f"have given {unchecked:.4g} MWh in all")
+    if "bound_W" in ds:
+        notes += _design_notes(ds, rows)
     listed, crashed = _cases_where(ds, invalid), _cases_where(ds, failed)
     if listed:
         notes.append(f"{len(listed)} of {n_cases} cases failed their physics checks and are "
@@ -170,6 +184,63 @@ def _summary(ds, seas, run, wall, n_cases) -> dict:
             "weighted_mean_power_W": weighted, "annual_energy_MWh": aep,
             "annual_energy_coverage": coverage if aep is not None else None,
             "annual_energy_unchecked_MWh": unchecked}
+
+
+def _designed_row(ds, k: int) -> dict:
+    """A sea's --design entries: the settings tuned for it (its first seed's: every seed of a
+    sea has the same spectrum, so the same tuning), linear theory's power, its bound inside
+    the envelope and the simulated power's share of it."""
+    import json
+    sea = ds.isel(sea=k)
+    first = np.ravel(sea["design_settings"].values)[0]
+    bound = float(np.nanmean(sea["bound_W"].values)) if np.isfinite(sea["bound_W"].values).any() \
+        else None
+    power = np.nanmean(sea["mean_power_W"].values) if np.isfinite(sea["mean_power_W"].values).any() \
+        else None
+    return {"settings": json.loads(first) if first else None,
+            "predicted_power_W": _plain(np.nanmean(sea["predicted_power_W"].values))
+            if np.isfinite(sea["predicted_power_W"].values).any() else None,
+            "bound_W": bound,
+            "percent_of_bound": None if bound is None or power is None else float(
+                100 * power / bound),
+            "inside_envelope": bool(sea["inside_envelope"].values.all()),
+            "meets_robustness_floors": bool(sea["meets_robustness_floors"].values.all())}
+
+
+def _design_notes(ds, rows) -> list[str]:
+    """What a reader of a --design sweep must know: seas where no setting stays inside the
+    envelope, laws below the robustness floors, simulations far off linear theory, and any
+    sea whose power beats its bound by more than 1 %."""
+    notes = []
+    outside = [r for r in rows if not r["inside_envelope"]]
+    if outside:
+        notes.append(f"{len(outside)} seas have no setting inside the linear model's envelope "
+                     f"(the closest was used; inside_envelope false): "
+                     + ", ".join(f"Hs {r['hs']:.3g} m Tp {r['tp']:.3g} s" for r in outside))
+    fragile = [r for r in rows if not r["meets_robustness_floors"]]
+    if fragile:
+        notes.append(f"{len(fragile)} seas' tuned laws are below the robustness floors (gain "
+                     f"margin 2, phase margin 30 deg; meets_robustness_floors false): deploy "
+                     f"them knowing a few % of model error can destabilise them")
+    # a loop that rings (a phase margin near 0: linear theory's steady state is never
+    # reached in the record): Humboldt Bay's Hs 1.25 m, Tp 20.4 s, reactive, 22 kW predicted,
+    # 1 kW simulated, phase margin 0.8 deg
+    astray = [r for r in rows if r["predicted_power_W"] and isinstance(r["mean_power_W"], float)
+              and not 0.5 <= r["mean_power_W"] / r["predicted_power_W"] <= 2.0]
+    if astray:
+        notes.append(f"{len(astray)} seas' simulated power is off linear theory's prediction by "
+                     f"more than a factor of 2 (a loop that rings, or a law linear theory does "
+                     f"not describe): " + ", ".join(
+                         f"Hs {r['hs']:.3g} m Tp {r['tp']:.3g} s {r['mean_power_W'] / 1e3:.3g} "
+                         f"kW against {r['predicted_power_W'] / 1e3:.3g} kW" for r in astray))
+    beaten = [r for r in rows if r["percent_of_bound"] is not None
+              and r["percent_of_bound"] > 101.0]
+    if beaten:
+        notes.append(f"{len(beaten)} seas absorb more than 101 % of their bound (linear theory "
+                     f"does not hold there): " + ", ".join(
+                         f"Hs {r['hs']:.3g} m Tp {r['tp']:.3g} s {r['percent_of_bound']:.1f} %"
+                         for r in beaten))
+    return notes
 
 
 def _cases_where(ds, mask) -> list[dict]:

@@ -1,0 +1,51 @@
+"""A controller designed for one sea of a sweep (`mbcontrol sweep --design`): its settings
+tuned as `design` tunes them (controllers.design_tuning.tune, the PTO's limits and the linear
+model's envelope respected), and the bound the same envelope sets (analysis.envelope)."""
+from __future__ import annotations
+
+from mbcontrol.results import jsonable
+
+# what --design tunes: the controllers with a tuner or defaults fitted to the sea
+DESIGNABLE = ("passive", "reactive", "latching", "declutching", "mpc", "nmpc")
+
+
+def design_for_sea(plant, wave, name: str, dt: float | None = None) -> dict:
+    """{"settings": the tuned settings (make(name, **settings, wave=...) runs them; a
+    predictive controller's period rounded to whole steps of the simulation's dt, s),
+    "predicted_W": linear theory's mean power (None where there is none), "bound_W": the
+    most any PTO force absorbs inside the same envelope (analysis.envelope.envelope_bound;
+    several PTOs: the multiport complex-conjugate bound, no envelope), "bound": how it was
+    made, "envelope": the tuner's verdict (inside, ratio, reason), "robustness": the linear
+    laws' margins against controllers.robustness' floors (None for the others), "notes"}.
+    JSON-ready."""
+    from mbcontrol.analysis.envelope import envelope_bound
+
+    from .design_tuning import tune
+    if name not in DESIGNABLE:
+        raise ValueError(f"--design: {name!r} has no tuner; expected one of "
+                         f"{', '.join(DESIGNABLE)}")
+    ptos = plant.scene.ptos
+    notes: list[str] = []
+    parameters, predicted, tuner, _ = tune(plant, wave, name, ptos[0], True, None, notes)
+    if dt and parameters.get("dt_s"):      # a controller period of whole simulation steps
+        parameters["dt_s"] = dt * max(1, round(parameters["dt_s"] / dt))
+    if isinstance(predicted, dict):
+        predicted = sum(predicted.values())
+    if len(ptos) == 1:
+        bound = envelope_bound(plant, wave, ptos[0].name)
+        bound["kind"] = "complex-conjugate bound within the envelope (analysis.envelope)"
+    else:
+        from mbcontrol.analysis.ports import multiport_bound
+        bound = {"bound_W": multiport_bound(plant, wave).power,
+                 "kind": "multiport complex-conjugate bound (no envelope: several PTOs)"}
+    envelope = tuner.get("envelope") or {"inside": None,
+                                         "reason": f"{name}'s tuner does not take the envelope"}
+    robust = None
+    if name in ("passive", "reactive") and len(ptos) == 1:   # the floors of `design`
+        from .margins import loop_margins
+        from .robustness import robustness
+        gains = {k: parameters[k] for k in ("damping", "stiffness") if k in parameters}
+        robust = robustness(loop_margins(plant, gains, pto=ptos[0].name))
+    return jsonable({"settings": parameters, "predicted_W": predicted,
+                     "bound_W": bound["bound_W"], "bound": bound, "envelope": envelope,
+                     "robustness": robust, "notes": notes})
