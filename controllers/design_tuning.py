@@ -66,6 +66,8 @@ def tune(plant, wave, name, pto_obj, limits, model_params, notes):
         if limits:                # and the linear model's range (analysis.envelope)
             kw["envelope"] = True
             info["envelope"] = {"share": ENVELOPE_SHARE, "inside": True}
+            if math.isfinite(pto_obj.rated_power):     # detuned to the PTO's rated power
+                kw["rated_power"] = info["settings"]["rated_power"] = pto_obj.rated_power
         try:
             if name == "passive":
                 damping, predicted = tuner(plant, wave, pto=pto, params=model_params, **kw)

@@ -83,7 +83,8 @@ class Passive:
 def optimal_damping(plant, wave, *, pto: str | None = None, params=None, bounds=None,
                     force_max: float | None = None, stroke_max: float | None = None,
                     exceedance: float = 0.01, objective: str = "auto",
-                    envelope: bool = False) -> tuple[float, float]:
+                    envelope: bool = False,
+                    rated_power: float | None = None) -> tuple[float, float]:
     """PTO damping that maximises the mean absorbed power in `wave`: (damping, power W).
 
     Evaluated on the frequency-domain solution built straight from the BEM data (linear
@@ -109,14 +110,17 @@ def optimal_damping(plant, wave, *, pto: str | None = None, params=None, bounds=
 
     envelope: keep the predicted significant relative heave, roll and pitch within the linear
     model's range (analysis.envelope; tuning.constrained_tuning, which raises OutsideEnvelope
-    with the closest damper when no damping can).
+    with the closest damper when no damping can). rated_power (W): the predicted mean power
+    at most that (a damper detuned in seas that would give more).
     """
     winding = electrical_winding(plant, pto, objective)
-    if force_max is not None or stroke_max is not None or winding is not None or envelope:
+    if (force_max is not None or stroke_max is not None or winding is not None or envelope
+            or rated_power is not None):
         c, _, power = constrained_tuning(plant, wave, pto=pto, params=params, passive=True,
                                          bounds=bounds, force_max=force_max,
                                          stroke_max=stroke_max, exceedance=exceedance,
-                                         winding=winding, envelope=envelope)
+                                         winding=winding, envelope=envelope,
+                                         rated_power=rated_power)
         return c, power
     from scipy.optimize import minimize_scalar
 

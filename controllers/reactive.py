@@ -117,7 +117,8 @@ def reactive_tuning(plant, wave, pto: str | None = None, *, params=None,
                     min_margin: float = 1e-3, force_max: float | None = None,
                     stroke_max: float | None = None, efficiency: float | None = None,
                     exceedance: float = 0.01, objective: str = "auto",
-                    envelope: bool = False) -> tuple[float, float, float]:
+                    envelope: bool = False,
+                    rated_power: float | None = None) -> tuple[float, float, float]:
     """(damping N s/m, stiffness N/m, predicted mean power W) for `wave`, linear theory.
 
     Regular wave: complex-conjugate control at its frequency (damping = Re Z_i, stiffness =
@@ -134,15 +135,17 @@ def reactive_tuning(plant, wave, pto: str | None = None, *, params=None,
     search is constrained_tuning's; the power returned is still the mechanical one. A PTO
     with a drivetrain is tuned for electrical power by default (objective "auto"; see
     passive.optimal_damping): the winding loss of the spring's reactive current moves the
-    optimum away from the complex conjugate. envelope: as passive.optimal_damping's.
+    optimum away from the complex conjugate. envelope, rated_power: as
+    passive.optimal_damping's.
     """
     winding = electrical_winding(plant, pto, objective)
     if (force_max is not None or stroke_max is not None or efficiency is not None or winding
-            or envelope):
+            or envelope or rated_power is not None):
         return constrained_tuning(plant, wave, pto=pto, params=params, force_max=force_max,
                                   stroke_max=stroke_max, efficiency=efficiency,
                                   exceedance=exceedance, min_margin=min_margin,
-                                  winding=winding, envelope=envelope)
+                                  winding=winding, envelope=envelope,
+                                  rated_power=rated_power)
 
     name = pto or plant.scene.ptos[0].name
     w, a = np.asarray(wave.omega, float), np.asarray(wave.amplitude, float)

@@ -24,15 +24,17 @@ def constrained_tuning(plant, wave, *, pto: str | None = None, params=None,
                        passive: bool = False, bounds=None, force_max: float | None = None,
                        stroke_max: float | None = None, efficiency: float | None = None,
                        exceedance: float = 0.01, min_margin: float = 1e-3,
-                       winding: float | None = None,
-                       envelope: bool = False) -> tuple[float, float, float]:
+                       winding: float | None = None, envelope: bool = False,
+                       rated_power: float | None = None) -> tuple[float, float, float]:
     """(damping, stiffness, predicted mean power W) maximising the predicted mean power
     (electrical with `efficiency` or a drivetrain's `winding` coefficient, else mechanical;
     impedance.fd_statistics) subject to fd_statistics' force and stroke
     peaks <= force_max (N) and stroke_max (m) (None: no limit) and, for a spring, a stable
     closed loop with margin >= min_margin (1/s), and with `envelope` every quantity of the
     linear model's range (analysis.envelope: relative heave against the mean draft, roll and
-    pitch against 30 deg) within ENVELOPE_SHARE of its limit, as predicted for this sea.
+    pitch against 30 deg) within ENVELOPE_SHARE of its limit, as predicted for this sea, and
+    with `rated_power` (W) the predicted mean power (the objective's: electrical or
+    mechanical) at most that: in a sea that would give more, the law detunes to it.
 
     passive: stiffness 0, a 1-D search: a log grid of 400 dampings over `bounds` (default
     impedance.default_bounds), then Brent's method between the best feasible point's neighbours
@@ -67,6 +69,8 @@ def constrained_tuning(plant, wave, *, pto: str | None = None, params=None,
         st = fd_statistics(Z, F, wave, c, k, efficiency=efficiency, exceedance=exceedance,
                            winding=winding)
         feasible = (st["force_peak"] <= f_max) & (st["stroke_peak"] <= s_max)
+        if rated_power is not None:
+            feasible = feasible & (st[key] <= rated_power)
         if env is not None:           # the PTO force phasors, exp(-i omega t) for the envelope
             cc, kk = np.asarray(c, float)[..., None], np.asarray(k, float)[..., None]
             force = -(cc - 1j * kk / w) * F * wave.amplitude / (Z + cc - 1j * kk / w)
@@ -82,6 +86,8 @@ def constrained_tuning(plant, wave, *, pto: str | None = None, params=None,
     objective, feasible, st = evaluate(np.exp(x), 0.0)
     if env is not None and not feasible.any():
         limited = (st["force_peak"] <= f_max) & (st["stroke_peak"] <= s_max)
+        if rated_power is not None:
+            limited = limited & (st[key] <= rated_power)
         if limited.any():            # the limits can be met, the envelope cannot
             j = int(np.argmin(np.where(limited, st["envelope_ratio"], np.inf)))
             c = float(np.exp(x[j]))

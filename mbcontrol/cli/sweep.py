@@ -36,7 +36,8 @@ The --json summary is a contract: {"model", "cases", "computed", "reused", "wall
 "isolated_scene_params", "q_factor", "annual_energy_isolated_MWh", "q_annual",
 "isolated_invalid_cases", "isolated_wall_time_s"} and "q_factor" per sea, and with
 --design per sea "settings" (the tuned values), "predicted_power_W", "bound_W",
-"percent_of_bound", "inside_envelope" and "meets_robustness_floors"} (per sea, means over the valid seeds; lists over the varied values when --vary
+"percent_of_bound", "inside_envelope" and "meets_robustness_floors", and with a PTO
+rated_power "rated_power_W" (the weighted figures then cap each sea's power at it)} (per sea, means over the valid seeds; lists over the varied values when --vary
 is given; weighted figures only for a weighted --seas file; a sea with no valid case counts
 as producing nothing there, the share of the year that is valid is annual_energy_coverage,
 and annual_energy_unchecked_MWh is the figure the failed cases would have given).

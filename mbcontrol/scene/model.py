@@ -91,6 +91,8 @@ class Pto:
     force_max: float = math.inf    # N or N m; a limit controllers must respect
     stroke_max: float = math.inf   # m or rad; a limit controllers must respect
     efficiency: float = 1.0        # mechanical to electrical conversion, 0..1
+    rated_power: float = math.inf  # W: the most mean power it delivers in a sea (tuners
+                                   # detune to it, a sweep's power matrix is capped at it)
     body: str | None = None
     point: tuple[float, float, float] | None = None        # m, n-frame at rest
     parent: str = "ground"

@@ -123,7 +123,7 @@ def _joint(r: Reader) -> Joint:
 
 def _pto(r: Reader, kinds: dict) -> Pto:
     r.allow("name", "joint", "damping", "stiffness", "force_max", "stroke_max", "efficiency",
-            "body", "point", "parent", "parent_point", "preload", "drivetrain")
+            "rated_power", "body", "point", "parent", "parent_point", "preload", "drivetrain")
     joint = r.string("joint", default=None)
     # limits in units of the joint's coordinate: "4 m" / "2 MN" (prismatic or between points),
     # "30 deg" / "5 MN m" (revolute); an unknown joint is named by the scene checks later
@@ -144,6 +144,7 @@ def _pto(r: Reader, kinds: dict) -> Pto:
                force_max=r.positive("force_max", force_dim, default=math.inf, finite=False),
                stroke_max=r.positive("stroke_max", stroke_dim, default=math.inf, finite=False),
                efficiency=efficiency,
+               rated_power=r.positive("rated_power", "power", default=math.inf, finite=False),
                body=r.string("body", default=None),
                point=r.vector("point", "length", default=None),
                parent=r.string("parent", default="ground"),

@@ -95,6 +95,10 @@ MEANING = {
     ("pto", "stroke_max"): "stroke limit: a length (prismatic, between points) or an angle "
                            "(revolute)",
     ("pto", "efficiency"): "drivetrain efficiency in (0, 1] (electrical power)",
+    ("pto", "rated_power"): "rated power: the most mean power the PTO delivers in a sea "
+                            "(mechanical; electrical with a drivetrain or an efficiency): the "
+                            "tuners detune to it and a sweep's power matrix is capped at it "
+                            "(the drivetrain's `power_max` is its peak rating)",
     ("pto", "preload"): "`balance`: the constant force that makes rest an equilibrium",
     ("pto", "drivetrain"): "gear and generator (`[pto.drivetrain]`): current, voltage, losses "
                            "and electrical power as signals",
@@ -209,6 +213,7 @@ point = [0, 0, 0]
 [[pto]]
 name = "generator"
 joint = "heave"
+rated_power = "500 W"
 [pto.drivetrain]
 torque_constant = 1.0
 winding_inductance = "1 mH"

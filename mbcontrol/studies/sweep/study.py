@@ -78,6 +78,9 @@ def sweep(model: str, seas, *, seeds: int = 1, vary: dict | None = None, params=
              "duration_s": duration, "dt_s": dt, "method": method,
              "created": datetime.datetime.now().isoformat(timespec="seconds"),
              "metrics": "mbcontrol.analysis.metrics.pto_metrics over the record after the ramp"}
+    rated = sum(p.rated_power for p in scene.ptos)
+    if scene.ptos and math.isfinite(rated):
+        attrs["rated_power_W"] = float(rated)
     ds = assemble(cases, case_store, seas, vary, seeds, attrs)
     J = np.array([site_energy_flux(s, depth, rho, g) for s in seas])   # the site's own J if given
     ds["energy_flux_W_per_m"] = ("sea", J)
@@ -94,6 +97,8 @@ def sweep(model: str, seas, *, seeds: int = 1, vary: dict | None = None, params=
     if why:
         summary["notes"].insert(0, why)
     summary["provenance"] = made_by
+    if "rated_power_W" in ds.attrs:
+        summary["rated_power_W"] = float(ds.attrs["rated_power_W"])
     return ds, summary
 
 
@@ -155,6 +160,16 @@ def _summary(ds, seas, run, wall, n_cases) -> dict:
         # covers and the figure the failed cases would have given
         missing = np.isnan(power.values) & (weights > 0)
         valid_power = np.where(missing, 0.0, power.values)
+        rated = ds.attrs.get("rated_power_W")
+        if rated is not None:        # the power matrix capped at the PTOs' rated power
+            capped = valid_power > rated
+            uncapped_aep = annual_energy_MWh(valid_power, weights)
+            valid_power = np.minimum(valid_power, rated)
+            if capped.any():
+                notes.append(f"{int(capped.sum())} seas are capped at the rated power "
+                             f"{rated / 1e3:.4g} kW: annual energy "
+                             f"{annual_energy_MWh(valid_power, weights):.4g} MWh, "
+                             f"{uncapped_aep:.4g} MWh uncapped")
         weighted = float(np.nansum(weights * valid_power))
         aep = annual_energy_MWh(valid_power, weights)
         coverage = float(1.0 - weights[missing].sum())
