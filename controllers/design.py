@@ -123,7 +123,7 @@ class DesignResult:
 
 def design(plant, wave, name: str, *, pto: str | None = None, simulate_s: float | None = None,
            dt: float | None = None, bounds: bool | str = True, limits: bool = True,
-           model_params: dict | None = None) -> DesignResult:
+           model_params: dict | None = None, robust: bool = False) -> DesignResult:
     """Tune controller `name` for `wave`, check, bound, simulate and score it.
 
     plant: a ProcessPlant; wave: mbcontrol.waves.Wave (regular or a sea); name: a REGISTRY
@@ -138,7 +138,9 @@ def design(plant, wave, name: str, *, pto: str | None = None, simulate_s: float 
     model_params: parameter overrides of the model the tuner sees, for model-error studies:
     the margins and the simulation use the plant as it is. An unstable linear loop is not
     simulated (it would diverge), and a simulation that fails (SimulationError) is reported,
-    not raised: the result says so in margins and warnings, with metrics None.
+    not raised: the result says so in margins and warnings, with metrics None. robust: a
+    reactive law within the robustness floors (controllers.robustness; others are checked
+    against them and flagged either way).
 
     Raises ValueError naming the controller when it is unknown or its tuner cannot apply
     (no wave, latching in a sea, latching in waves shorter than the natural period, ...).
@@ -157,7 +159,7 @@ def design(plant, wave, name: str, *, pto: str | None = None, simulate_s: float 
 
     try:
         parameters, predicted, tuner, extra = tune(plant, wave, name, pto_obj, limits,
-                                                    model_params, notes)
+                                                    model_params, notes, robust=robust)
     except ValueError as exc:
         raise ValueError(f"design {name!r}: {exc}") from None
     controller = make(name, **parameters, **extra)

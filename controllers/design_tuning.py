@@ -40,8 +40,9 @@ def _limit_kwargs(func, finite: dict, what: str, notes: list) -> dict:
     return taken
 
 
-def tune(plant, wave, name, pto_obj, limits, model_params, notes):
-    """(parameters, predicted W or None, tuner info, extra controller settings)."""
+def tune(plant, wave, name, pto_obj, limits, model_params, notes, robust: bool = False):
+    """(parameters, predicted W or None, tuner info, extra controller settings). robust: a
+    reactive law within the robustness floors (controllers.robustness)."""
     cls = REGISTRY[name]
     pto = pto_obj.name
     scene = {"force_max": float(pto_obj.force_max), "stroke_max": float(pto_obj.stroke_max)}
@@ -54,6 +55,9 @@ def tune(plant, wave, name, pto_obj, limits, model_params, notes):
     # the wave is a setting beyond the parameters: a predictive controller's preview
     extra = {"wave": wave} if _accepts(cls, "wave") else {}
     if name in ("passive", "reactive") and len(plant.scene.ptos) > 1:
+        if robust:
+            notes.append("robust: not applied to several PTOs tuned jointly (their margins "
+                         "are reported)")
         return _tune_jointly(plant, wave, name, limits, model_params, own, extra)
     if name in ("passive", "reactive"):
         from .passive import optimal_damping
@@ -68,6 +72,8 @@ def tune(plant, wave, name, pto_obj, limits, model_params, notes):
             info["envelope"] = {"share": ENVELOPE_SHARE, "inside": True}
             if math.isfinite(pto_obj.rated_power):     # detuned to the PTO's rated power
                 kw["rated_power"] = info["settings"]["rated_power"] = pto_obj.rated_power
+        if robust and name == "reactive":
+            kw["robust"] = info["robust"] = True
         try:
             if name == "passive":
                 damping, predicted = tuner(plant, wave, pto=pto, params=model_params, **kw)

@@ -9,7 +9,8 @@ from mbcontrol.results import jsonable
 DESIGNABLE = ("passive", "reactive", "latching", "declutching", "mpc", "nmpc")
 
 
-def design_for_sea(plant, wave, name: str, dt: float | None = None) -> dict:
+def design_for_sea(plant, wave, name: str, dt: float | None = None,
+                   robust: bool = False) -> dict:
     """{"settings": the tuned settings (make(name, **settings, wave=...) runs them; a
     predictive controller's period rounded to whole steps of the simulation's dt, s),
     "predicted_W": linear theory's mean power (None where there is none), "bound_W": the
@@ -17,7 +18,7 @@ def design_for_sea(plant, wave, name: str, dt: float | None = None) -> dict:
     several PTOs: the multiport complex-conjugate bound, no envelope), "bound": how it was
     made, "envelope": the tuner's verdict (inside, ratio, reason), "robustness": the linear
     laws' margins against controllers.robustness' floors (None for the others), "notes"}.
-    JSON-ready."""
+    JSON-ready. robust: a reactive law tuned within those floors."""
     from mbcontrol.analysis.envelope import envelope_bound
 
     from .design_tuning import tune
@@ -26,7 +27,8 @@ def design_for_sea(plant, wave, name: str, dt: float | None = None) -> dict:
                          f"{', '.join(DESIGNABLE)}")
     ptos = plant.scene.ptos
     notes: list[str] = []
-    parameters, predicted, tuner, _ = tune(plant, wave, name, ptos[0], True, None, notes)
+    parameters, predicted, tuner, _ = tune(plant, wave, name, ptos[0], True, None, notes,
+                                           robust=robust)
     if dt and parameters.get("dt_s"):      # a controller period of whole simulation steps
         parameters["dt_s"] = dt * max(1, round(parameters["dt_s"] / dt))
     if isinstance(predicted, dict):

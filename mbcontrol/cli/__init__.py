@@ -277,6 +277,9 @@ def build_parser() -> argparse.ArgumentParser:
                         "loop settles slowly; a sea: its repeat period, max(600 s, 20 Tp))")
     p.add_argument("--dt", type=float, default=None,
                    help="time step, s (default: period / 1000, or Tp / 1000)")
+    p.add_argument("--robust", action="store_true",
+                   help="reactive: tune within the robustness floors (gain margin 2, phase "
+                        "margin 30 deg at the least: min |1 + L| >= 0.52)")
     p.add_argument("--unconstrained", action="store_true",
                    help="tune without the PTO's force and stroke limits (e.g. complex-conjugate\n"
                         "control) and with no controller saturation; the limits are still\n"

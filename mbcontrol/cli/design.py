@@ -15,7 +15,7 @@ def run_design(args) -> int:
     wave = _wave(args, plant, args.duration or 600.0)
     result = design(plant, wave, args.controller, pto=args.pto, simulate_s=args.duration,
                     dt=args.dt, bounds={"auto": True, "full": "full", "off": False}[args.bounds],
-                    limits=not args.unconstrained)
+                    limits=not args.unconstrained, robust=args.robust)
     command = _simulate_command(args, result)
     if args.json:
         print(json.dumps({**result.to_dict(), "model": plant.name, "wave": wave.describe(),

@@ -60,7 +60,9 @@ latching, declutching: their simulated tuners; mpc: a horizon of one peak period
 no setting stays inside is flagged (inside_envelope false; the closest setting runs). bound_W
 is the most any PTO force could absorb in that sea inside the same envelope (linear theory,
 mbcontrol.analysis.envelope), so percent_of_bound says how much a law leaves. --set values
-override the tuned ones. Without --design, a damped law named with no settings absorbs
+override the tuned ones. --robust keeps a reactive law within the robustness floors (gain
+margin 2, phase margin 30 deg at the least; otherwise laws below them are only flagged,
+meets_robustness_floors). Without --design, a damped law named with no settings absorbs
 nothing, and says so on stderr.
 
 Examples:
@@ -98,6 +100,9 @@ def add_parser(sub) -> None:
     p.add_argument("--design", action="store_true",
                    help="tune the controller for each sea as `design` does (settings and "
                         "bound_W per sea in the JSON)")
+    p.add_argument("--robust", action="store_true",
+                   help="with --design: a reactive law within the robustness floors (gain "
+                        "margin 2, phase margin 30 deg at the least)")
     p.add_argument("--seeds", type=int, default=1, help="wave realisations per sea (1)")
     p.add_argument("--duration", type=float,
                    help=f"simulated time per case, s ({default_help('sweep.duration')})")
@@ -182,7 +187,7 @@ def run_sweep(args) -> int:
                                  isolated=dict(_key_value(s, "--isolated") for s in args.isolated), **common)
     else:
         ds, summary = sweep(args.model, seas, scene_params=scene_params, design=args.design,
-                            **common)
+                            robust=args.robust, **common)
     if args.plot:
         from ..studies.sweep.plots import plot_sweep
         plot_sweep(ds, summary, args.plot)

@@ -40,6 +40,7 @@ class Case:
     roles: dict = field(default_factory=dict, compare=False)   # varied name -> its kind
     inputs: tuple = ()                  # content hashes of what made the plant ((name, sha), ...)
     design: bool = False                # tune the controller for the case's sea (--design)
+    robust: bool = False                # ... within the robustness floors (--robust)
 
     @property
     def key(self) -> str:
@@ -48,8 +49,9 @@ class Case:
         package version; `mbcontrol.plant.provenance`), so an edited scene never reuses a
         stored result."""
         record = {k: v for k, v in asdict(self).items() if k not in ("index", "roles")}
-        if not self.design:              # the keys of stores made before --design existed
-            record.pop("design")
+        for flag in ("design", "robust"):  # the keys of stores made before they existed
+            if not record[flag]:
+                record.pop(flag)
         text = json.dumps(record, sort_keys=True, default=float)
         return hashlib.sha256(text.encode()).hexdigest()[:20]
 
@@ -71,11 +73,12 @@ def build_cases(model: str, seas, *, seeds: int = 1, vary: dict | None = None, r
                 params=None, scene_params=None, controller=None, settings=None,
                 duration: float | None = None, dt: float | None = None,
                 method: str | None = None, inputs: dict | None = None,
-                design: bool = False) -> list[Case]:
+                design: bool = False, robust: bool = False) -> list[Case]:
     """Every sea x seed x combination of the varied values. roles: varied name -> "param",
     "scene" or "setting" (see `roles_for`); inputs: the plant's provenance (content hashes),
     part of every case's key. duration, dt and method left out: the "sweep.*" defaults.
-    design: each case's controller is tuned for its sea (controllers.sea_design)."""
+    design: each case's controller is tuned for its sea (controllers.sea_design); robust:
+    within the robustness floors."""
     duration = defaults.resolve("sweep.duration", duration)
     dt, method = defaults.resolve("sweep.dt", dt), defaults.resolve("sweep.method", method)
     vary = dict(vary or {})
@@ -90,7 +93,7 @@ def build_cases(model: str, seas, *, seeds: int = 1, vary: dict | None = None, r
                           tuple(sorted((scene_params or {}).items())), controller,
                           tuple(sorted((settings or {}).items())), float(duration), float(dt),
                           method, dict(roles or {}), tuple(sorted((inputs or {}).items())),
-                          bool(design)))
+                          bool(design), bool(robust)))
     return cases
 
 

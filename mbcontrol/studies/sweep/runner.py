@@ -71,7 +71,8 @@ def run_case(case) -> dict:
     if case.design:      # tuned for this sea; settings given with --set take precedence
         from mbcontrol.controllers.sea_design import design_for_sea
         try:
-            designed = design_for_sea(plant, wave, case.controller, dt=case.dt)
+            designed = design_for_sea(plant, wave, case.controller, dt=case.dt,
+                                      robust=case.robust)
         except Exception as exc:   # noqa: BLE001 - a sea the tuner cannot serve is a result
             return failed_record(case, exc, start)
         settings = {**designed["settings"], **settings}

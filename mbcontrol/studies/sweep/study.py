@@ -25,7 +25,8 @@ def sweep(model: str, seas, *, seeds: int = 1, vary: dict | None = None, params=
           scene_params=None, controller: str | None = None, settings=None,
           duration: float | None = None, dt: float | None = None, method: str | None = None,
           store=None, workers: int | None = 0, scheduler: str | None = None,
-          width: float | None = None, progress: bool = True, design: bool = False):
+          width: float | None = None, progress: bool = True, design: bool = False,
+          robust: bool = False):
     """Run a sweep and return (Dataset, summary).
 
     seas: SeaStates (`cases.grid`, `cases.read_seas`); vary: name -> values (scene
@@ -34,7 +35,7 @@ def sweep(model: str, seas, *, seeds: int = 1, vary: dict | None = None, params=
     finished cases are not run again; `<store>/sweep.nc` holds the Dataset); width: the
     characteristic width (m) for the capture width ratio. design: the controller is tuned for
     each sea (controllers.sea_design; per sea "settings", "bound_W", "percent_of_bound" in the
-    summary). duration, dt (s) and method left out
+    summary); robust: a reactive law tuned within the robustness floors. duration, dt (s) and method left out
     take the defaults "sweep.duration" (600 s), "sweep.dt" (0.05 s) and "sweep.method"
     (mbcontrol.defaults)."""
     from mbcontrol.controllers import REGISTRY
@@ -48,6 +49,8 @@ def sweep(model: str, seas, *, seeds: int = 1, vary: dict | None = None, params=
     scene = load_scene(model, scene_params or None)
     if controller is not None and controller not in REGISTRY:
         raise ValueError(f"--controller {controller}: expected one of {', '.join(REGISTRY)}")
+    if robust and not design:
+        raise ValueError("--robust tunes within the robustness floors: it goes with --design")
     if design:
         from mbcontrol.controllers.sea_design import DESIGNABLE
         if controller not in DESIGNABLE:
@@ -64,14 +67,15 @@ def sweep(model: str, seas, *, seeds: int = 1, vary: dict | None = None, params=
     cases = build_cases(model, seas, seeds=seeds, vary=vary, roles=roles, params=params,
                         scene_params=scene_params, controller=controller, settings=settings,
                         duration=duration, dt=dt, method=method, inputs=inputs,
-                        design=design)
+                        design=design, robust=robust)
     case_store = CaseStore(store, inputs)
     run = execute(cases, case_store, workers=workers, scheduler=scheduler, progress=progress)
     depth, rho, g = scene.water.depth, scene.water.rho, scene.water.g
     made_by = {**inputs, "controller": controller,
                "settings": resolved_settings(controller, settings, vary, roles)}
     if design:
-        made_by["settings"] = {"designed_per_sea": True, "given": dict(settings or {})}
+        made_by["settings"] = {"designed_per_sea": True, "robust": bool(robust),
+                               "given": dict(settings or {})}
     attrs = {"model": scene.name, "controller": controller, "settings": dict(settings or {}),
              "provenance": made_by,
              "params": dict(params or {}), "scene_params": dict(scene_params or {}),
