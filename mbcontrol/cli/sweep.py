@@ -32,12 +32,14 @@ The --json summary is a contract: {"model", "cases", "computed", "reused", "wall
 ...}], "weighted_mean_power_W", "annual_energy_MWh",
 "annual_energy_coverage", "annual_energy_unchecked_MWh", "provenance":
 {"model", "version", "scene_sha256", "hydro_sha256", "radiation_sha256", "controller",
-"settings"}, and with --isolated "farm": {"devices", "isolated_devices",
+"settings", "amplitudes"}, and with --isolated "farm": {"devices", "isolated_devices",
 "isolated_scene_params", "q_factor", "annual_energy_isolated_MWh", "q_annual",
 "isolated_invalid_cases", "isolated_wall_time_s"} and "q_factor" per sea, and with
 --design per sea "settings" (the tuned values), "predicted_power_W", "bound_W",
 "percent_of_bound", "inside_envelope" and "meets_robustness_floors", and with a PTO
-rated_power "rated_power_W" (the weighted figures then cap each sea's power at it)} (per sea, means over the valid seeds; lists over the varied values when --vary
+rated_power "rated_power_W" (the weighted figures then cap each sea's power at it), and with
+--seeds N >= 2 per sea "valid_seeds", "mean_power_stderr_W" and "mean_power_ci95_W" [lo,
+hi] (Student's t over the valid seeds)} (per sea, means over the valid seeds; lists over the varied values when --vary
 is given; weighted figures only for a weighted --seas file; a sea with no valid case counts
 as producing nothing there, the share of the year that is valid is annual_energy_coverage,
 and annual_energy_unchecked_MWh is the figure the failed cases would have given).
@@ -104,6 +106,9 @@ def add_parser(sub) -> None:
                    help="with --design: a reactive law within the robustness floors (gain "
                         "margin 2, phase margin 30 deg at the least)")
     p.add_argument("--seeds", type=int, default=1, help="wave realisations per sea (1)")
+    p.add_argument("--amplitudes", choices=("deterministic", "random"), default="deterministic",
+                   help="deterministic: a = sqrt(2 S dw), the expected power (default); random: "
+                        "Rayleigh amplitudes, a record's statistics")
     p.add_argument("--duration", type=float,
                    help=f"simulated time per case, s ({default_help('sweep.duration')})")
     p.add_argument("--dt", type=float, help=f"time step, s ({default_help('sweep.dt')})")
@@ -176,7 +181,8 @@ def run_sweep(args) -> int:
     common = dict(seeds=args.seeds, vary=vary, params=dict(_key_value(s, "--param") for s in args.param),
                   controller=args.controller, settings=settings, duration=args.duration, dt=args.dt,
                   method=args.method, store=args.store, workers=_workers(args.workers),
-                  scheduler=args.scheduler, width=args.width, progress=not args.json)
+                  scheduler=args.scheduler, width=args.width, progress=not args.json,
+                  amplitudes=args.amplitudes)
     scene_params = dict(_key_value(s, "--scene-param") for s in args.scene_param)
     if args.isolated:
         if args.design:

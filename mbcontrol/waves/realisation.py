@@ -91,13 +91,19 @@ def variance_outside(hs: float, tp: float, gamma: float, band, kept) -> float:
 def irregular(hs: float, tp: float, *, gamma: float = 3.3, seed: int = 0,
               duration: float = 600.0, band: tuple[float, float] = DEFAULT_BAND,
               direction: float = 0.0, ramp_time: float | None = None,
-              kind: str = "jonswap", data_band=None) -> Wave:
+              kind: str = "jonswap", data_band=None,
+              amplitudes: str = "deterministic") -> Wave:
     """An irregular sea with random phases (seeded) on a uniform grid covering `duration`.
 
     Components span band[0]..band[1] times the peak frequency, cut to data_band (rad/s, the
     hydro data's) when given (`band_limits`; settings["spectrum_outside_data"] then records
-    the share of the variance left out); amplitudes a = sqrt(2 S dw) are scaled so that
-    4 sqrt(m0) equals hs exactly on the kept grid. Ramp: 2 Tp by default.
+    the share of the variance left out). amplitudes "deterministic" (the default, the
+    expected power): a = sqrt(2 S dw), scaled so that 4 sqrt(m0) equals hs exactly on the kept
+    grid, so over a repeat period a linear model's mean power does not depend on the seed;
+    "random" (a record's statistics): a = sqrt(2 S dw) R with R Rayleigh, E[R^2] = 1, drawn
+    after the phases from the same seed (the phases are those of the deterministic sea), no
+    rescaling, so each record's Hs and power scatter as a measured record's do (Tucker,
+    Challenor & Carter 1984); settings["amplitudes"] says so. Ramp: 2 Tp by default.
     """
     if hs <= 0 or tp <= 0 or gamma < 1:
         raise ValueError(f"{kind}: expected hs > 0, tp > 0, gamma >= 1; got {hs}, {tp}, {gamma}")
@@ -109,11 +115,20 @@ def irregular(hs: float, tp: float, *, gamma: float = 3.3, seed: int = 0,
     k = np.arange(math.ceil(kept[0] * wp / d_omega), math.floor(kept[1] * wp / d_omega) + 1)
     omega = k * d_omega
     density = jonswap_spectrum(omega, hs, tp, gamma_used)
+    if amplitudes not in ("deterministic", "random"):
+        raise ValueError(f"{kind}: amplitudes must be 'deterministic' or 'random', got "
+                         f"{amplitudes!r}")
     amplitude = np.sqrt(2 * density * d_omega)
-    amplitude *= hs / (4 * np.sqrt(0.5 * np.sum(amplitude**2)))
-    phase = np.random.default_rng(seed).uniform(0, 2 * np.pi, omega.size)
+    rng = np.random.default_rng(seed)
+    phase = rng.uniform(0, 2 * np.pi, omega.size)
+    if amplitudes == "random":                 # Rayleigh: a^2 exponential about 2 S dw
+        amplitude = amplitude * np.sqrt(rng.exponential(1.0, omega.size))
+    else:
+        amplitude *= hs / (4 * np.sqrt(0.5 * np.sum(amplitude**2)))
     ramp_time = 2 * tp if ramp_time is None else ramp_time
     settings = {"hs": hs, "tp": tp, "gamma": gamma_used, "seed": seed}
+    if amplitudes == "random":
+        settings["amplitudes"] = "random"
     if data_band is not None:
         settings["spectrum_outside_data"] = variance_outside(hs, tp, gamma_used, band, kept)
     return Wave(kind, omega, amplitude, phase, direction, ramp_time, settings, d_omega)

@@ -41,6 +41,7 @@ class Case:
     inputs: tuple = ()                  # content hashes of what made the plant ((name, sha), ...)
     design: bool = False                # tune the controller for the case's sea (--design)
     robust: bool = False                # ... within the robustness floors (--robust)
+    amplitudes: str = "deterministic"   # or "random": Rayleigh amplitudes (waves.irregular)
 
     @property
     def key(self) -> str:
@@ -52,6 +53,8 @@ class Case:
         for flag in ("design", "robust"):  # the keys of stores made before they existed
             if not record[flag]:
                 record.pop(flag)
+        if record["amplitudes"] == "deterministic":
+            record.pop("amplitudes")
         text = json.dumps(record, sort_keys=True, default=float)
         return hashlib.sha256(text.encode()).hexdigest()[:20]
 
@@ -73,12 +76,14 @@ def build_cases(model: str, seas, *, seeds: int = 1, vary: dict | None = None, r
                 params=None, scene_params=None, controller=None, settings=None,
                 duration: float | None = None, dt: float | None = None,
                 method: str | None = None, inputs: dict | None = None,
-                design: bool = False, robust: bool = False) -> list[Case]:
+                design: bool = False, robust: bool = False,
+                amplitudes: str = "deterministic") -> list[Case]:
     """Every sea x seed x combination of the varied values. roles: varied name -> "param",
     "scene" or "setting" (see `roles_for`); inputs: the plant's provenance (content hashes),
     part of every case's key. duration, dt and method left out: the "sweep.*" defaults.
     design: each case's controller is tuned for its sea (controllers.sea_design); robust:
-    within the robustness floors."""
+    within the robustness floors; amplitudes: the seas' ("deterministic" or "random",
+    waves.irregular)."""
     duration = defaults.resolve("sweep.duration", duration)
     dt, method = defaults.resolve("sweep.dt", dt), defaults.resolve("sweep.method", method)
     vary = dict(vary or {})
@@ -93,7 +98,7 @@ def build_cases(model: str, seas, *, seeds: int = 1, vary: dict | None = None, r
                           tuple(sorted((scene_params or {}).items())), controller,
                           tuple(sorted((settings or {}).items())), float(duration), float(dt),
                           method, dict(roles or {}), tuple(sorted((inputs or {}).items())),
-                          bool(design), bool(robust)))
+                          bool(design), bool(robust), amplitudes))
     return cases
 
 

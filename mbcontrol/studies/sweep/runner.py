@@ -65,7 +65,7 @@ def run_case(case) -> dict:
         direction = math.radians(case.direction_deg)
     wave = waves.irregular(sea.hs, sea.tp, gamma=sea.gamma, seed=case.seed,
                            duration=case.duration, data_band=(float(omega[0]), float(omega[-1])),
-                           direction=direction)
+                           direction=direction, amplitudes=case.amplitudes)
     controller, designed = None, None
     start = time.perf_counter()
     if case.design:      # tuned for this sea; settings given with --set take precedence

@@ -26,7 +26,7 @@ def sweep(model: str, seas, *, seeds: int = 1, vary: dict | None = None, params=
           duration: float | None = None, dt: float | None = None, method: str | None = None,
           store=None, workers: int | None = 0, scheduler: str | None = None,
           width: float | None = None, progress: bool = True, design: bool = False,
-          robust: bool = False):
+          robust: bool = False, amplitudes: str = "deterministic"):
     """Run a sweep and return (Dataset, summary).
 
     seas: SeaStates (`cases.grid`, `cases.read_seas`); vary: name -> values (scene
@@ -35,7 +35,10 @@ def sweep(model: str, seas, *, seeds: int = 1, vary: dict | None = None, params=
     finished cases are not run again; `<store>/sweep.nc` holds the Dataset); width: the
     characteristic width (m) for the capture width ratio. design: the controller is tuned for
     each sea (controllers.sea_design; per sea "settings", "bound_W", "percent_of_bound" in the
-    summary); robust: a reactive law tuned within the robustness floors. duration, dt (s) and method left out
+    summary); robust: a reactive law tuned within the robustness floors; amplitudes:
+    "deterministic" (the expected power) or "random" (Rayleigh: a record's statistics;
+    waves.irregular). With several seeds each sea gets its standard error and 95 % interval
+    (seed_statistics). duration, dt (s) and method left out
     take the defaults "sweep.duration" (600 s), "sweep.dt" (0.05 s) and "sweep.method"
     (mbcontrol.defaults)."""
     from mbcontrol.controllers import REGISTRY
@@ -67,12 +70,13 @@ def sweep(model: str, seas, *, seeds: int = 1, vary: dict | None = None, params=
     cases = build_cases(model, seas, seeds=seeds, vary=vary, roles=roles, params=params,
                         scene_params=scene_params, controller=controller, settings=settings,
                         duration=duration, dt=dt, method=method, inputs=inputs,
-                        design=design, robust=robust)
+                        design=design, robust=robust, amplitudes=amplitudes)
     case_store = CaseStore(store, inputs)
     run = execute(cases, case_store, workers=workers, scheduler=scheduler, progress=progress)
     depth, rho, g = scene.water.depth, scene.water.rho, scene.water.g
     made_by = {**inputs, "controller": controller,
-               "settings": resolved_settings(controller, settings, vary, roles)}
+               "settings": resolved_settings(controller, settings, vary, roles),
+               "amplitudes": amplitudes}
     if design:
         made_by["settings"] = {"designed_per_sea": True, "robust": bool(robust),
                                "given": dict(settings or {})}
@@ -148,6 +152,8 @@ def _summary(ds, seas, run, wall, n_cases) -> dict:
                "failed_cases": int(failed.isel(sea=k).sum())}
         if not math.isnan(s.te):
             row["te"] = s.te
+        if ds.sizes["seed"] > 1 and np.ndim(p) == 0:
+            row.update(seed_statistics(ds["mean_power_W"].isel(sea=k).values))
         if "bound_W" in ds:                 # --design: the sea's settings and its bound
             row.update(_designed_row(ds, k))
         if "capture_width_ratio" in ds:
@@ -203,6 +209,25 @@ def _summary(ds, seas, run, wall, n_cases) -> dict:
             "weighted_mean_power_W": weighted, "annual_energy_MWh": aep,
             "annual_energy_coverage": coverage if aep is not None else None,
             "annual_energy_unchecked_MWh": unchecked}
+
+
+def seed_statistics(powers) -> dict:
+    """A sea's mean power over its valid seeds (W) as an estimate: its standard error s / sqrt(n)
+    and the 95 % interval mean +- t(0.975, n - 1) s / sqrt(n) (Student), from n >= 2 valid
+    seeds; valid_seeds: n. Each seed is an independent record (with random amplitudes, a
+    record's statistics; with deterministic ones the spread is what the phases leave over the
+    record)."""
+    from scipy.stats import t as student
+    x = np.asarray(powers, float)
+    x = x[np.isfinite(x)]
+    out = {"valid_seeds": int(x.size)}
+    if x.size < 2:
+        return {**out, "mean_power_stderr_W": None, "mean_power_ci95_W": None}
+    stderr = float(np.std(x, ddof=1) / np.sqrt(x.size))
+    half = float(student.ppf(0.975, x.size - 1)) * stderr
+    mean = float(np.mean(x))
+    return {**out, "mean_power_stderr_W": stderr,
+            "mean_power_ci95_W": [mean - half, mean + half]}
 
 
 def _designed_row(ds, k: int) -> dict:
