@@ -15,15 +15,21 @@ phases = 3
 """
 
 
-def with_drivetrain(folder: Path, model: str, *, gear=12.0, kt=6.7, resistance="0.5 ohm",
-                    inertia=2.0, friction=1.0) -> Path:
-    """`folder/<model>_dt.toml`: the catalogue scene, its hydro file made absolute, with the
-    drivetrain table appended to its only PTO (it must be the file's last table)."""
+def catalogue_copy(folder: Path, model: str, suffix: str, appended: str) -> Path:
+    """`folder/<model>_<suffix>.toml`: the catalogue scene, its hydro file made absolute,
+    with `appended` added to its last table (its only PTO in the scenes used here)."""
     text = (catalogue_dir() / f"{model}.toml").read_text()
     text = text.replace('file = "', f'file = "{catalogue_dir()}/')
     text = "\n".join(line for line in text.splitlines()
                      if not line.startswith(("source =", "source_bodies")))
-    path = folder / f"{model}_dt.toml"
-    path.write_text(text + DRIVETRAIN.format(gear=gear, kt=kt, resistance=resistance,
-                                             inertia=inertia, friction=friction))
+    path = folder / f"{model}_{suffix}.toml"
+    path.write_text(text + appended)
     return path
+
+
+def with_drivetrain(folder: Path, model: str, *, gear=12.0, kt=6.7, resistance="0.5 ohm",
+                    inertia=2.0, friction=1.0) -> Path:
+    """`folder/<model>_dt.toml`: the catalogue scene with the drivetrain table appended to its
+    only PTO (it must be the file's last table)."""
+    return catalogue_copy(folder, model, "dt", DRIVETRAIN.format(
+        gear=gear, kt=kt, resistance=resistance, inertia=inertia, friction=friction))

@@ -4,26 +4,21 @@ project is judged by). rm3 rated at 300 kW, a test copy of the catalogue scene."
 import json
 
 import pytest
+from drivetrain_scenes import catalogue_copy
 
 from mbcontrol import waves
 from mbcontrol.cli import main
 from mbcontrol.controllers.passive import optimal_damping
 from mbcontrol.controllers.reactive import reactive_tuning
 from mbcontrol.plant import build_plant
-from mbcontrol.scene import catalogue_dir, load_scene
+from mbcontrol.scene import load_scene
 
 RATED = 3e5
 
 
 def rated_rm3(folder):
     """rm3 with its PTO rated at 300 kW (the PTO table is the scene's last)."""
-    text = (catalogue_dir() / "rm3.toml").read_text()
-    text = text.replace('file = "', f'file = "{catalogue_dir()}/')
-    text = "\n".join(line for line in text.splitlines()
-                     if not line.startswith(("source =", "source_bodies")))
-    path = folder / "rm3_rated.toml"
-    path.write_text(text + '\nrated_power = "300 kW"\n')
-    return path
+    return catalogue_copy(folder, "rm3", "rated", '\nrated_power = "300 kW"\n')
 
 
 def test_the_scene_key_reads_in_watts(tmp_path):
