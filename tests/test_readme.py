@@ -56,6 +56,7 @@ TABLES = {
     "floats": ("measured", "benchmarks/array_scaling.py"),
     "farm at PacWave South, 32 seas": ("measured", "--isolated n=1"),
     "R": ("measured", "benchmarks/interaction_cutoff.py"),
+    "rm3 at PacWave South, reactive, designed per sea": ("measured", "--amplitudes random"),
 }
 MODEL_TABLES = {"mbcontrol (method, dt, radiation tol)": ("measured", "benchmarks/speed.py"),
                 "C step median / p99 / max (us)": ("measured", "benchmarks/export_step.py"),

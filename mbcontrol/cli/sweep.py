@@ -39,10 +39,33 @@ The --json summary is a contract: {"model", "cases", "computed", "reused", "wall
 "percent_of_bound", "inside_envelope" and "meets_robustness_floors", and with a PTO
 rated_power "rated_power_W" (the weighted figures then cap each sea's power at it), and with
 --seeds N >= 2 per sea "valid_seeds", "mean_power_stderr_W" and "mean_power_ci95_W" [lo,
-hi] (Student's t over the valid seeds)} (per sea, means over the valid seeds; lists over the varied values when --vary
+hi] (Student's t over the valid seeds) with "power_std_W", "power_min_W", "power_max_W"
+(IEC TS 62600-100 Annex D's per-bin statistics), and for a linear law (the scene's PTO law,
+passive, reactive; nothing varied) per sea "spectral_cv" (one record's mean power: its
+standard deviation over records / mean, from the frequency-domain solution), "bandwidth_hz"
+(B_s of the power density), "effective_samples" (valid seeds / cv^2) and
+"spectral_stderr_W", and for a weighted list "annual_energy_ci95_MWh" [lo, hi] and
+"annual_energy_budget": {"components": [{"component" (statistical, model, radiation_fit,
+parameters, resource), "type" (A or B), "over_seas" (quadrature, linear, one term),
+"std_MWh" (null when absent), "dof", "source", "absent" (why not, or null),
+"share_of_variance"}], "combined_std_MWh", "effective_dof", "coverage_factor", "method"},
+and with --identified per sea "model_std_W" and "parameter_std_W"}
+(per sea, means over the valid seeds; lists over the varied values when --vary
 is given; weighted figures only for a weighted --seas file; a sea with no valid case counts
 as producing nothing there, the share of the year that is valid is annual_energy_coverage,
 and annual_energy_unchecked_MWh is the figure the failed cases would have given).
+
+Error bars: --seeds N (N >= 2) gives each sea its standard error and 95 % interval over
+records; --amplitudes random makes each record a real sea's (Rayleigh amplitudes: what a
+20-minute measured record scatters by; use --duration 1200 as IEC's sea tests do), while the
+default deterministic amplitudes estimate the expected power. The annual energy's budget adds,
+in quadrature, the statistical part (each sea's standard error over its seeds, or with one
+seed of a linear law the spectral estimate), the radiation fit's effect (linear laws), the
+model's error and the parameters' covariance of an identification (--identified
+summary.json: its values are run, its validation error is the model error, its covariance
+goes through linear theory's sensitivities), and the resource's interannual variability when
+the --seas file has weights_<year> columns; a part that cannot be evaluated is listed as
+absent with the reason.
 
 Every case is checked like `simulate`'s results (power bound of its own wave, energy
 balance, linear-hydrodynamics range); a case that fails is counted and listed, never
@@ -72,6 +95,8 @@ Examples:
   mbcontrol sweep oswec --seas ../shared/data/sites/pacwave_cluster_32.csv --width 18 --json
   mbcontrol sweep rm3 --seas ../shared/data/sites/pacwave_cluster_32.csv --controller reactive \
       --design --json
+  mbcontrol sweep sphere --hs 1 2 3 --tp 8 10 --controller passive --set damping=4e5 \
+      --seeds 4 --amplitudes random --json
   mbcontrol sweep array_grid --scene-param n=3 --scene-param scale=25 --isolated n=1 \
       --seas ../shared/data/sites/pacwave_cluster_32.csv --vary direction=0,45
 """
@@ -109,6 +134,10 @@ def add_parser(sub) -> None:
     p.add_argument("--amplitudes", choices=("deterministic", "random"), default="deterministic",
                    help="deterministic: a = sqrt(2 S dw), the expected power (default); random: "
                         "Rayleigh amplitudes, a record's statistics")
+    p.add_argument("--identified", metavar="SUMMARY.json",
+                   help="an identification of this model (`identify --json` or its\n"
+                        "summary.json): its parameter values are run, and its model error\n"
+                        "and covariance enter the annual energy's budget")
     p.add_argument("--duration", type=float,
                    help=f"simulated time per case, s ({default_help('sweep.duration')})")
     p.add_argument("--dt", type=float, help=f"time step, s ({default_help('sweep.dt')})")
@@ -185,6 +214,9 @@ def run_sweep(args) -> int:
                   amplitudes=args.amplitudes)
     scene_params = dict(_key_value(s, "--scene-param") for s in args.scene_param)
     if args.isolated:
+        if args.identified:
+            raise ValueError("--identified with --isolated: not built (a farm's budget); "
+                             "sweep one device with --identified instead")
         if args.design:
             raise ValueError("--design with --isolated: not built (a farm's controllers are "
                              "tuned per device); tune one device with --design instead")
@@ -192,8 +224,11 @@ def run_sweep(args) -> int:
         ds, summary = farm_sweep(args.model, seas, scene_params=scene_params,
                                  isolated=dict(_key_value(s, "--isolated") for s in args.isolated), **common)
     else:
+        from ..waves import read_year_weights
+        years = read_year_weights(args.seas) if args.seas else None
         ds, summary = sweep(args.model, seas, scene_params=scene_params, design=args.design,
-                            robust=args.robust, **common)
+                            robust=args.robust, identified=args.identified, years=years,
+                            **common)
     if args.plot:
         from ..studies.sweep.plots import plot_sweep
         plot_sweep(ds, summary, args.plot)
@@ -208,6 +243,9 @@ def run_sweep(args) -> int:
     for row in summary["seas"]:
         power = row["mean_power_W"]
         text = f"{power / 1e3:10.4g}" if isinstance(power, float) else "  (varied)"
+        if row.get("mean_power_ci95_W"):
+            lo, hi = row["mean_power_ci95_W"]
+            text += f" ±{(hi - lo) / 2e3:.3g}"
         cw = row["capture_width_m"]
         cw_text = f"{cw:8.3g}" if isinstance(cw, float) else "    -"
         weight = f"{row['weight']:8.4f}" if row["weight"] is not None else "       -"
@@ -229,6 +267,12 @@ def run_sweep(args) -> int:
               f"energy {summary['annual_energy_MWh']:.4g} MWh"
               + ("" if share == 1 else f" (valid seas only: {100 * share:.3g} % of the year; a "
                                        f"lower bound)"))
+    if summary.get("annual_energy_ci95_MWh"):
+        from ..studies.sweep.budget import table
+        lo, hi = summary["annual_energy_ci95_MWh"]
+        print(f"  annual energy 95 % interval [{lo:.4g}, {hi:.4g}] MWh; its budget:")
+        print("\n".join("    " + line for line in table(summary["annual_energy_budget"])
+                        .splitlines()))
     if farm and farm["q_annual"] is not None:
         print(f"  farm of {farm['devices']} devices: annual energy {summary['annual_energy_MWh']:.4g} MWh "
               f"against {farm['annual_energy_isolated_MWh']:.4g} MWh for as many devices alone: "

@@ -15,7 +15,7 @@ from .flux import deep_water_flux, energy_flux, spectrum_energy_flux
 from .realisation import (DEFAULT_BAND, Wave, band_limits, from_args, from_elevation,
                           irregular, regular, variance_outside)
 from .sites import (SeaState, grid, occurrence, read_ndbc_spectra, read_seas,
-                    site_energy_flux)
+                    read_year_weights, site_energy_flux)
 from .spectra import gamma_for_te_over_tp, jonswap_spectrum, moment, spectral_hm0_te, te_over_tp
 from .synthesis import ramp
 
@@ -27,6 +27,7 @@ __all__ = [
     "excitation_series", "excitation_at_offsets", "excitation_impulse_response",
     "interpolate_complex",
     "energy_flux", "spectrum_energy_flux", "deep_water_flux",
-    "SeaState", "grid", "read_seas", "site_energy_flux", "read_ndbc_spectra", "occurrence",
+    "SeaState", "grid", "read_seas", "read_year_weights", "site_energy_flux",
+    "read_ndbc_spectra", "occurrence",
     "HOURS_PER_YEAR", "annual_energy_MWh", "bin_seas",
 ]

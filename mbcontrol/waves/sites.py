@@ -120,6 +120,40 @@ def read_seas(path, gamma: float = 3.3) -> list[SeaState]:
     return seas
 
 
+def read_year_weights(path) -> dict[str, np.ndarray]:
+    """label -> weights of each row of a seas CSV in one year, from columns named
+    weights_<label> (e.g. weights_2019): the interannual variability of the resource
+    (`studies.sweep.budget.resource`). {} when the file has none; errors name the file, row
+    and column; each year's weights must sum to 1 within WEIGHT_SUM_TOLERANCE."""
+    path = Path(path)
+    with path.open(newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    columns = [c for c in (rows[0] if rows else {}) if c and c.startswith("weights_")]
+    years = {}
+    for column in columns:
+        values = []
+        for i, row in enumerate(rows, start=2):
+            text = (row.get(column) or "").strip()
+            try:
+                value = float(text)
+            except ValueError:
+                raise ValueError(f"{path}: row {i}, column {column}: expected a number (the "
+                                 f"sea's share of that year), got {text!r}") from None
+            if not value >= 0:
+                raise ValueError(f"{path}: row {i}, column {column}: expected >= 0, got "
+                                 f"{value:g}")
+            values.append(value)
+        total = sum(values)
+        if abs(total - 1.0) > WEIGHT_SUM_TOLERANCE:
+            raise ValueError(f"{path}: column {column} sums to {total:.4g}; expected 1 within "
+                             f"{WEIGHT_SUM_TOLERANCE} (shares of that year)")
+        years[column[len("weights_"):]] = np.array(values) / total
+    if len(years) == 1:
+        raise ValueError(f"{path}: one weights_<year> column ({columns[0]}); interannual "
+                         f"variability needs two or more years")
+    return years
+
+
 def read_ndbc_spectra(path) -> tuple[np.ndarray, np.ndarray, list]:
     """(f in Hz, S in m^2/Hz per row, row stamps) from an NDBC spectral wave density file
     (text or .gz: header 'YY MM DD hh [mm] f1 f2 ...', one hour a row; rows with the

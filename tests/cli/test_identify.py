@@ -65,7 +65,15 @@ def test_identify_json_contract(capsys, tmp_path):
     for p in s["predictions"]:
         lo, hi = p["interval_95"]
         assert 0 <= lo < p["model"] < hi and p["sigma"] > 0 and p["extrapolated"]
-    assert s["prediction_coverage"]["rows"] == 2
+        # two fitted runs give 4 scores, under the 19 a 95 % conformal quantile needs and the 9
+        # the largest score needs to mean 90 %: the parametric interval is kept (no fold is
+        # refitted) and the calibration block says why
+        assert p["interval_95"] == p["interval_95_parametric"]
+        assert p["sigma"] == pytest.approx(math.hypot(p["sigma_parameters"],
+                                                      p["sigma_repeatability"]))
+    assert s["prediction_coverage"]["rows"] == s["prediction_coverage"]["parametric"]["rows"] == 2
+    cal = s["calibration"]
+    assert cal["method"] is None and cal["n_scores"] == 4 and "at least 9 needed" in cal["reason"]
     assert s["simulations"] > 0 and s["wall_time_s"] > 0
     assert s["cost_final"] <= s["cost_initial"]
     assert json.loads((tmp_path / "summary.json").read_text()) == s
@@ -157,3 +165,32 @@ def test_cross_validation_by_series_on_the_shipped_data(capsys):
     code, _, err = run(capsys, "identify", "flume_section", "--data", *files,
                        "--cross-validate", "--candidate", "nothing")
     assert code == 1 and "expected NAME=SPEC[,SPEC...]" in err
+
+
+def test_validate_calibrates_on_folds_of_the_fitted_runs(capsys):
+    """Coarse (dt 0.02 s, 10 s settling): six runs of series 4 and 5 fitted, two of series 6
+    predicted. --validate refits leaving each series out (two folds); 12 scores are too few
+    for 95 %: the largest is used (nominal 12/13), said in the block; interval_95 is the hull
+    of CV+ and the parametric interval; the coverage of both is counted."""
+    files = [str(RUNS / f"{n}.csv.xz") for n in ("4061_1", "4101_2", "5061_1", "5101_1",
+                                                 "4081_2", "5081_1")]
+    held = [str(RUNS / f"{n}.csv.xz") for n in ("6081_1", "6101_2")]
+    fit = ["--fit", "viscous__Roll_linear", "--fit", "section__Roll__added_mass_scale",
+           "--dt", "0.02", "--settle", "10"]
+    code, out, err = run(capsys, "identify", "flume_section", "--data", *files, "--validate",
+                         *held, *fit, "--json")
+    assert code == 0, err
+    s = json.loads(out)
+    cal = s["calibration"]
+    assert cal["method"].startswith("CV+") and cal["folds"] == "leave one series out"
+    assert cal["n_scores"] == 12 and cal["quantile_index"] == 12
+    assert cal["nominal_coverage"] == pytest.approx(12 / 13)
+    assert sorted(cal["fold_runs"]) == ["series 4", "series 5"]
+    assert "the largest is used" in cal["guarantee"] and cal["channels"] == ["Heave", "Roll",
+                                                                             "Sway"]
+    for p in s["predictions"]:
+        lo, hi = p["interval_95"]
+        plo, phi = p["interval_95_parametric"]
+        assert 0 <= lo <= plo < p["model"] < phi <= hi
+        assert hi - lo > phi - plo          # model error: wider than the parametric part
+    assert s["prediction_coverage"]["inside"] >= s["prediction_coverage"]["parametric"]["inside"]

@@ -14,7 +14,8 @@ def run(capsys, *argv):
 
 def test_sweep_json_contract_and_annual_energy(capsys, tmp_path):
     seas = tmp_path / "seas.csv"
-    seas.write_text("Hm0,Tp,weights\n1.0,8,0.5\n2.0,10,0.3\n3.0,12,0.2\n")
+    seas.write_text("Hm0,Tp,weights,weights_2001,weights_2002\n1.0,8,0.5,0.6,0.4\n"
+                    "2.0,10,0.3,0.2,0.4\n3.0,12,0.2,0.2,0.2\n")
     png = tmp_path / "sweep.png"
     code, out, err = run(capsys, "sweep", "sphere", "--seas", str(seas), "--duration", "100",
                          "--dt", "0.1", "--workers", "0", "--width", "10", "--plot", str(png),
@@ -58,6 +59,14 @@ def test_sweep_json_contract_and_annual_energy(capsys, tmp_path):
     assert s["weighted_mean_power_W"] == pytest.approx(weighted)
     assert s["annual_energy_MWh"] == pytest.approx(weighted * 8766 / 1e6)
     assert png.stat().st_size > 20_000
+    # error bars: the scene's linear damper gives each sea its spectral scatter, and the
+    # annual energy an interval with its budget (the resource term from the two years)
+    assert all(r["spectral_cv"] > 0 and r["effective_samples"] > 1 for r in rows)
+    lo, hi = s["annual_energy_ci95_MWh"]
+    assert lo < s["annual_energy_MWh"] < hi
+    parts = {c["component"]: c for c in s["annual_energy_budget"]["components"]}
+    assert set(parts) == {"statistical", "model", "radiation_fit", "parameters", "resource"}
+    assert parts["resource"]["std_MWh"] > 0 and parts["model"]["absent"]
 
 
 def test_sweep_vary_gives_lists(capsys):

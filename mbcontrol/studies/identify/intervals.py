@@ -7,7 +7,9 @@ Two parts, added in quadrature per predicted first-harmonic amplitude a (channel
 - the data's own floor: the measured spread of repeated runs of that channel
   (`report.repeatability`, relative, on the fitted runs), which no model can beat.
 The interval is a +- z sigma with z = 1.96 (95 %), clipped at 0. What it leaves out: model
-error the fitted structure cannot express (the cross-validation table measures that).
+error the fitted structure cannot express (the cross-validation table measures that): on the
+flume data 74 % of held-out amplitudes fell inside. `calibration` widens it by the fitted runs'
+own held-out errors (CV+); `mbcontrol identify --validate` reports that one as interval_95.
 """
 from __future__ import annotations
 
@@ -47,8 +49,9 @@ def prediction_intervals(problem, result, rows: list[dict], floor: dict) -> list
     return out
 
 
-def coverage(rows: list[dict]) -> dict:
-    """{"inside", "rows", "share"}: measured amplitudes inside their 95 % intervals."""
-    inside = sum(r["interval_95"][0] <= r["measured"] <= r["interval_95"][1] for r in rows)
+def coverage(rows: list[dict], key: str = "interval_95") -> dict:
+    """{"inside", "rows", "share"}: measured amplitudes inside their 95 % intervals (`key`:
+    "interval_95" or, once calibrated, "interval_95_parametric")."""
+    inside = sum(r[key][0] <= r["measured"] <= r[key][1] for r in rows)
     return {"inside": int(inside), "rows": len(rows),
             "share": inside / len(rows) if rows else None}

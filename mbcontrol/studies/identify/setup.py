@@ -65,10 +65,12 @@ def channel_outputs(plant, runs) -> dict:
 
 
 def flume_identification(model, files, *, calibration=None, fit=(), drop_bad: bool = False,
-                         runs=None, **options) -> Identification:
+                         runs=None, drop_absent: bool | None = None,
+                         **options) -> Identification:
     """An Identification of `model` (catalogue name or scene path) on flume files (naming
     SPPH[_R], see `flume`), or on `runs` already loaded. fit: NAME[=LO:HI] specs (default:
-    the scene's [identify] table, with parameters the runs cannot see dropped with a warning);
+    the scene's [identify] table, with parameters the runs cannot see dropped with a warning;
+    drop_absent=True drops them from given specs too, as calibration folds need);
     options: Identification's (cost, phase, params, dt, settle, ...)."""
     from ...plant import build_plant
     from ...scene import load_scene
@@ -79,7 +81,8 @@ def flume_identification(model, files, *, calibration=None, fit=(), drop_bad: bo
     full = build_plant(scene, hydro_corrections=True)
     parameters = fit_parameters(scene, dict(zip(full.parameters, full.p0)), list(fit))
     problem = Identification(scene.path, runs, parameters, outputs=channel_outputs(full, runs),
-                             drop_absent=not fit, **options)
+                             drop_absent=not fit if drop_absent is None else drop_absent,
+                             **options)
     extrapolation.warn(problem, "fit")
     return problem
 

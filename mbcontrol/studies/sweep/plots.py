@@ -29,16 +29,45 @@ def _edges(centres) -> np.ndarray:
     return np.concatenate([[c[0] - (mid[0] - c[0])], mid, [c[-1] + (c[-1] - mid[-1])]])
 
 
-def _matrix(fig, ax, ds, table, period):
-    """A grid of sea states: cells on the real Hs and Tp values, annotated, invalid hatched."""
+def spread_95(summary: dict) -> np.ndarray:
+    """Per sea the half-width of its power's 95 % interval over its mean (-, NaN: none): from
+    its seeds (Student), else 1.96 x the spectral standard error of a linear law."""
+    out = []
+    for row in summary["seas"]:
+        mean = row["mean_power_W"]
+        if not isinstance(mean, float) or not mean > 0:
+            out.append(np.nan)
+        elif row.get("mean_power_ci95_W"):
+            lo, hi = row["mean_power_ci95_W"]
+            out.append((hi - lo) / 2 / mean)
+        elif row.get("spectral_stderr_W") is not None:
+            out.append(1.959964 * row["spectral_stderr_W"] / mean)
+        else:
+            out.append(np.nan)
+    return np.array(out, float)
+
+
+def _label(value: float, spread: float) -> str:
+    """A cell's power (kW) with its 95 % spread (%) beneath, when there is one."""
+    return f"{value:.3g}" + (f"\n±{100 * spread:.0f}%" if np.isfinite(spread) else "")
+
+
+def _matrix(fig, ax, ds, table, period, spread=None):
+    """A grid of sea states: cells on the real Hs and Tp values, annotated (power, kW, and
+    its 95 % spread), invalid hatched."""
     import matplotlib.pyplot as plt
     x, y = table[period].values, table.hs.values
     xe, ye = _edges(x), _edges(y)
     image = ax.pcolormesh(xe, ye, np.ma.masked_invalid(table.values), cmap="viridis")
+    spreads = np.full(table.shape, np.nan)
+    if spread is not None:
+        spreads = power_matrix(ds.assign(spread_95=("sea", spread)), "spread_95",
+                               period).values
     if table.size <= 120:
         for (i, j), v in np.ndenumerate(table.values):
             if np.isfinite(v):
-                ax.text(x[j], y[i], f"{v:.3g}", ha="center", va="center", fontsize=6, color="w")
+                ax.text(x[j], y[i], _label(v, spreads[i, j]), ha="center", va="center",
+                        fontsize=6, color="w")
     for (i, j), n in _invalid_cells(ds, table, period).items():   # shown, never averaged
         ax.add_patch(plt.Rectangle((xe[j], ye[i]), xe[j + 1] - xe[j], ye[i + 1] - ye[i],
                                    fill=False, hatch="xx", edgecolor="C3", lw=0))
@@ -49,16 +78,19 @@ def _matrix(fig, ax, ds, table, period):
     ax.set_ylabel("significant wave height Hs, m")
 
 
-def _scattered(fig, ax, ds):
+def _scattered(fig, ax, ds, spread=None):
     """Sea states that do not fill a grid (a site's list): a dot each at its Hs and Tp,
-    coloured and labelled by mean power (kW); invalid ones as red crosses."""
+    coloured and labelled by mean power (kW, and its 95 % spread); invalid ones as red
+    crosses."""
     power = ds["mean_power_W"].mean([d for d in ds["mean_power_W"].dims if d != "sea"]) / 1e3
     ok = np.isfinite(power.values)
+    spread = np.full(ok.size, np.nan) if spread is None else spread
     dots = ax.scatter(ds["tp"].values[ok], ds["hs"].values[ok], c=power.values[ok],
                       cmap="viridis", s=60, edgecolor="k", lw=0.3)
-    for tp, hs, v in zip(ds["tp"].values[ok], ds["hs"].values[ok], power.values[ok]):
-        ax.annotate(f"{v:.3g}", (tp, hs), textcoords="offset points", xytext=(0, 5),
-                    ha="center", fontsize=6)
+    for tp, hs, v, e in zip(ds["tp"].values[ok], ds["hs"].values[ok], power.values[ok],
+                            spread[ok]):
+        ax.annotate(_label(v, e), (tp, hs), textcoords="offset points", xytext=(0, 5),
+                    ha="center", fontsize=5.5)
     if (~ok).any():
         ax.scatter(ds["tp"].values[~ok], ds["hs"].values[~ok], marker="x", color="C3", s=30,
                    label="invalid (left out)")
@@ -81,17 +113,21 @@ def plot_sweep(ds, summary: dict, path=None):
     from ...plotting import save
     weighted = summary.get("annual_energy_MWh") is not None
     designed = "bound_W" in ds
-    n = 2 + weighted + designed
+    budgeted = summary.get("annual_energy_budget") is not None
+    n = 2 + weighted + designed + budgeted
     fig, axes = plt.subplots(1, n, figsize=(5.3 * n, 4.4))
     period = "tp"
     try:
         table = power_matrix(ds, period=period) / 1e3
+        spread = spread_95(summary) if ds["mean_power_W"].ndim == 2 else None
         if np.isfinite(table.values).mean() >= 0.5:
-            _matrix(fig, axes[0], ds, table, period)
+            _matrix(fig, axes[0], ds, table, period, spread)
         else:                       # a site's scattered list: each sea state where it lies
-            _scattered(fig, axes[0], ds)
+            _scattered(fig, axes[0], ds, spread)
         n_bad = summary.get("invalid_cases", 0)
-        axes[0].set_title(f"{ds.attrs.get('model')}: mean power by sea state"
+        axes[0].set_title(f"{ds.attrs.get('model')}: mean power by sea state, kW"
+                          + (" (± 95 % spread)" if spread is not None
+                             and np.isfinite(spread).any() else "")
                           + (f"\n{n_bad} invalid cases left out (red crosses / hatched)"
                              if n_bad else ""), fontsize=9)
     except ValueError as exc:                       # other quantities varied: no single table
@@ -122,7 +158,9 @@ def plot_sweep(ds, summary: dict, path=None):
         ax.set_title(f"annual energy {summary['annual_energy_MWh']:.4g} MWh: each sea state's "
                      f"share (area)", fontsize=9)
     if designed:
-        _share_of_bound(fig, axes[-1], ds)
+        _share_of_bound(fig, axes[2 + weighted], ds)
+    if budgeted:
+        _budget(axes[-1], summary)
     fig.tight_layout()
     if path is not None:
         save(fig, path)
@@ -150,3 +188,24 @@ def _share_of_bound(fig, ax, ds):
     ax.set_ylabel("significant wave height Hs, m")
     ax.grid(alpha=0.3)
     ax.set_title("designed per sea: share of the bound", fontsize=9)
+
+
+def _budget(ax, summary):
+    """The annual energy's budget: each component's standard uncertainty (MWh, 1 sigma) as a
+    bar, absent ones named with a dash; the annual energy and its 95 % interval in the title."""
+    rows = summary["annual_energy_budget"]["components"]
+    names = [r["component"].replace("_", " ") for r in rows]
+    values = [r["std_MWh"] or 0.0 for r in rows]
+    y = np.arange(len(rows))[::-1]
+    ax.barh(y, values, color=["C0" if r["type"] == "A" else "C1" for r in rows])
+    for yi, r in zip(y, rows):
+        text = "absent" if r["std_MWh"] is None else \
+            f"{r['std_MWh']:.3g} ({100 * r['share_of_variance']:.0f} %)"
+        ax.text(0, yi, " " + text, va="center", fontsize=7)
+    ax.set_yticks(y, [f"{n} ({r['type']})" for n, r in zip(names, rows)], fontsize=8)
+    ax.set_xlabel("standard uncertainty of the annual energy, MWh (1 sigma)")
+    lo, hi = summary["annual_energy_ci95_MWh"]
+    ax.set_title(f"annual energy {summary['annual_energy_MWh']:.4g} MWh, 95 % interval "
+                 f"[{lo:.4g}, {hi:.4g}]\n(A statistical, B systematic; share of the "
+                 f"variance)", fontsize=9)
+    ax.grid(alpha=0.3, axis="x")

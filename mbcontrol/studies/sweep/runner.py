@@ -53,19 +53,12 @@ def run_case(case) -> dict:
 
     from mbcontrol.controllers import REGISTRY, make
 
-    from ... import waves
     from ...sim import light, simulate
     params, scene_params, settings = case.resolved()
     plant = _plant(case.model, tuple(sorted(scene_params.items())))
-    sea = case.sea
-    headings = plant.hydro.data["wave_direction"].values
-    omega = plant.hydro.omega
-    direction = float(headings[0]) if len(headings) == 1 else 0.0
-    if case.direction_deg is not None:
-        direction = math.radians(case.direction_deg)
-    wave = waves.irregular(sea.hs, sea.tp, gamma=sea.gamma, seed=case.seed,
-                           duration=case.duration, data_band=(float(omega[0]), float(omega[-1])),
-                           direction=direction, amplitudes=case.amplitudes)
+    direction = None if case.direction_deg is None else math.radians(case.direction_deg)
+    wave = sea_wave(plant, case.sea, case.duration, seed=case.seed, direction=direction,
+                    amplitudes=case.amplitudes)
     controller, designed = None, None
     start = time.perf_counter()
     if case.design:      # tuned for this sea; settings given with --set take precedence
@@ -95,6 +88,20 @@ def run_case(case) -> dict:
     if designed is not None:
         record["design"] = designed
     return record
+
+
+def sea_wave(plant, sea, duration: float, *, seed: int = 0, direction: float | None = None,
+             amplitudes: str = "deterministic"):
+    """The wave a case of `sea` runs in: JONSWAP cut to the hydro data's band, seeded; its
+    heading the data's one heading, or `direction` (rad), or 0."""
+    from ... import waves
+    headings = plant.hydro.data["wave_direction"].values
+    omega = plant.hydro.omega
+    if direction is None:
+        direction = float(headings[0]) if len(headings) == 1 else 0.0
+    return waves.irregular(sea.hs, sea.tp, gamma=sea.gamma, seed=seed, duration=duration,
+                           data_band=(float(omega[0]), float(omega[-1])), direction=direction,
+                           amplitudes=amplitudes)
 
 
 def failed_record(case, exc: BaseException, start: float) -> dict:

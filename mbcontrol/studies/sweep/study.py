@@ -26,7 +26,8 @@ def sweep(model: str, seas, *, seeds: int = 1, vary: dict | None = None, params=
           duration: float | None = None, dt: float | None = None, method: str | None = None,
           store=None, workers: int | None = 0, scheduler: str | None = None,
           width: float | None = None, progress: bool = True, design: bool = False,
-          robust: bool = False, amplitudes: str = "deterministic"):
+          robust: bool = False, amplitudes: str = "deterministic", identified=None,
+          years: dict | None = None):
     """Run a sweep and return (Dataset, summary).
 
     seas: SeaStates (`cases.grid`, `cases.read_seas`); vary: name -> values (scene
@@ -38,7 +39,10 @@ def sweep(model: str, seas, *, seeds: int = 1, vary: dict | None = None, params=
     summary); robust: a reactive law tuned within the robustness floors; amplitudes:
     "deterministic" (the expected power) or "random" (Rayleigh: a record's statistics;
     waves.irregular). With several seeds each sea gets its standard error and 95 % interval
-    (seed_statistics). duration, dt (s) and method left out
+    (seed_statistics). identified: an identification's summary (path): its parameter values
+    are run (params given explicitly win) and its covariance and model error enter the annual
+    energy's budget (`uncertainty`); years: label -> per-year weights of the seas
+    (`waves.read_year_weights`), the budget's resource term. duration, dt (s) and method left out
     take the defaults "sweep.duration" (600 s), "sweep.dt" (0.05 s) and "sweep.method"
     (mbcontrol.defaults)."""
     from mbcontrol.controllers import REGISTRY
@@ -62,6 +66,10 @@ def sweep(model: str, seas, *, seeds: int = 1, vary: dict | None = None, params=
     plant = build_plant(scene)
     _PLANTS[(model, tuple(sorted((scene_params or {}).items())))] = plant   # serial path: reuse
     roles = roles_for(vary, scene, plant.parameters, REGISTRY.get(controller))
+    if identified is not None:
+        from .uncertainty import read_identified
+        identified = read_identified(identified, scene.name, plant.parameters)
+        params = {**identified["values"], **dict(params or {})}
     unknown = [p for p in (params or {}) if p not in plant.parameters]
     if unknown:
         raise ValueError(f"--param {unknown[0]}: not a parameter of {scene.name}; it has "
@@ -77,6 +85,8 @@ def sweep(model: str, seas, *, seeds: int = 1, vary: dict | None = None, params=
     made_by = {**inputs, "controller": controller,
                "settings": resolved_settings(controller, settings, vary, roles),
                "amplitudes": amplitudes}
+    if identified is not None:
+        made_by["identified"] = identified["source"]
     if design:
         made_by["settings"] = {"designed_per_sea": True, "robust": bool(robust),
                                "given": dict(settings or {})}
@@ -104,6 +114,10 @@ def sweep(model: str, seas, *, seeds: int = 1, vary: dict | None = None, params=
     why = None if design else absorbs_nothing(controller, settings, vary)
     if why:
         summary["notes"].insert(0, why)
+    from .uncertainty import add_uncertainty
+    add_uncertainty(summary, ds, seas, plant, controller=controller, settings=settings,
+                    params=params, duration=duration, amplitudes=amplitudes,
+                    identified=identified, years=years)
     summary["provenance"] = made_by
     if "rated_power_W" in ds.attrs:
         summary["rated_power_W"] = float(ds.attrs["rated_power_W"])
@@ -214,7 +228,8 @@ def _summary(ds, seas, run, wall, n_cases) -> dict:
 def seed_statistics(powers) -> dict:
     """A sea's mean power over its valid seeds (W) as an estimate: its standard error s / sqrt(n)
     and the 95 % interval mean +- t(0.975, n - 1) s / sqrt(n) (Student), from n >= 2 valid
-    seeds; valid_seeds: n. Each seed is an independent record (with random amplitudes, a
+    seeds; valid_seeds: n; and IEC TS 62600-100 Annex D's per-bin statistics of the records
+    (power_std_W, power_min_W, power_max_W; the count is valid_seeds). Each seed is an independent record (with random amplitudes, a
     record's statistics; with deterministic ones the spread is what the phases leave over the
     record)."""
     from scipy.stats import t as student
@@ -223,11 +238,13 @@ def seed_statistics(powers) -> dict:
     out = {"valid_seeds": int(x.size)}
     if x.size < 2:
         return {**out, "mean_power_stderr_W": None, "mean_power_ci95_W": None}
-    stderr = float(np.std(x, ddof=1) / np.sqrt(x.size))
+    std = float(np.std(x, ddof=1))
+    stderr = std / math.sqrt(x.size)
     half = float(student.ppf(0.975, x.size - 1)) * stderr
     mean = float(np.mean(x))
     return {**out, "mean_power_stderr_W": stderr,
-            "mean_power_ci95_W": [mean - half, mean + half]}
+            "mean_power_ci95_W": [mean - half, mean + half],
+            "power_std_W": std, "power_min_W": float(x.min()), "power_max_W": float(x.max())}
 
 
 def _designed_row(ds, k: int) -> dict:

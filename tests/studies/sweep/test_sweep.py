@@ -113,7 +113,7 @@ def test_sweep_figure_on_real_axes(tmp_path):
     assert ax.get_xlabel() == "peak period Tp, s" and ax.get_ylabel().endswith("Hs, m")
     lo, hi = ax.get_xlim()
     assert lo < 8.0 and 11.0 < hi and ax.get_ylim()[0] < 1.0 < 2.0 < ax.get_ylim()[1]
-    texts = {t.get_text() for t in ax.texts}
+    texts = {t.get_text().split("\n")[0] for t in ax.texts}     # power, then its spread
     kw = ds["mean_power_W"].mean("seed").values / 1e3 if "seed" in ds["mean_power_W"].dims \
         else ds["mean_power_W"].values / 1e3
     assert {f"{v:.3g}" for v in np.ravel(kw)} <= texts
@@ -169,6 +169,19 @@ def test_random_amplitudes_give_intervals_that_hold():
         < row["mean_power_ci95_W"][1]
     assert row["mean_power_stderr_W"] == pytest.approx(
         np.std(ds["mean_power_W"].isel(sea=0).values, ddof=1) / 6)
+    # the spectral CV (frequency-domain solution, no simulation) against the 36 records'
+    # scatter: a record's mean power is near a sum of N_eff = 1 / cv^2 exponentials (a gamma
+    # law, excess kurtosis 6 / N_eff), so the sample std's relative standard error is
+    # 0.5 sqrt(2 / (n - 1) + 6 / (N_eff n)); each sea within 3 of them
+    for k, row in enumerate(result["seas"]):
+        powers = ds["mean_power_W"].isel(sea=k).values
+        cv = row["spectral_cv"]
+        n_eff = 1 / cv ** 2
+        assert row["effective_samples"] == pytest.approx(36 * n_eff)
+        se = 0.5 * np.sqrt(2 / 35 + 6 / (n_eff * 36))
+        observed = np.std(powers, ddof=1) / np.mean(powers)
+        assert abs(observed / cv - 1) < 3 * se, (row["hs"], row["tp"], observed, cv)
+        assert row["spectral_stderr_W"] == pytest.approx(cv * row["mean_power_W"] / 6)
 
 
 def test_random_amplitudes_scatter_hs_deterministic_ones_do_not():

@@ -1,0 +1,167 @@
+"""How sure a sweep's numbers are: per sea the spectral scatter of a linear law's power, and for
+a weighted list the annual energy's 95 % interval with its budget (`budget`).
+
+Inputs beyond the sweep itself: an identification's summary (`mbcontrol identify --json` or
+its summary.json: the fitted parameters, their covariance and the model's relative amplitude
+error) and a site file's per-year weights (`waves.read_year_weights`).
+"""
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+
+from . import budget as bud
+from .spectral import radiation_fit_effect, parameter_gradient, sea_components, sea_gains, \
+    spectral_row
+
+
+def read_identified(path, model: str, plant_parameters) -> dict:
+    """{"values": name -> value, "names", "covariance", "model_error", "model_error_source",
+    "source"} from an identification summary; errors name the file and the field."""
+    path = Path(path)
+    try:
+        summary = json.loads(path.read_text())
+    except (OSError, json.JSONDecodeError) as exc:
+        raise ValueError(f"{path}: cannot read an identification summary ({exc})") from None
+    for field in ("model", "parameters", "correlation", "fit"):
+        if field not in summary:
+            raise ValueError(f"{path}: field {field!r} missing (expected the JSON of "
+                             f"`mbcontrol identify --json` or its summary.json)")
+    if summary["model"] != model:
+        raise ValueError(f"{path}: field 'model' is {summary['model']!r}; this sweep runs "
+                         f"{model!r} (an identification applies to the model it fitted)")
+    names_all = list(summary["parameters"])
+    unknown = [n for n in names_all if n not in plant_parameters]
+    if unknown:
+        raise ValueError(f"{path}: field 'parameters' names {unknown[0]!r}, not a parameter "
+                         f"of {model} ({', '.join(plant_parameters)})")
+    values = {n: float(summary["parameters"][n]["value"]) for n in names_all}
+    keep = [i for i, n in enumerate(names_all) if summary["parameters"][n].get("std")]
+    names = [names_all[i] for i in keep]
+    std = np.array([summary["parameters"][n]["std"] for n in names], float)
+    corr = np.asarray(summary["correlation"], float)
+    if corr.shape != (len(names_all), len(names_all)):
+        raise ValueError(f"{path}: field 'correlation' is {corr.shape}; expected "
+                         f"{len(names_all)} x {len(names_all)} (one row per parameter)")
+    cov = corr[np.ix_(keep, keep)] * np.outer(std, std)
+    block, where = (summary.get("validation"), "validation runs (out of sample)")
+    if not block or block.get("rms_error") is None:
+        block, where = summary["fit"], "fitted runs (in sample: optimistic)"
+    return {"values": values, "names": names, "covariance": cov,
+            "model_error": float(block["rms_error"]), "model_error_source": where,
+            "source": str(path)}
+
+
+def add_uncertainty(summary: dict, ds, seas, plant, *, controller, settings, params,
+                    duration: float, amplitudes: str, identified: dict | None = None,
+                    years: dict | None = None) -> None:
+    """Adds to `summary` (in place): per sea the spectral entries of a linear law, and for a
+    weighted list "annual_energy_ci95_MWh" and "annual_energy_budget" (with an
+    identification also per sea "model_std_W" and "parameter_std_W", W)."""
+    rows = summary["seas"]
+    if ds["mean_power_W"].ndim != 2:           # other quantities varied: no single law per sea
+        return
+    laws, why_not, waves = [], None, []
+    for k, sea in enumerate(seas):
+        gains, why = sea_gains(ds, k, plant, controller, settings, params)
+        laws.append(gains)
+        why_not = why_not or why
+        if gains is None:
+            waves.append(None)
+            continue
+        wave, rms = sea_components(plant, sea, duration)
+        waves.append(wave)
+        n_valid = rows[k].get("valid_seeds", int(ds["valid"].isel(sea=k).sum()))
+        rows[k].update(spectral_row(plant, wave, rms, gains, duration, amplitudes, n_valid,
+                                    rows[k]["mean_power_W"]))
+    if summary.get("annual_energy_MWh") is None:
+        return
+    weights = np.array([s.weight for s in seas])
+    power = np.array([np.nan if r["mean_power_W"] is None else r["mean_power_W"]
+                      for r in rows], float)
+    rated = summary.get("rated_power_W")
+    capped = power >= rated if rated else np.zeros(power.size, bool)
+    linear = all(g is not None for g in laws)
+    components = [_statistical(rows, weights)]
+    components.append(_model(identified, weights, power, capped))
+    if identified is not None:           # each sea's own share of the model's error
+        for k, row in enumerate(rows):
+            row["model_std_W"] = None if capped[k] or not np.isfinite(power[k]) else \
+                2 * identified["model_error"] * power[k]
+    if linear:
+        effect = np.array([0.0 if capped[k] else radiation_fit_effect(plant, waves[k], laws[k],
+                                                                      params)
+                           for k in range(len(seas))])
+        components.append(bud.linear_over_seas(
+            "radiation_fit", weights, effect * np.nan_to_num(power),
+            "linear theory's power with the state-space radiation fit over that with the BEM "
+            "data, per sea, times the simulated power"))
+    else:
+        components.append(bud.absent("radiation_fit", "B", "linear",
+                                     f"needs a linear law ({why_not})"))
+    components.append(_parameters(identified, weights, plant, waves, laws, params, controller,
+                                  capped, why_not, power, rows))
+    power_valid = np.where(np.isfinite(power), power, 0.0)
+    if rated:
+        power_valid = np.minimum(power_valid, rated)
+    components.append(bud.resource(years, power_valid) if years else bud.absent(
+        "resource", "A", "one term", "the site file has one set of weights (give "
+        "weights_<year> columns, one per year, for the interannual variability)"))
+    ci, table = bud.combine(summary["annual_energy_MWh"], components)
+    if capped.any():
+        table["notes"] = [f"{int(capped.sum())} seas at the rated power carry no model, "
+                          f"radiation or parameter uncertainty (the cap holds their power)"]
+    summary["annual_energy_ci95_MWh"] = ci
+    summary["annual_energy_budget"] = table
+
+
+def _statistical(rows, weights) -> dict:
+    stderr, dof = [], []
+    for r in rows:
+        if r.get("mean_power_stderr_W") is not None:
+            stderr.append(r["mean_power_stderr_W"])
+            dof.append(r["valid_seeds"] - 1)
+        elif r.get("spectral_stderr_W") is not None:
+            stderr.append(r["spectral_stderr_W"])
+            dof.append(math.inf)
+        else:
+            stderr.append(math.nan)
+            dof.append(math.inf)
+    return bud.statistical(weights, stderr, dof)
+
+
+def _model(identified, weights, power, capped) -> dict:
+    if identified is None:
+        return bud.absent("model", "B", "linear", "no identification given (--identified): "
+                          "the model's error against measurements is not known here")
+    r = identified["model_error"]
+    per_sea = np.where(capped, 0.0, 2 * r * np.nan_to_num(power))
+    return bud.linear_over_seas(
+        "model", weights, per_sea,
+        f"identification's RMS relative amplitude error {100 * r:.3g} % on its "
+        f"{identified['model_error_source']}, x2 for power ({identified['source']})")
+
+
+def _parameters(identified, weights, plant, waves, laws, params, controller, capped,
+                why_not, power, rows) -> dict:
+    if identified is None or not identified["names"]:
+        return bud.absent("parameters", "B", "linear",
+                          "no identified parameters with standard errors (--identified)")
+    if any(g is None for g in laws):
+        return bud.absent("parameters", "B", "linear", f"needs a linear law ({why_not})")
+    values = {**identified["values"], **dict(params or {})}
+    grads = np.array([np.zeros(len(identified["names"])) if capped[k] or not power[k] > 0
+                      else power[k] * parameter_gradient(plant, waves[k], laws[k],
+                                                         identified["names"], values,
+                                                         scene_law=controller is None)
+                      for k in range(len(waves))])
+    for k, row in enumerate(rows):        # each sea's spread from the parameters alone
+        row["parameter_std_W"] = float(np.sqrt(max(grads[k] @ identified["covariance"]
+                                                   @ grads[k], 0.0)))
+    return bud.parameters(weights, grads, identified["covariance"], identified["names"],
+                          f"{len(identified['names'])} identified parameters' covariance "
+                          f"through linear theory's relative sensitivities (central "
+                          f"differences) times the simulated power")
