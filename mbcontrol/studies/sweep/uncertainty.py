@@ -85,7 +85,7 @@ def add_uncertainty(summary: dict, ds, seas, plant, *, controller, settings, par
     rated = summary.get("rated_power_W")
     capped = power >= rated if rated else np.zeros(power.size, bool)
     linear = all(g is not None for g in laws)
-    components = [_statistical(rows, weights)]
+    components = [_statistical(rows, weights, power, capped)]
     components.append(_model(identified, weights, power, capped))
     if identified is not None:           # each sea's own share of the model's error
         for k, row in enumerate(rows):
@@ -111,17 +111,28 @@ def add_uncertainty(summary: dict, ds, seas, plant, *, controller, settings, par
         "resource", "A", "one term", "the site file has one set of weights (give "
         "weights_<year> columns, one per year, for the interannual variability)"))
     ci, table = bud.combine(summary["annual_energy_MWh"], components)
+    notes = []
     if capped.any():
-        table["notes"] = [f"{int(capped.sum())} seas at the rated power carry no model, "
-                          f"radiation or parameter uncertainty (the cap holds their power)"]
+        notes.append(f"{int(capped.sum())} seas at the rated power carry no uncertainty (the "
+                     f"cap holds their power)")
+    if summary.get("annual_energy_coverage", 1.0) < 1.0:
+        notes.append("seas with no valid case count as producing nothing: the interval is on "
+                     "a lower bound of the annual energy (annual_energy_coverage)")
+    if notes:
+        table["notes"] = notes
     summary["annual_energy_ci95_MWh"] = ci
     summary["annual_energy_budget"] = table
 
 
-def _statistical(rows, weights) -> dict:
+def _statistical(rows, weights, power, capped) -> dict:
+    """Each sea's standard error: from its seeds, else spectral; none where its power is held
+    (capped at the rated power) or counted as nothing (no valid case)."""
     stderr, dof = [], []
-    for r in rows:
-        if r.get("mean_power_stderr_W") is not None:
+    for r, p, held in zip(rows, power, capped):
+        if held or not np.isfinite(p):
+            stderr.append(0.0)
+            dof.append(math.inf)
+        elif r.get("mean_power_stderr_W") is not None:
             stderr.append(r["mean_power_stderr_W"])
             dof.append(r["valid_seeds"] - 1)
         elif r.get("spectral_stderr_W") is not None:
