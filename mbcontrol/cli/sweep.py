@@ -62,8 +62,8 @@ default deterministic amplitudes estimate the expected power. The annual energy'
 in quadrature, the statistical part (each sea's standard error over its seeds, or with one
 seed of a linear law the spectral estimate), the radiation fit's effect (linear laws), the
 model's error and the parameters' covariance of an identification (--identified
-summary.json: its values are run, its validation error is the model error, its covariance
-goes through linear theory's sensitivities), and the resource's interannual variability when
+summary.json: its values are run, its calibrated error (else its validation error) is the
+model error, its covariance goes through linear theory's sensitivities), and the resource's interannual variability when
 the --seas file has weights_<year> columns; a part that cannot be evaluated is listed as
 absent with the reason.
 

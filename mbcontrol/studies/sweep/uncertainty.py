@@ -47,12 +47,25 @@ def read_identified(path, model: str, plant_parameters) -> dict:
         raise ValueError(f"{path}: field 'correlation' is {corr.shape}; expected "
                          f"{len(names_all)} x {len(names_all)} (one row per parameter)")
     cov = corr[np.ix_(keep, keep)] * np.outer(std, std)
+    return {"values": values, "names": names, "covariance": cov, **_model_error(summary),
+            "source": str(path)}
+
+
+def _model_error(summary: dict) -> dict:
+    """The identified model's relative amplitude error (1 sigma) and where it comes from: the
+    calibrated one (the CV+ quantile of held-out relative errors at 95 %, / 1.96), else the
+    validation runs' RMS relative error, else the fitted runs' (in sample: optimistic)."""
+    calibration = summary.get("calibration") or {}
+    if calibration.get("quantile") is not None and calibration.get("alpha"):
+        from scipy.stats import norm
+        z = float(norm.ppf(1 - calibration["alpha"] / 2))
+        return {"model_error": float(calibration["quantile"]) / z,
+                "model_error_source": f"calibrated held-out errors ({calibration['method']}, "
+                                      f"quantile {calibration['quantile']:.3g} / {z:.3g})"}
     block, where = (summary.get("validation"), "validation runs (out of sample)")
     if not block or block.get("rms_error") is None:
         block, where = summary["fit"], "fitted runs (in sample: optimistic)"
-    return {"values": values, "names": names, "covariance": cov,
-            "model_error": float(block["rms_error"]), "model_error_source": where,
-            "source": str(path)}
+    return {"model_error": float(block["rms_error"]), "model_error_source": where}
 
 
 def add_uncertainty(summary: dict, ds, seas, plant, *, controller, settings, params,
@@ -152,7 +165,7 @@ def _model(identified, weights, power, capped) -> dict:
     per_sea = np.where(capped, 0.0, 2 * r * np.nan_to_num(power))
     return bud.linear_over_seas(
         "model", weights, per_sea,
-        f"identification's RMS relative amplitude error {100 * r:.3g} % on its "
+        f"identification's relative amplitude error {100 * r:.3g} % (1 sigma) from its "
         f"{identified['model_error_source']}, x2 for power ({identified['source']})")
 
 

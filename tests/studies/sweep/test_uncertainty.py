@@ -107,6 +107,18 @@ def test_identification_of_another_model_is_refused(tmp_path):
         read_identified(path, "sphere", ["pto__damping"])
 
 
+def test_the_calibrated_model_error_is_preferred(tmp_path):
+    """An identification with a CV+ calibration: its 95 % quantile of relative held-out
+    errors / 1.96 is the model's 1-sigma error, before the validation RMS."""
+    path = _identification(tmp_path)
+    summary = json.loads(path.read_text())
+    summary["calibration"] = {"quantile": 0.196, "alpha": 0.05, "method": "CV+"}
+    path.write_text(json.dumps(summary))
+    got = read_identified(path, "sphere", ["pto__damping"])
+    assert got["model_error"] == pytest.approx(0.196 / 1.959964)
+    assert "calibrated" in got["model_error_source"]
+
+
 def test_a_nonlinear_law_says_what_it_lacks(tmp_path):
     """Latching with two seeds: no spectral estimate, no radiation-fit term; each listed as
     absent with its reason, and the interval carries what is known."""
