@@ -151,7 +151,8 @@ def design(plant, wave, name: str, *, pto: str | None = None, simulate_s: float 
     if wave is None:
         raise ValueError(f"design {name!r}: needs a wave to tune for")
     pto_obj = _pto(plant, pto)
-    limit_values = {"force_max": float(pto_obj.force_max), "stroke_max": float(pto_obj.stroke_max)}
+    limit_values = {"force_max": float(pto_obj.force_max), "stroke_max": float(pto_obj.stroke_max),
+                    "force_max_on": pto_obj.limited_force()}   # the machine's force or the hull's
     period = float(wave.period)
     default_dt = dt is None
     dt = period / 1000 if default_dt else float(dt)

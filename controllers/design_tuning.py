@@ -11,6 +11,7 @@ from mbcontrol.results import jsonable
 from mbcontrol.analysis.envelope import ENVELOPE_SHARE
 
 from . import REGISTRY, make
+from .limits import command_limit
 from .tuning import OutsideEnvelope
 
 # the tuned parameters of each controller (the contract of make(name, **parameters))
@@ -48,8 +49,13 @@ def tune(plant, wave, name, pto_obj, limits, model_params, notes, robust: bool =
     scene = {"force_max": float(pto_obj.force_max), "stroke_max": float(pto_obj.stroke_max)}
     finite = {k: v for k, v in scene.items() if limits and math.isfinite(v)}
     # the controller's own limits, explicit (its default, None, would mean the scene's): the
-    # scene's with limits, none without, so make(name, **parameters) is the very controller
-    own = {k: (v if limits else math.inf) for k, v in scene.items() if _accepts(cls, k)}
+    # scene's with limits, none without, so make(name, **parameters) is the very controller;
+    # a limit on the hull is no clip of the command (limits.command_limit): the tuners hold
+    # it in prediction, and the MPC, which cannot, is left to refuse it
+    command = {**scene, "force_max": command_limit(pto_obj)}
+    own = {k: (v if limits else math.inf) for k, v in command.items() if _accepts(cls, k)}
+    if name in ("mpc", "nmpc") and pto_obj.limited_force() == "hull":
+        own.pop("force_max", None)
     if name == "mpc" and limits:     # no scene limit: the MPC's own default (a soft stroke
         own = {k: v for k, v in own.items() if math.isfinite(v)}   # limit in its linear range)
     # the wave is a setting beyond the parameters: a predictive controller's preview

@@ -124,7 +124,8 @@ def margin_function(plant, name: str, params=None):
 
 
 def fd_statistics(Z, F, wave, damping, stiffness, *, efficiency: float | None = None,
-                  exceedance: float = 0.01, winding: float | None = None) -> dict:
+                  exceedance: float = 0.01, winding: float | None = None,
+                  hull=None) -> dict:
     """Linear-theory statistics of u = -(damping v + stiffness x) in `wave` (exp(+i omega t)).
 
     Z, F: intrinsic_impedance at wave.omega. damping (N s/m) and stiffness (N/m) broadcast
@@ -148,28 +149,48 @@ def fd_statistics(Z, F, wave, damping, stiffness, *, efficiency: float | None = 
       crossings, and they come in clusters (tests/controllers/test_limits.py measures 2-3 % of
       random-phase records at exceedance 10 %);
     - stroke_std, force_std: standard deviations (m, N).
+
+    hull: a drivetrain's impedance Z_d = gear^2 (b + i omega J) at wave.omega (`hull_impedance`)
+    when the force limit acts on the hull: force_peak and force_std are then those of the
+    force the drivetrain puts on the hull, U - Z_d V (the winding loss stays the machine's).
     """
     w, a = np.asarray(wave.omega, float), np.asarray(wave.amplitude, float)
     c = np.asarray(damping, float)[..., None]
     k = np.asarray(stiffness, float)[..., None]
     V = F * a / (Z + c - 1j * k / w)
     X = V / (1j * w)
-    return phasor_statistics(V, X, -(c * V + k * X), c, wave, efficiency=efficiency,
-                             exceedance=exceedance, winding=winding)
+    U = -(c * V + k * X)
+    return phasor_statistics(V, X, U, c, wave, efficiency=efficiency, exceedance=exceedance,
+                             winding=winding, limited=None if hull is None else U - hull * V)
+
+
+def hull_impedance(plant, pto: str, omega, force_on: str | None = None):
+    """Z_d = gear^2 (b + i omega J) (exp(+i omega t); N s/m or N m s/rad) of the PTO's
+    drivetrain when its force limit acts on the hull (scene Pto.limited_force), else None:
+    the limited force is then the machine's."""
+    owner = next(p for p in plant.scene.ptos if p.name == pto)
+    if owner.limited_force(force_on) != "hull":
+        return None
+    d = owner.drivetrain
+    return d.gear_ratio ** 2 * (d.friction + 1j * np.asarray(omega, float) * d.inertia)
 
 
 def phasor_statistics(V, X, U, c, wave, *, efficiency: float | None = None,
-                      exceedance: float = 0.01, winding: float | None = None) -> dict:
+                      exceedance: float = 0.01, winding: float | None = None,
+                      limited=None) -> dict:
     """fd_statistics' keys from one PTO's velocity, position and force phasors per wave
     component (V, X, U: (..., n_omega), m/s, m, N; either time convention, only moduli and
-    c enter) and its damping c (N s/m, broadcast against V): see fd_statistics."""
+    c enter) and its damping c (N s/m, broadcast against V): see fd_statistics. limited: the
+    phasors of the force the limit acts on when it is not U (force_peak, force_std)."""
     w = np.asarray(wave.omega, float)
     power = np.sum(0.5 * c * np.abs(V) ** 2, axis=-1)
+    L = U if limited is None else limited
     var = {name: 0.5 * np.sum(np.abs(z) ** 2, axis=-1) for name, z in
-           (("x", X), ("v", V), ("u", U), ("du", w * U))}
+           (("x", X), ("v", V), ("u", U), ("du", w * L), ("limited", L))}
     s_x, s_v, s_u = (np.sqrt(var[n]) for n in ("x", "v", "u"))
+    s_l = np.sqrt(var["limited"])
     if w.size == 1:
-        stroke, force = np.sqrt(2) * s_x, np.sqrt(2) * s_u           # amplitudes
+        stroke, force = np.sqrt(2) * s_x, np.sqrt(2) * s_l           # amplitudes
         half = s_u * s_v                                             # B = |U| |V| / 2
         with np.errstate(divide="ignore", invalid="ignore"):
             theta = np.arccos(np.clip(np.where(half > 0, -power / half, -1.0), -1, 1))
@@ -180,7 +201,7 @@ def phasor_statistics(V, X, U, c, wave, *, efficiency: float | None = None,
         def peak(s, s_rate):
             crossings = record * s_rate / (np.pi * np.maximum(s, 1e-300))   # 2 T / T_z
             return s * np.sqrt(2 * np.log(np.maximum(crossings / exceedance, 1.0)))
-        stroke, force = peak(s_x, s_v), peak(s_u, np.sqrt(var["du"]))
+        stroke, force = peak(s_x, s_v), peak(s_l, np.sqrt(var["du"]))
         with np.errstate(divide="ignore", invalid="ignore"):
             r = np.clip(np.where(s_u * s_v > 0, -power / (s_u * s_v), 0.0), -1, 1)
         mean_abs = s_u * s_v * (2 / np.pi) * (np.sqrt(1 - r ** 2) + r * np.arcsin(r))
@@ -192,7 +213,7 @@ def phasor_statistics(V, X, U, c, wave, *, efficiency: float | None = None,
     else:
         electrical = efficiency * positive + (power - positive) / efficiency
     return {"power_W": power, "electrical_W": electrical, "stroke_peak": stroke,
-            "force_peak": force, "stroke_std": s_x, "force_std": s_u}
+            "force_peak": force, "stroke_std": s_x, "force_std": s_l}
 
 
 def default_bounds(plant, wave, name: str, params) -> tuple[float, float]:

@@ -22,19 +22,29 @@ LINEAR_RANGE_SHARE = 0.8
 def force_limits(plant, force_max=None) -> np.ndarray:
     """Per-PTO force limit (N or N m, > 0, inf: none), scene order.
 
-    force_max None: each scene PTO's own force_max; a number: that limit on every PTO; a dict
-    by PTO name: those PTOs' limits, the others keep their scene limit.
+    force_max None: each scene PTO's own force_max on its machine (`command_limit`); a number:
+    that limit on every PTO; a dict by PTO name: those PTOs' limits, the others keep their
+    scene limit.
     """
     ptos = plant.scene.ptos
-    limits = np.array([p.force_max for p in ptos], float)
+    limits = np.array([command_limit(p) for p in ptos], float)
     if isinstance(force_max, dict):
         per_pto(plant, force_max, "force_max")          # rejects unknown PTO names
-        limits = np.array([float(force_max.get(p.name, p.force_max)) for p in ptos])
+        limits = np.array([float(force_max.get(p.name, command_limit(p))) for p in ptos])
     elif force_max is not None:
         limits = np.full(len(ptos), float(force_max))
     if not np.all(limits > 0):                           # NaN fails too
         raise ValueError(f"{plant.name}: force_max must be > 0 (inf: none), got {limits}")
     return limits
+
+
+def command_limit(pto) -> float:
+    """The limit a scene PTO puts on the machine's force, the controller's command (N or N m):
+    its force_max, or none (inf) when force_max_on = "hull" with a drivetrain, where the limit
+    is on the force the drivetrain puts on the hull (the machine's less gear^2 (J a + b v)),
+    which a command clip does not bound: the tuners keep the predicted hull force inside it
+    and the metrics check the simulated one."""
+    return math.inf if pto.limited_force() == "hull" else float(pto.force_max)
 
 
 def saturate(u: np.ndarray, limits: np.ndarray) -> np.ndarray:

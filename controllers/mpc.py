@@ -67,7 +67,7 @@ from mbcontrol.results import jsonable
 from .base import signal_indices
 from .control_plant import build_control_plant, device_frequency, hydro_band, pto_impedance
 from .estimation import ArPredictor, ExcitationKalman, excitation_error, wave_frequencies
-from .limits import LINEAR_RANGE_SHARE, linear_range, per_pto_values
+from .limits import LINEAR_RANGE_SHARE, command_limit, linear_range, per_pto_values
 from .sampled import held_dampers
 from .mpc_envelope import MpcEnvelope
 from .mpc_qp import CondensedQp
@@ -149,6 +149,11 @@ class Mpc:
                    for p in ptos]
         self.stroke_default = None if self.stroke_max is not None else {
             p.name: s for p, s in zip(ptos, strokes) if not math.isfinite(p.stroke_max)}
+        hull = [p.name for p in ptos if command_limit(p) != p.force_max]
+        if hull and self.force_max is None:     # hull-force rows are not built
+            raise ValueError(f"mpc: PTO {hull[0]!r} limits the force on the hull (force_max_on"
+                             f" = 'hull'); the MPC limits the machine's command only: give it "
+                             f"force_max (a machine limit) explicitly")
         self.limits = {
             "force": per_pto_values(plant, self.force_max, [p.force_max for p in ptos], "force_max"),
             "stroke": per_pto_values(plant, self.stroke_max, strokes, "stroke_max"),

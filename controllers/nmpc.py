@@ -121,6 +121,10 @@ class Nmpc:
                     for k in ("damping", "stiffness")}
         p = model.params(**{**zero_law, **self.params})
 
+        if self.force_max is None and ptos[name].limited_force() == "hull":
+            raise ValueError(f"nmpc: PTO {name!r} limits the force on the hull (force_max_on = "
+                             f"'hull'); the NMPC limits the machine's command only: give it "
+                             f"force_max (a machine limit) explicitly")
         fmax = ptos[name].force_max if self.force_max is None else self.force_max
         smax = ptos[name].stroke_max if self.stroke_max is None else self.stroke_max
         self._fmax, self._smax = float(fmax), float(smax)

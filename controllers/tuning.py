@@ -6,8 +6,8 @@ import numpy as np
 
 from mbcontrol.analysis.envelope import ENVELOPE_SHARE, envelope_response
 
-from .impedance import (base_params, default_bounds, fd_statistics, intrinsic_impedance,
-                        margin_function)
+from .impedance import (base_params, default_bounds, fd_statistics, hull_impedance,
+                        intrinsic_impedance, margin_function)
 
 
 class OutsideEnvelope(ValueError):
@@ -26,7 +26,8 @@ def constrained_tuning(plant, wave, *, pto: str | None = None, params=None,
                        exceedance: float = 0.01, min_margin: float = 1e-3,
                        winding: float | None = None, envelope: bool = False,
                        rated_power: float | None = None,
-                       min_stability: float | None = None) -> tuple[float, float, float]:
+                       min_stability: float | None = None,
+                       force_on: str | None = None) -> tuple[float, float, float]:
     """(damping, stiffness, predicted mean power W) maximising the predicted mean power
     (electrical with `efficiency` or a drivetrain's `winding` coefficient, else mechanical;
     impedance.fd_statistics) subject to fd_statistics' force and stroke
@@ -39,6 +40,8 @@ def constrained_tuning(plant, wave, *, pto: str | None = None, params=None,
     `min_stability` (controllers.robustness.STABILITY_FLOOR) the loop's least distance from
     -1, min |1 + L(i omega)| with L = Z_pto / Z_i over the hydro data's band and at rest, is at
     least that (0.52 gives a gain margin of 2.08 and a phase margin of 30.1 deg at the least).
+    force_on: which force force_max limits (None: the scene PTO's force_max_on; with a
+    drivetrain "hull" is the force on the hull, the machine's less gear^2 (J a + b v)).
 
     passive: stiffness 0, a 1-D search: a log grid of 400 dampings over `bounds` (default
     impedance.default_bounds), then Brent's method between the best feasible point's neighbours
@@ -63,6 +66,7 @@ def constrained_tuning(plant, wave, *, pto: str | None = None, params=None,
     if not (f_max > 0 and s_max > 0):
         raise ValueError(f"limits must be > 0, got force_max={force_max}, stroke_max={stroke_max}")
     key = "power_W" if efficiency is None and winding is None else "electrical_W"
+    hull = hull_impedance(plant, name, wave.omega, force_on)
 
     env = None
     if envelope:
@@ -72,7 +76,7 @@ def constrained_tuning(plant, wave, *, pto: str | None = None, params=None,
 
     def evaluate(c, k):
         st = fd_statistics(Z, F, wave, c, k, efficiency=efficiency, exceedance=exceedance,
-                           winding=winding)
+                           winding=winding, hull=hull)
         feasible = (st["force_peak"] <= f_max) & (st["stroke_peak"] <= s_max)
         if rated_power is not None:
             feasible = feasible & (st[key] <= rated_power)

@@ -31,6 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import MbcontrolError
+from ..waves.realisation import repeat_period
 from .dense import OVERSAMPLE, dense_extremes
 
 # Re Z_i may be a tiny negative number where the radiation damping all but vanishes: BEM
@@ -179,25 +180,6 @@ class PseudoSpectralBound:
     position_overshoot_pct: float = math.nan
 
 
-def repeat_period(wave) -> tuple[float, np.ndarray]:
-    """(T, k): the wave's repeat period (s) and its components' harmonic numbers on 2 pi / T.
-
-    Regular waves repeat over their period; irregular seas made on a uniform grid (Wave.d_omega)
-    over 2 pi / d_omega. Raises ValueError for waves that are not periodic on such a grid.
-    """
-    omega = np.asarray(wave.omega, float)
-    if omega.size == 1:
-        return 2 * np.pi / float(omega[0]), np.array([1])
-    if wave.d_omega is None:
-        raise ValueError("pseudo-spectral bound: an irregular wave needs a uniform frequency "
-                         "grid (Wave.d_omega) to be periodic")
-    k = omega / wave.d_omega
-    if np.max(np.abs(k - np.rint(k))) > 1e-6 or np.any(np.rint(k) < 1):
-        raise ValueError("pseudo-spectral bound: the wave's frequencies are not positive "
-                         "multiples of its d_omega")
-    return 2 * np.pi / wave.d_omega, np.rint(k).astype(int)
-
-
 class PseudoSpectralProblem:
     """The convex QP of the pseudo-spectral bound, built once for a plant, sea and PTO.
 
@@ -221,7 +203,7 @@ class PseudoSpectralProblem:
 
     def __init__(self, plant, wave, *, pto: str | None = None, params=None,
                  oversample: float = OVERSAMPLE, harmonics: int = 1, min_points: int = 32,
-                 omega_max: float | None = None):
+                 omega_max: float | None = None, force_on: str | None = None):
         T, k_wave = repeat_period(wave)
         if harmonics > 1 and wave.omega.size != 1:
             raise ValueError("harmonics > 1 needs a regular wave")
@@ -249,7 +231,16 @@ class PseudoSpectralProblem:
             eb = basis * beta[None, :]
             return (basis @ alpha).real, np.hstack([eb.real, -eb.imag])
 
-        self.force_map = affine(np.zeros(k.size), np.ones(k.size))
+        # the limited force: the machine's, or (Pto.limited_force "hull") the force the
+        # drivetrain puts on the hull, F - Z_d V, Z_d = gear^2 (b - i omega J), V = (E + F) / Z
+        owner = next(p for p in plant.scene.ptos if p.name == _pto_name(plant, pto))
+        self.force_on = owner.limited_force(force_on)
+        alpha, self.force_gain = np.zeros(k.size), np.ones(k.size, complex)
+        if self.force_on == "hull":
+            d = owner.drivetrain
+            z_d = d.gear_ratio ** 2 * (d.friction - 1j * self.omega * d.inertia)
+            alpha, self.force_gain = -z_d * E / Z, 1 - z_d / Z
+        self.force_map = affine(alpha, self.force_gain)
         self.velocity_map = affine(E / Z, 1 / Z)
         gain = 1j / (self.omega * Z)                                     # X = i V / omega
         self.position_map = affine(gain * E, gain)
@@ -340,9 +331,9 @@ class PseudoSpectralProblem:
         n_t, k = self.time.size, np.rint(self.omega * self.period / (2 * np.pi)).astype(int)
         if np.isfinite(force_max):
             rows.append(self.force_map[1])
-            offsets.append(np.zeros(n_t))
+            offsets.append(self.force_map[0] / self.F0)
             limits.append(np.full(n_t, force_max / self.F0))
-            grams.append(fourier_gram(k, np.ones(k.size), n_t))
+            grams.append(fourier_gram(k, self.force_gain, n_t))
         if np.isfinite(stroke_max):
             rows.append(self.F0 * self.position_map[1])
             offsets.append(self.position_map[0])
@@ -375,7 +366,8 @@ class PseudoSpectralProblem:
 def pseudo_spectral_bound(plant, wave, *, pto: str | None = None, force_max: float = np.inf,
                           stroke_max: float = np.inf, params=None, oversample=OVERSAMPLE,
                           harmonics: int = 1, min_points: int = 32, solver: str = "CLARABEL",
-                          omega_max: float | None = None, **solver_options) -> PseudoSpectralBound:
+                          omega_max: float | None = None, force_on: str | None = None,
+                          **solver_options) -> PseudoSpectralBound:
     """Optimal constrained mean absorbed power (W) for a periodic sea, non-causal.
 
     Optimises the PTO force's Fourier coefficients, by default on the wave's own frequency
@@ -392,8 +384,9 @@ def pseudo_spectral_bound(plant, wave, *, pto: str | None = None, force_max: flo
     0.6 s for 75 components, 12-25 s for 278 (a 600 s sea); "IPM" like n_points x n^2 with a
     BLAS constant (300 s sea to 12 rad/s, 573 components: see analysis.box_qp).
     For several limits on one sea, build one PseudoSpectralProblem and call solve repeatedly.
+    force_on: the force force_max limits (scene Pto.limited_force; None: its force_max_on).
     """
     problem = PseudoSpectralProblem(plant, wave, pto=pto, params=params, oversample=oversample,
                                     harmonics=harmonics, min_points=min_points,
-                                    omega_max=omega_max)
+                                    omega_max=omega_max, force_on=force_on)
     return problem.solve(force_max, stroke_max, solver, **solver_options)

@@ -32,40 +32,26 @@ def winding_coefficient(plant, pto: str) -> float | None:
 
 def electrical_bound(plant, wave, *, pto: str | None = None, force_max: float = np.inf,
                      stroke_max: float = np.inf, params=None, omega_max: float | None = None,
-                     force_on: str = "machine", solver: str = "CLARABEL",
+                     force_on: str | None = None, solver: str = "CLARABEL",
                      **solver_options) -> ElectricalBound:
     """The most mean electrical power (W) a PTO with a drivetrain can deliver in a periodic
     `wave` with |F| <= force_max and |x| <= stroke_max, non-causal (the force's Fourier
     coefficients optimised as pseudo_spectral_bound does; omega_max: let the force hold every
     multiple of 2 pi / T up to it, as WecOptTool's frequency grid does).
 
-    force_on: which force force_max limits: "machine" (the PTO force, the scene's force_max),
-    or "wec" (what the whole drivetrain puts on the joint, the machine's force less the
-    reflected inertia and friction forces gear^2 (J a + b v): WecOptTool's PTO force; the
-    result's force series and max_force are then that force)."""
+    force_on: which force force_max limits (None: the scene PTO's force_max_on): "machine"
+    (the PTO force, the machine's), or "hull" ("wec" too: what the whole drivetrain puts on
+    the joint, the machine's force less the reflected inertia and friction forces gear^2 (J a
+    + b v): WecOptTool's PTO force; the result's force series and max_force are then that
+    force)."""
     name = _pto_name(plant, pto)
     winding = winding_coefficient(plant, name)
     if winding is None:
         raise ValueError(f"PTO {name!r} has no [pto.drivetrain]: no electrical bound")
-    problem = PseudoSpectralProblem(plant, wave, pto=name, params=params, omega_max=omega_max)
+    problem = PseudoSpectralProblem(plant, wave, pto=name, params=params, omega_max=omega_max,
+                                    force_on=force_on)
     problem.rho = problem.rho + winding          # mean loss winding x sum(c_k^2 + s_k^2) / 2
-    if force_on == "wec":
-        _limit_force_on_wec(problem, next(p for p in plant.scene.ptos if p.name == name))
-    elif force_on != "machine":
-        raise ValueError(f"force_on {force_on!r}: expected 'machine' or 'wec'")
     result = problem.solve(force_max, stroke_max, solver, **solver_options)
     loss = float(winding * 0.5 * np.sum(np.abs(result.force_coefficients) ** 2))
     return ElectricalBound(result.mean_power - loss, result.mean_power, loss, result)
 
-
-def _limit_force_on_wec(problem, pto) -> None:
-    """Make the problem's force map the force on the joint, F - Z_d V: the drivetrain's
-    impedance Z_d = gear^2 (b - i omega J) in the problem's exp(-i omega t) phasors, with
-    V = (E + F) / Z its velocity (Z holds the drivetrain, as the plant does)."""
-    d = pto.drivetrain
-    z_d = d.gear_ratio ** 2 * (d.friction - 1j * problem.omega * d.inertia)
-    Z = problem.thevenin.impedance
-    alpha, beta = -z_d * problem.E / Z, 1 - z_d / Z
-    basis = np.exp(-1j * np.outer(problem.time, problem.omega))
-    scaled = basis * beta[None, :]
-    problem.force_map = ((basis @ alpha).real, np.hstack([scaled.real, -scaled.imag]))

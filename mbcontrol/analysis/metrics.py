@@ -119,7 +119,8 @@ def pto_metrics(ds, pto, start: float | None = None, end: float | None = None) -
     the drivetrain model when the PTO has one, with mean_winding_loss_W, max_current_A and
     max_voltage_V; else with the PTO's efficiency), mean_abs_power_W, papr (peak |P| over mean P; inf when mean P <= 0),
     p98_W (98th percentile of |P|), max_force, f98, max_stroke, z98 (98th percentiles of |F|
-    and |x|), force_max / stroke_max (the PTO's limits), force_violation / stroke_violation
+    and |x|; F the force the limit acts on, force_max_on: the machine's or the hull's),
+    force_max / stroke_max (the PTO's limits), force_violation / stroke_violation
     (worst excess over the limit, 0 if none) and violation_fraction (share of samples outside
     either limit). Force and stroke are in the PTO's units (N, m or N m, rad).
     """
@@ -139,7 +140,10 @@ def pto_metrics(ds, pto, start: float | None = None, end: float | None = None) -
     if steps.sum() < 1:
         raise ValueError(f"empty metrics window [{start}, {end}) s in a {t[-1]:.4g} s record")
     power = p_step[steps]
-    force = np.abs(ds[f"{name}__force"].values[samples])
+    # the force the limit acts on: the machine's, or with force_max_on "hull" the force the
+    # drivetrain puts on the hull (the plant's <pto>__hull_force)
+    on_hull = getattr(pto, "force_max_on", "machine") == "hull" and f"{name}__hull_force" in ds
+    force = np.abs(ds[f"{name}__hull_force" if on_hull else f"{name}__force"].values[samples])
     stroke = np.abs(ds[f"{name}__position"].values[samples])
     mean = float(power.mean())
     outside = (force > force_max * (1 + 1e-9)) | (stroke > stroke_max * (1 + 1e-9))
@@ -155,7 +159,8 @@ def pto_metrics(ds, pto, start: float | None = None, end: float | None = None) -
         "p98_W": float(np.percentile(np.abs(power), 98)),
         "max_force": float(force.max()), "f98": float(np.percentile(force, 98)),
         "max_stroke": float(stroke.max()), "z98": float(np.percentile(stroke, 98)),
-        "force_max": force_max, "stroke_max": stroke_max, "efficiency": efficiency,
+        "force_max": force_max, "force_max_on": "hull" if on_hull else "machine",
+        "stroke_max": stroke_max, "efficiency": efficiency,
         "force_violation": float(max(force.max() - force_max, 0.0)),
         "stroke_violation": float(max(stroke.max() - stroke_max, 0.0)),
         "violation_fraction": float(outside.mean()),

@@ -15,9 +15,11 @@ import numpy as np
 
 from mbcontrol.errors import HydroError
 
+from .revolution import check_profile, revolution_mesh
+
 LOG = logging.getLogger(__name__)
 RIGID_DOFS = ("Surge", "Sway", "Heave", "Roll", "Pitch", "Yaw")
-GEOMETRY_TYPES = ("box", "cylinder", "sphere", "mesh")
+GEOMETRY_TYPES = ("box", "cylinder", "sphere", "revolution", "mesh")
 NED_TO_ZUP = np.diag([1.0, -1.0, -1.0])  # its own inverse
 
 
@@ -32,6 +34,9 @@ class BemBody:
         ``{"type": "box", "size": [Lx, Ly, Lz], "center": [x, y, z]}``,
         ``{"type": "cylinder", "radius": r, "length": L, "center": [...], "axis": "z"|"x"|"y"}``,
         ``{"type": "sphere", "radius": r, "center": [...]}``,
+        ``{"type": "revolution", "profile": [[r, z], ...], "center": [...]}`` (a polyline from
+        the top to the keel, z down from the centre, revolved about the vertical axis through
+        the centre: :mod:`.revolution`),
         ``{"type": "mesh", "file": path, "axes": "z_up"|"ned"}``.
         Coordinates in the n-frame (NED) at rest, m; "center" is the geometric centre.
         Mesh files are read with ``capytaine.load_mesh`` (STL through meshio); their vertices
@@ -106,6 +111,9 @@ def validate_body(body: BemBody) -> None:
     elif kind == "sphere":
         _positive(name, "geometry.radius", g.get("radius"))
         _vec3(name, "geometry.center", g.get("center"))
+    elif kind == "revolution":
+        _vec3(name, "geometry.center", g.get("center", (0.0, 0.0, 0.0)))
+        check_profile(name, g)
     else:
         f = g.get("file")
         if not f or not Path(f).is_file():
@@ -132,7 +140,8 @@ def hull_mesh(body: BemBody):
 
     Returns ``(mesh, symmetric, waterplane)``: ``symmetric`` is True when the mesh is
     mirror-symmetric about the xz plane (y = 0), so the solver may use a ReflectionSymmetricMesh;
-    ``waterplane`` is an exact lid mesh (box, vertical cylinder piercing the surface) or None.
+    ``waterplane`` is an exact lid mesh (box, vertical cylinder or revolution piercing the
+    surface) or None.
     Raises HydroError if nothing of the body is below the free surface.
     """
     import capytaine as cpt
@@ -141,7 +150,7 @@ def hull_mesh(body: BemBody):
     g, h = body.geometry, float(body.panel_size)
     kind, waterplane = g["type"], None
     if kind != "mesh":
-        c = NED_TO_ZUP @ np.asarray(g["center"], dtype=float)
+        c = NED_TO_ZUP @ np.asarray(g.get("center", (0.0, 0.0, 0.0)), dtype=float)
     if kind == "box":
         lx, ly, lz = (float(s) for s in g["size"])
         bottom, top = c[2] - lz / 2, min(c[2] + lz / 2, 0.0)
@@ -189,6 +198,8 @@ def hull_mesh(body: BemBody):
             size, res = ((length, 2 * half), (n_l, n_w)) if g["axis"] == "y" else ((2 * half, length), (n_w, n_l))
             waterplane = cpt.mesh_rectangle(size=size, center=(c[0], c[1], 0.0), resolution=res,
                                             normal=(0.0, 0.0, -1.0), name=f"lid of {body.name}")
+    elif kind == "revolution":   # meshed wet part only; exact, volume-preserving waterplane lid
+        mesh, waterplane = revolution_mesh(body.name, g, h)
     elif kind == "sphere":
         r = float(g["radius"])
         mesh = cpt.mesh_sphere(radius=r, center=tuple(c),

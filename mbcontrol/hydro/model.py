@@ -243,6 +243,8 @@ def geometry_dict(geometry) -> dict:
         value = getattr(geometry, key)
         if value is not None:
             g[key] = list(value) if isinstance(value, tuple) else value
+    if geometry.profile is not None:
+        g["profile"] = [list(point) for point in geometry.profile]
     if geometry.kind == "cylinder":
         g["axis"] = geometry.axis
     return g

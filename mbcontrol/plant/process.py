@@ -287,7 +287,8 @@ _ENERGY_UNITS = {"radiated_power": "W", "excitation_power": "W", "energy": "J"}
 
 
 DRIVETRAIN_SIGNALS = {"current": "A", "voltage": "V", "winding_loss": "W", "friction_loss": "W",
-                      "electrical_power": "W", "mechanical_power": "W"}
+                      "electrical_power": "W", "mechanical_power": "W",
+                      "hull_force": "force"}   # N or N m, as the PTO's force
 
 
 def drivetrain_signals(d, v, force, acceleration) -> list:
@@ -296,13 +297,14 @@ def drivetrain_signals(d, v, force, acceleration) -> list:
     R I + kt' gear v (a current-controlled drive; the inductive L dI/dt, whose mean power is
     zero, is left out), winding loss R I^2, friction loss gear^2 b v^2, electrical power
     delivered -F v - R I^2, and the mechanical power the joint puts in,
-    -(F - gear^2 (J a + b v)) v = electrical + losses + d/dt(gear^2 J v^2 / 2)."""
+    -(F - gear^2 (J a + b v)) v = electrical + losses + d/dt(gear^2 J v^2 / 2), and the
+    force on the hull F - gear^2 (J a + b v) (what force_max_on = "hull" limits)."""
     current = force / d.force_per_current
     winding = d.winding_resistance * current ** 2
     friction = d.gear_ratio ** 2 * d.friction * v * v
     shaft = d.gear_ratio ** 2 * (d.inertia * acceleration + d.friction * v)
     return [current, d.winding_resistance * current + d.kt * d.gear_ratio * v, winding,
-            friction, -force * v - winding, -(force - shaft) * v]
+            friction, -force * v - winding, -(force - shaft) * v, force - shaft]
 
 
 def _coordinate_unit(plant, name: str) -> str:
@@ -330,8 +332,8 @@ def _units(plant, signal: str) -> str:
             coord = "m" if pto.between_points else _coordinate_unit(plant, pto.joint)
             force = "N m" if coord == "rad" else "N"
             kind = "force" if base == pto.name else base.split("__")[-1]
-            return {"position": coord, "velocity": f"{coord}/s", "force": force,
-                    "power": "W", **DRIVETRAIN_SIGNALS}[kind]
+            return {"position": coord, "velocity": f"{coord}/s", "power": "W",
+                    **DRIVETRAIN_SIGNALS, "force": force, "hull_force": force}[kind]
     if signal.endswith("__tension"):
         return "N"
     if signal.endswith(("__span", "__height")):

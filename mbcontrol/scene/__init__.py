@@ -3,13 +3,16 @@
 `load_scene(path_or_name)` reads a TOML scene (or a catalogue model by name) and checks every
 field once; later stages trust the result. Modules: `model` (the dataclasses), `parse` (one
 section each), `checks` (field readers and whole-scene checks), `template` ([parameters] and
-repeat), `units` ("60 mm" -> 0.06), `load` (files and the catalogue).
+repeat), `units` ("60 mm" -> 0.06), `shapes` (revolution profiles, immersed volumes), `load`
+(files and the catalogue).
 """
 from .load import catalogue_dir, list_models, load_scene, resolve
 from .model import (DOF_NAMES, JOINT_TYPES, Body, Drag, Drivetrain, EndStop, Friction, Geometry, HydroSettings,
                     Joint, Mooring, Obstacle, Pto, Scene, Water)
 from .parse import parse_scene
+from .shapes import immersed_profile, immersed_volume, profile_problem
 
 __all__ = ["load_scene", "list_models", "catalogue_dir", "resolve", "parse_scene",
            "DOF_NAMES", "JOINT_TYPES", "Scene", "Water", "Geometry", "Body", "Joint", "Pto",
-           "Friction", "Mooring", "EndStop", "Drag", "Drivetrain", "HydroSettings", "Obstacle"]
+           "Friction", "Mooring", "EndStop", "Drag", "Drivetrain", "HydroSettings", "Obstacle",
+           "immersed_profile", "immersed_volume", "profile_problem"]

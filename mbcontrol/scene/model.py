@@ -32,13 +32,15 @@ class Water:
 @dataclass(frozen=True)
 class Geometry:
     """BEM geometry of a body in the n-frame at rest: a primitive or a mesh file."""
-    kind: str                              # "box" | "cylinder" | "sphere" | "mesh"
-    center: tuple[float, float, float] = (0.0, 0.0, 0.0)   # m, geometric centre (primitives)
+    kind: str                              # "box" | "cylinder" | "sphere" | "revolution" | "mesh"
+    center: tuple[float, float, float] = (0.0, 0.0, 0.0)   # m, geometric centre (primitives;
+                                           # revolution: the axis point profile z counts from)
     size: tuple[float, float, float] | None = None         # m, box edge lengths (x, y, z)
     radius: float | None = None                            # m, cylinder and sphere
     length: float | None = None                            # m, cylinder
     axis: str = "z"                                        # cylinder axis
     file: str | None = None                                # mesh file, absolute path
+    profile: tuple[tuple[float, float], ...] | None = None  # m, revolution: (r, z down), top to keel
 
 
 @dataclass(frozen=True)
@@ -99,10 +101,23 @@ class Pto:
     parent_point: tuple[float, float, float] | None = None  # m, n-frame at rest
     preload: str = "none"          # "none" | "balance"
     drivetrain: "Drivetrain | None" = None   # None: an ideal PTO (efficiency applies)
+    force_max_on: str = "machine"  # "machine": force_max limits the machine's force (the
+                                   # command); "hull": the force the drivetrain puts on the
+                                   # hull, the machine's less gear^2 (J a + b v)
 
     @property
     def between_points(self) -> bool:
         return self.joint is None
+
+    def limited_force(self, force_on: str | None = None) -> str:
+        """Which force force_max limits: "machine" or "hull" (`force_on`, or None for
+        force_max_on; "wec", WecOptTool's word, is "hull"). "hull" needs a drivetrain:
+        without one the two are the same force, and "machine" is returned."""
+        on = self.force_max_on if force_on is None else {"wec": "hull"}.get(force_on, force_on)
+        if on not in ("machine", "hull"):
+            raise ValueError(f"PTO {self.name!r}: force_on {force_on!r}: expected 'machine' "
+                             f"or 'hull'")
+        return "hull" if on == "hull" and self.drivetrain is not None else "machine"
 
 
 @dataclass(frozen=True)
@@ -257,6 +272,8 @@ class Scene:
         for body in list(data["bodies"]) + list(data.get("obstacles", ())):
             if body["geometry"] and body["geometry"]["file"]:
                 body["geometry"]["file"] = _file_digest(body["geometry"]["file"])
+            if body["geometry"] and body["geometry"]["profile"] is None:
+                body["geometry"].pop("profile")   # digests of scenes without one stay as they were
         text = json.dumps(data, sort_keys=True, default=str)
         return hashlib.sha256(text.encode()).hexdigest()
 

@@ -10,6 +10,7 @@ from .. import defaults
 from .checks import Reader, catenary_geometry, check_topology
 from .model import (DOF_NAMES, JOINT_TYPES, Body, Drag, Drivetrain, EndStop, Friction, Geometry,
                     HydroSettings, Joint, Mooring, Obstacle, Pto, Scene, Water)
+from .shapes import displaced_mass, read_profile
 from .template import expand
 from .units import JOINT_DIMENSIONS
 
@@ -24,7 +25,7 @@ def parse_scene(data: dict, path: Path, parameters: dict | None = None) -> Scene
     top.allow("name", "description", "water", "body", "joint", "pto", "friction", "mooring",
               "drag", "end_stop", "hydro", "identify", "obstacle")
     water = _water(top.table("water", required=False))
-    bodies = tuple(_body(r, path) for r in top.tables("body", required=True))
+    bodies = tuple(_body(r, path, water) for r in top.tables("body", required=True))
     joints = tuple(_joint(r) for r in top.tables("joint", required=True))
     kinds = {j.name: j.type for j in joints}
     hydro = _hydro(top.table("hydro", required=False), path)
@@ -54,20 +55,23 @@ def _water(r: Reader) -> Water:
                  depth=r.positive("depth", "length", default=math.inf, finite=False))
 
 
-def _body(r: Reader, path: Path) -> Body:
+def _body(r: Reader, path: Path, water: Water) -> Body:
     r.allow("name", "mass", "inertia", "cog", "geometry", "hydro")
-    return Body(name=r.name(), mass=r.positive("mass", "mass"),
+    name = r.name()
+    geometry = _geometry(r.table("geometry", required=False), path, f"body '{name}'")
+    return Body(name=name, mass=displaced_mass(r, geometry, water.rho),
                 inertia=r.inertia("inertia"), cog=r.vector("cog", "length"),
-                geometry=_geometry(r.table("geometry", required=False), path),
-                hydro=r.boolean("hydro", default=True))
+                geometry=geometry, hydro=r.boolean("hydro", default=True))
 
 
-def _geometry(r: Reader, path: Path) -> Geometry | None:
+def _geometry(r: Reader, path: Path, owner: str) -> Geometry | None:
     if r.empty:
         return None
-    r.allow("type", "center", "size", "radius", "length", "axis", "file")
-    kind = r.choice("type", ("box", "cylinder", "sphere", "mesh"))
+    r.allow("type", "center", "size", "radius", "length", "axis", "file", "profile")
+    kind = r.choice("type", ("box", "cylinder", "sphere", "revolution", "mesh"))
     center = r.vector("center", "length", default=(0.0, 0.0, 0.0))
+    if kind == "revolution":
+        return Geometry(kind, center, profile=read_profile(r, owner))
     if kind == "box":
         size = r.vector("size", "length")
         if min(size) <= 0:
@@ -100,7 +104,7 @@ def _obstacles(top: Reader, path: Path, bodies, hydro) -> tuple[Obstacle, ...]:
         if not hydro.interaction:
             r.fail("name", "expected [hydro] interaction = true: an obstacle acts on the bodies "
                            "through the waves it scatters, which a solve of each body alone leaves out")
-        out.append(Obstacle(name=name, geometry=_geometry(r.table("geometry"), path)))
+        out.append(Obstacle(name=name, geometry=_geometry(r.table("geometry"), path, f"obstacle '{name}'")))
     return tuple(out)
 
 
@@ -122,8 +126,9 @@ def _joint(r: Reader) -> Joint:
 
 
 def _pto(r: Reader, kinds: dict) -> Pto:
-    r.allow("name", "joint", "damping", "stiffness", "force_max", "stroke_max", "efficiency",
-            "rated_power", "body", "point", "parent", "parent_point", "preload", "drivetrain")
+    r.allow("name", "joint", "damping", "stiffness", "force_max", "force_max_on", "stroke_max",
+            "efficiency", "rated_power", "body", "point", "parent", "parent_point", "preload",
+            "drivetrain")
     joint = r.string("joint", default=None)
     # limits in units of the joint's coordinate: "4 m" / "2 MN" (prismatic or between points),
     # "30 deg" / "5 MN m" (revolute); an unknown joint is named by the scene checks later
@@ -138,6 +143,12 @@ def _pto(r: Reader, kinds: dict) -> Pto:
     efficiency = r.positive("efficiency", None, default=1.0)
     if efficiency > 1:
         r.fail("efficiency", f"expected a number in (0, 1], got {efficiency}")
+    force_max_on = r.choice("force_max_on", ("machine", "hull"), default="machine")
+    drivetrain = _drivetrain(r.table("drivetrain", required=False), joint is None)
+    if force_max_on == "hull" and drivetrain is None:
+        r.fail("force_max_on", "'hull' limits the force the drivetrain puts on the hull (the "
+                               "machine's less its reflected inertia and friction): it needs "
+                               "a [pto.drivetrain]; without one the two are the same force")
     return Pto(name=r.name(), joint=joint,
                damping=r.nonnegative("damping", default=0.0),
                stiffness=r.finite("stiffness", default=0.0),
@@ -150,7 +161,7 @@ def _pto(r: Reader, kinds: dict) -> Pto:
                parent=r.string("parent", default="ground"),
                parent_point=r.vector("parent_point", "length", default=None),
                preload=r.choice("preload", ("none", "balance"), default="none"),
-               drivetrain=_drivetrain(r.table("drivetrain", required=False), joint is None))
+               drivetrain=drivetrain, force_max_on=force_max_on)
 
 
 def _drivetrain(r: Reader, between_points: bool) -> Drivetrain | None:

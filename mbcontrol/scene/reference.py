@@ -26,7 +26,7 @@ SECTIONS = {
     "body": "`[[body]]`: one rigid body each (at least one)",
     "geometry": "`[body.geometry]` and `[obstacle.geometry]`: the hull the BEM meshes "
                 "(by `type`: box `size`; cylinder `radius`, `length`, `axis`; sphere `radius`; "
-                "mesh `file`)",
+                "revolution `profile`; mesh `file`)",
     "joint": "`[[joint]]`: the tree, rooted at `ground`, one joint per body",
     "pto": "`[[pto]]`: a power take-off on a joint, or between two body points",
     "pto.drivetrain": "`[pto.drivetrain]`: the PTO's gear and electric machine (absent: an "
@@ -62,18 +62,23 @@ MEANING = {
     ("water", "g"): "gravity",
     ("water", "depth"): "water depth (`inf`: deep water)",
     ("body", "name"): "the body's name (signals are `<name>__Heave` ...)",
-    ("body", "mass"): "mass",
+    ("body", "mass"): "mass; `\"displaced\"`: water rho x the geometry's immersed volume at "
+                      "rest (box or revolution), so that the body floats there",
     ("body", "inertia"): "inertia about the CoG, in the body frame",
     ("body", "cog"): "centre of gravity at rest, n-frame (z down)",
     ("body", "geometry"): "the hull for the BEM (`[body.geometry]`)",
     ("body", "hydro"): "false: no hydrodynamic forces on this body",
     ("geometry", "type"): "the primitive, or a mesh file",
-    ("geometry", "center"): "the primitive's centre (or the mesh's origin), n-frame",
+    ("geometry", "center"): "the primitive's centre (or the mesh's origin; a revolution's "
+                            "axis point that its profile's z counts from), n-frame",
     ("geometry", "size"): "box edge lengths",
     ("geometry", "radius"): "cylinder or sphere radius",
     ("geometry", "length"): "cylinder length",
     ("geometry", "axis"): "cylinder axis",
     ("geometry", "file"): "mesh file (STL or any meshio format), beside the scene",
+    ("geometry", "profile"): "revolution: [[r, z], ...] from the top to the keel (z down, "
+                             "non-decreasing; r >= 0), revolved about the vertical axis; open "
+                             "ends are closed by flat discs",
     ("joint", "name"): "the joint's name (its coordinate's signal name)",
     ("joint", "type"): "revolute, prismatic, fixed or free",
     ("joint", "parent"): "parent body, or `ground`",
@@ -92,6 +97,11 @@ MEANING = {
     ("pto", "stiffness"): "spring of the scene's own law (N/m or N m/rad)",
     ("pto", "force_max"): "force limit: a force on a prismatic joint or between points, a "
                           "moment on a revolute one",
+    ("pto", "force_max_on"): "what `force_max` limits with a drivetrain: `machine` (the "
+                             "machine's force, the command; the default) or `hull` (the force "
+                             "the drivetrain puts on the hull, the machine's less its "
+                             "reflected inertia and friction, gear^2 (J a + b v): WecOptTool's "
+                             "PTO force); bounds, tuners, design and the MPC hold it",
     ("pto", "stroke_max"): "stroke limit: a length (prismatic, between points) or an angle "
                            "(revolute)",
     ("pto", "efficiency"): "drivetrain efficiency in (0, 1] (electrical power)",
@@ -186,7 +196,8 @@ MEANING = {
 OPTIONAL = {("drag.coefficients", None), ("drag.linear", None), ("hydro.source_options", None),
             ("mooring", "excursion")}
 # units that follow the joint (recorded here on a prismatic one)
-UNITS = {("pto", "force_max"): "number, N (prismatic, between points) or N m (revolute), or a "
+UNITS = {("body", "mass"): "number, kg or a unit string, or `\"displaced\"`",
+         ("pto", "force_max"): "number, N (prismatic, between points) or N m (revolute), or a "
                                "unit string",
          ("pto", "stroke_max"): "number, m or rad by joint, or a unit string",
          ("end_stop", "lower"): "number, m or rad by joint, or a unit string",
@@ -199,10 +210,13 @@ name = "reference"
 depth = 20
 [[body]]
 name = "float"
-mass = 1000
+mass = "displaced"
 inertia = [1, 1, 1]
 cog = [0, 0, 0]
 hydro = false
+[body.geometry]
+type = "revolution"
+profile = [[0.5, -0.1], [0.5, 0.3], [0, 0.5]]
 [[joint]]
 name = "heave"
 type = "prismatic"
@@ -214,6 +228,7 @@ point = [0, 0, 0]
 name = "generator"
 joint = "heave"
 rated_power = "500 W"
+force_max_on = "hull"
 [pto.drivetrain]
 torque_constant = 1.0
 winding_inductance = "1 mH"

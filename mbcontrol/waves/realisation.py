@@ -187,3 +187,22 @@ def from_elevation(t, eta, *, band: tuple[float, float] | None = None,
                 "dropped_variance": float(dropped)}
     return Wave("elevation", omega[keep], amplitude[keep], phase[keep], direction, ramp_time,
                 settings, d_omega)
+
+
+def repeat_period(wave) -> tuple[float, np.ndarray]:
+    """(T, k): the wave's repeat period (s) and its components' harmonic numbers on 2 pi / T.
+
+    Regular waves repeat over their period; irregular seas made on a uniform grid (Wave.d_omega)
+    over 2 pi / d_omega. Raises ValueError for waves that are not periodic on such a grid.
+    """
+    omega = np.asarray(wave.omega, float)
+    if omega.size == 1:
+        return 2 * np.pi / float(omega[0]), np.array([1])
+    if wave.d_omega is None:
+        raise ValueError("a repeat period: an irregular wave needs a uniform frequency "
+                         "grid (Wave.d_omega) to be periodic")
+    k = omega / wave.d_omega
+    if np.max(np.abs(k - np.rint(k))) > 1e-6 or np.any(np.rint(k) < 1):
+        raise ValueError("a repeat period: the wave's frequencies are not positive "
+                         "multiples of its d_omega")
+    return 2 * np.pi / wave.d_omega, np.rint(k).astype(int)

@@ -47,7 +47,8 @@ def test_signals_and_their_units(sphere):
     assert units == {"pto__position": "m", "pto__velocity": "m/s", "pto__force": "N",
                      "pto__power": "W", "pto__current": "A", "pto__voltage": "V",
                      "pto__winding_loss": "W", "pto__friction_loss": "W",
-                     "pto__electrical_power": "W", "pto__mechanical_power": "W"}
+                     "pto__electrical_power": "W", "pto__mechanical_power": "W",
+                     "pto__hull_force": "N"}
 
 
 def test_drivetrain_balance_pointwise(sphere):
@@ -67,6 +68,9 @@ def test_drivetrain_balance_pointwise(sphere):
         out = [y[y_index[f"pto__{k}"]] for k in ("electrical_power", "winding_loss",
                                                  "friction_loss", "mechanical_power")]
         assert out[3] == pytest.approx(out[0] + out[1] + out[2] + stored, rel=1e-12, abs=1e-6)
+        # the force on the hull: the machine's less the reflected inertia and friction forces
+        hull = y[y_index["pto__force"]] - d.gear_ratio ** 2 * (d.inertia * a + d.friction * v)
+        assert y[y_index["pto__hull_force"]] == pytest.approx(hull, rel=1e-12, abs=1e-6)
         current = y[y_index["pto__force"]] / d.force_per_current
         assert y[y_index["pto__current"]] == pytest.approx(current, rel=1e-12)
         assert y[y_index["pto__voltage"]] == pytest.approx(
