@@ -31,6 +31,7 @@ from .commands import (run_bench, run_fidelity, run_hydro, run_linearize, run_mo
                        run_simulate)
 from .describe import default_help, run_defaults, run_keys
 from .design import run_design
+from .codesign import add_parser as add_codesign_parser
 from .export import add_parser as add_export_parser
 from .identify import add_parser as add_identify_parser
 from .sweep import add_parser as add_sweep_parser
@@ -338,6 +339,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(run=run_linearize)
     add_identify_parser(sub)
     add_sweep_parser(sub)
+    add_codesign_parser(sub, _wave_options)
     add_export_parser(sub, _model_options, _wave_options)
     return parser
 
