@@ -100,6 +100,12 @@ def codesign(spec: Spec, *, vary: dict | None = None, optimize: dict | None = No
     if bad:
         raise ValueError(f"codesign: {bad[0]} is the wave's heading; expected a scene "
                          f"parameter, a plant parameter or a controller setting")
+    laws = {f"{p.name}__{k}" for p in scene.ptos for k in ("damping", "stiffness")}
+    idle = [n for n in names if roles[n] == "param" and n in laws]
+    if idle:          # the bounds free the PTO force, a controller replaces the scene's law
+        raise ValueError(f"codesign: {idle[0]} is the scene PTO's own law, which every "
+                         f"objective sets aside; vary the controller's setting instead "
+                         f"(e.g. damping with --controller passive)")
     text = Path(scene.path).read_text()
     cache, points = Store(store), []
 
