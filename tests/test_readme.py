@@ -47,6 +47,7 @@ TABLES = {
     "site": ("test", "tests/waves/test_annual_energy_pins.py"),
     "device": ("test", "tests/controllers/test_electrical.py"),
     "optimum": ("measured", "benchmarks/wecopttool_electrical.py"),
+    "keel radius r2 (m)": ("measured", "benchmarks/wecopttool_codesign.py"),
     "data": ("measured", "benchmarks/radiation_fit.py"),
     "method": ("reference", "the integration methods by name"),
     "scenario": ("measured", "--stability"),

@@ -37,14 +37,23 @@ def expand(data: dict, file: str, overrides: dict | None = None) -> tuple[dict, 
     params = data.pop("parameters", {})
     if not isinstance(params, dict):
         raise SceneError(f"{file}: parameters: expected a table of numbers")
+    derived = {}           # "{expr}" of the parameters declared before it: h2 from r2
     for key, value in params.items():
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise SceneError(f"{file}: parameters.{key}: expected a number, got {value!r}")
+        if isinstance(value, str) and value.strip().startswith("{") and value.strip().endswith("}"):
+            derived[key] = value.strip()[1:-1]
+        elif isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise SceneError(f"{file}: parameters.{key}: expected a number or an \"{{expr}}\" of "
+                             f"the parameters before it, got {value!r}")
     unknown = sorted(set(overrides or {}) - set(params))
     if unknown:
         raise SceneError(f"{file}: parameters: {unknown} not declared; the scene's parameters are "
                          f"{sorted(params) or 'none'}")
-    values = {**params, **(overrides or {})}
+    values = {k: v for k, v in params.items() if k not in derived}
+    values.update({k: v for k, v in (overrides or {}).items() if k not in derived})
+    for key, text in derived.items():             # in declaration order; an override wins
+        values[key] = (overrides or {}).get(key, evaluate(text, values, file,
+                                                          f"parameters.{key}"))
+    values = {k: values[k] for k in params}
     out = {}
     for key, value in data.items():
         if isinstance(value, list) and value and all(isinstance(v, dict) for v in value):

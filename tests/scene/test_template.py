@@ -122,3 +122,17 @@ def test_end_stop_on_unknown_joint():
     text = text.replace('"{LOWER}"', "-0.1").replace('"{UPPER}"', "0.1")
     with pytest.raises(SceneError, match=r"end_stop\[0\]\.joint: expected a joint with one coordinate"):
         _scene(text)
+
+
+def test_a_parameter_may_follow_those_before_it():
+    """A derived parameter ("{expr}" of the ones declared before it) follows an override of
+    them, may itself be overridden, and may not name one declared after it."""
+    text = CHAIN.replace("L = 2.0", 'L = 2.0\nhalf = "{L / 2}"').replace(
+        'cog = ["{(i - 1) * L + L / 2}"', 'cog = ["{(i - 1) * L + half}"')
+    scene = _scene(text, {"L": 4.0})
+    assert scene.parameters["half"] == 2.0 and scene.bodies[1].cog[0] == pytest.approx(6.0)
+    assert _scene(text, {"half": 0.5}).bodies[0].cog[0] == pytest.approx(0.5)
+    with pytest.raises(SceneError, match="parameters.half: cannot evaluate"):
+        _scene(text.replace('half = "{L / 2}"', 'half = "{M / 2}"'))
+    with pytest.raises(SceneError, match="parameters.L: expected a number or"):
+        _scene(text.replace("L = 2.0", 'L = "two"'))
