@@ -25,8 +25,6 @@ from __future__ import annotations
 import dataclasses
 import math
 
-import numpy as np
-
 OBJECTIVES = ("electrical_bound", "mechanical_bound", "controller", "annual_energy")
 
 
@@ -123,6 +121,8 @@ def _bound(objective: str, plant, wave, params) -> dict:
 
 def _controller(spec: Spec, plant, wave, params, settings) -> dict:
     """A causal law designed for the wave (sea_design), simulated and checked."""
+    import inspect
+
     from mbcontrol.controllers import REGISTRY, make
     from mbcontrol.controllers.sea_design import design_for_sea
 
@@ -131,7 +131,6 @@ def _controller(spec: Spec, plant, wave, params, settings) -> dict:
     from ...sim import simulate
     designed = design_for_sea(plant, wave, spec.controller, dt=spec.dt)
     chosen = {**designed["settings"], **settings}
-    import inspect
     if "wave" in inspect.signature(REGISTRY[spec.controller]).parameters:
         chosen["wave"] = wave
     run = simulate(plant, wave, duration=spec.duration, dt=spec.dt,
@@ -188,7 +187,3 @@ def cost_proxy(per: str, scene, values: dict) -> float:
     if not (value > 0 and math.isfinite(value)):
         raise ValueError(f"--per {per}: the cost proxy is {value!r}; expected a finite number > 0")
     return float(value)
-
-
-def finite_or_none(x):
-    return None if x is None or not np.isfinite(x) else float(x)
