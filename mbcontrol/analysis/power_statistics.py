@@ -28,15 +28,22 @@ from __future__ import annotations
 import numpy as np
 
 
+def law_params(plant, gains: dict, params=None) -> dict:
+    """Plant parameter overrides that put the linear law F = -(c v + k x) in place on each
+    PTO of `gains` (pto -> (c, k)), Coulomb friction left out (`ports.linear_params`)."""
+    from .ports import linear_params
+    values = linear_params(plant, list(gains), params)
+    for name, (c, k) in gains.items():
+        values[f"{name}__damping"], values[f"{name}__stiffness"] = float(c), float(k)
+    return values
+
+
 def law_responses(plant, omega, gains: dict, *, direction: float = 0.0, params=None) -> dict:
     """{pto: (V, X)}: complex velocity and position of each PTO per unit wave amplitude
     (exp(+i w t)) with the law F = -(c v + k x) in place; gains: pto -> (c, k) in N s/m and
     N/m (or N m s/rad, N m/rad). Coulomb friction is left out (it is not linear)."""
     from .frequency import frequency_domain_response
-    from .ports import linear_params
-    values = linear_params(plant, list(gains), params)
-    for name, (c, k) in gains.items():
-        values[f"{name}__damping"], values[f"{name}__stiffness"] = float(c), float(k)
+    values = law_params(plant, gains, params)
     omega = np.asarray(omega, float)
     names = [f"{name}__velocity" for name in gains]
     V = frequency_domain_response(plant, omega, direction=direction, params=values,

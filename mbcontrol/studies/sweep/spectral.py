@@ -80,19 +80,15 @@ def expected_power(plant, wave, gains, *, params=None, statespace: bool = False)
     BEM data straight (statespace False) or with the radiation fit the plant steps
     (`analysis.statespace_response` of the model linearised with the law in place)."""
     from ...analysis import linearize, statespace_response
-    from ...analysis.power_statistics import law_responses
-    from ...analysis.ports import linear_params
+    from ...analysis.power_statistics import law_params, law_responses
     a2 = np.asarray(wave.amplitude, float) ** 2
     if not statespace:
         responses = law_responses(plant, wave.omega, gains, direction=wave.direction,
                                   params=params)
         return float(sum(0.5 * c * np.sum(a2 * np.abs(responses[n][0]) ** 2)
                          for n, (c, _) in gains.items()))
-    values = linear_params(plant, list(gains), params)
-    for name, (c, k) in gains.items():
-        values[f"{name}__damping"], values[f"{name}__stiffness"] = float(c), float(k)
     outputs = [f"{name}__velocity" for name in gains]
-    sys = linearize(plant, params=values, outputs=outputs)
+    sys = linearize(plant, params=law_params(plant, gains, params), outputs=outputs)
     V = statespace_response(sys, plant, wave.omega, direction=wave.direction, outputs=outputs)
     return float(sum(0.5 * c * np.sum(a2 * np.abs(V[:, i]) ** 2)
                      for i, (c, _) in enumerate(gains.values())))
@@ -114,6 +110,7 @@ def parameter_gradient(plant, wave, gains, names, values: dict, *,
     law is the scene PTOs' own (no controller), so a PTO's damping or stiffness parameter
     moves its gains; under a controller those parameters are set aside (no effect)."""
     out = np.zeros(len(names))
+    base = expected_power(plant, wave, gains, params=values)
     for j, name in enumerate(names):
         x = float(values[name])
         h = STEP * abs(x) if x else STEP
@@ -125,6 +122,5 @@ def parameter_gradient(plant, wave, gains, names, values: dict, *,
                 c, k = gains[pto]
                 moved[pto] = (value, k) if kind == "damping" else (c, value)
             power.append(expected_power(plant, wave, moved, params={**values, name: value}))
-        out[j] = (power[0] - power[1]) / (2 * h) / expected_power(plant, wave, gains,
-                                                                  params=values)
+        out[j] = (power[0] - power[1]) / (2 * h) / base
     return out
