@@ -64,6 +64,7 @@ bench: $(VENV)/.installed-test
 	$(PY) benchmarks/spectral_scatter.py --out $(OUT)/bench/spectral_scatter
 	$(PY) benchmarks/wecopttool_electrical.py --out $(OUT)/bench/wecopttool
 	$(PY) benchmarks/wecopttool_codesign.py --out $(OUT)/bench/wecopttool_codesign
+	$(PY) benchmarks/wecopttool_tste.py --out $(OUT)/bench/wecopttool_tste
 	$(PY) benchmarks/export_qp.py
 	$(PY) benchmarks/export_step.py --out $(OUT)/bench/export
 

@@ -72,9 +72,10 @@ def electrical_optimum(plant, wave, *, pto: str | None = None, params=None) -> d
     Z_out = R + i omega L + (G kt')^2 / Z_i. The delivered power -Re(V I*) / 2 is largest at
     I = -V_oc / (2 Re Z_out): |V_oc|^2 / (8 Re Z_out) per component. With R = 0 this is the
     complex-conjugate bound; with losses the optimal mechanical load Z_pto = -F / v is no
-    longer conj(Z_i). Z_i holds the drivetrain's reflected inertia and friction (the plant
-    does). Returns {"power_W", "omega", "power_per_omega_W", "load_impedance" (Z_pto, N s/m or
-    N m s/rad), "electrical_load" (V / -I, ohm), "mechanical_power_W" (its -F v)}.
+    longer conj(Z_i). Z_i holds the drivetrain's reflected inertia, friction and stiffness
+    (the plant does). Returns {"power_W", "omega", "power_per_omega_W", "load_impedance"
+    (Z_pto, N s/m or N m s/rad), "electrical_load" (V / -I, ohm), "mechanical_power_W" (its
+    -F v)}.
     """
     name = pto or plant.scene.ptos[0].name
     drive = next(p for p in plant.scene.ptos if p.name == name).drivetrain
@@ -150,9 +151,10 @@ def fd_statistics(Z, F, wave, damping, stiffness, *, efficiency: float | None = 
       random-phase records at exceedance 10 %);
     - stroke_std, force_std: standard deviations (m, N).
 
-    hull: a drivetrain's impedance Z_d = gear^2 (b + i omega J) at wave.omega (`hull_impedance`)
-    when the force limit acts on the hull: force_peak and force_std are then those of the
-    force the drivetrain puts on the hull, U - Z_d V (the winding loss stays the machine's).
+    hull: a drivetrain's impedance Z_d = gear^2 (i omega J + b - i K / omega) at wave.omega
+    (`hull_impedance`) when the force limit acts on the hull: force_peak and force_std are
+    then those of the force the drivetrain puts on the hull, U - Z_d V (the winding loss stays
+    the machine's).
     """
     w, a = np.asarray(wave.omega, float), np.asarray(wave.amplitude, float)
     c = np.asarray(damping, float)[..., None]
@@ -165,14 +167,14 @@ def fd_statistics(Z, F, wave, damping, stiffness, *, efficiency: float | None = 
 
 
 def hull_impedance(plant, pto: str, omega, force_on: str | None = None):
-    """Z_d = gear^2 (b + i omega J) (exp(+i omega t); N s/m or N m s/rad) of the PTO's
-    drivetrain when its force limit acts on the hull (scene Pto.limited_force), else None:
-    the limited force is then the machine's."""
+    """Z_d = gear^2 (i omega J + b - i K / omega) (exp(+i omega t); N s/m or N m s/rad), the
+    PTO drivetrain's reflected impedance (Drivetrain.reflected_impedance), when its force limit
+    acts on the hull (scene Pto.limited_force), else None: the limited force is then the
+    machine's."""
     owner = next(p for p in plant.scene.ptos if p.name == pto)
     if owner.limited_force(force_on) != "hull":
         return None
-    d = owner.drivetrain
-    return d.gear_ratio ** 2 * (d.friction + 1j * np.asarray(omega, float) * d.inertia)
+    return owner.drivetrain.reflected_impedance(1j * np.asarray(omega, float))
 
 
 def phasor_statistics(V, X, U, c, wave, *, efficiency: float | None = None,

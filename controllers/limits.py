@@ -41,10 +41,26 @@ def force_limits(plant, force_max=None) -> np.ndarray:
 def command_limit(pto) -> float:
     """The limit a scene PTO puts on the machine's force, the controller's command (N or N m):
     its force_max, or none (inf) when force_max_on = "hull" with a drivetrain, where the limit
-    is on the force the drivetrain puts on the hull (the machine's less gear^2 (J a + b v)),
+    is on the force the drivetrain puts on the hull (the machine's less gear^2 (J a + b v +
+    K x)),
     which a command clip does not bound: the tuners keep the predicted hull force inside it
     and the metrics check the simulated one."""
     return math.inf if pto.limited_force() == "hull" else float(pto.force_max)
+
+
+def hull_limits(ptos, names, force_max=None) -> list:
+    """The MPC's hull-force rows: (index in `names`, gear^2 J, gear^2 b, gear^2 K, limit) per
+    PTO whose scene limit acts on the force its drivetrain puts on the hull; none when the
+    controller is given its own force_max (a limit on the machine, its command)."""
+    if force_max is not None:
+        return []
+    out = []
+    for p in ptos:
+        if p.limited_force() == "hull":
+            d, g2 = p.drivetrain, p.drivetrain.gear_ratio ** 2
+            out.append((names.index(p.name), g2 * d.inertia, g2 * d.friction,
+                        g2 * d.stiffness, float(p.force_max)))
+    return out
 
 
 def saturate(u: np.ndarray, limits: np.ndarray) -> np.ndarray:

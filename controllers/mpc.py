@@ -8,6 +8,7 @@ over each step) and P the PTO positions at the ends of the steps:
     minimise   sum_k u_k . (p_k+1 - p_k)          (minus the absorbed energy, J)
              + r |U|^2 + w1 |s|_1 + w2 |s|^2      (force penalty, stroke slack)
     subject to |u_k| <= force_max, |u_k - u_k-1| <= rate_max dt, |p_k| <= stroke_max + s_k
+               (force_max_on = "hull": the hull's force at each step's ends, mpc_qp)
 
 The energy of a held force is exactly u_k (p_k+1 - p_k). Condensed (P affine in U), the
 energy term is U^T G U + q^T U with G + G^T positive semidefinite whenever the plant is
@@ -67,7 +68,8 @@ from mbcontrol.results import jsonable
 from .base import signal_indices
 from .control_plant import build_control_plant, device_frequency, hydro_band, pto_impedance
 from .estimation import ArPredictor, ExcitationKalman, excitation_error, wave_frequencies
-from .limits import LINEAR_RANGE_SHARE, command_limit, linear_range, per_pto_values
+from .limits import (LINEAR_RANGE_SHARE, command_limit, hull_limits, linear_range,
+                     per_pto_values)
 from .sampled import held_dampers
 from .mpc_envelope import MpcEnvelope
 from .mpc_qp import CondensedQp
@@ -149,13 +151,10 @@ class Mpc:
                    for p in ptos]
         self.stroke_default = None if self.stroke_max is not None else {
             p.name: s for p, s in zip(ptos, strokes) if not math.isfinite(p.stroke_max)}
-        hull = [p.name for p in ptos if command_limit(p) != p.force_max]
-        if hull and self.force_max is None:     # hull-force rows are not built
-            raise ValueError(f"mpc: PTO {hull[0]!r} limits the force on the hull (force_max_on"
-                             f" = 'hull'); the MPC limits the machine's command only: give it "
-                             f"force_max (a machine limit) explicitly")
+        hull = hull_limits(ptos, list(cp.ptos), self.force_max)   # force_max_on = "hull"
         self.limits = {
-            "force": per_pto_values(plant, self.force_max, [p.force_max for p in ptos], "force_max"),
+            "force": per_pto_values(plant, self.force_max, [command_limit(p) for p in ptos],
+                                    "force_max"),
             "stroke": per_pto_values(plant, self.stroke_max, strokes, "stroke_max"),
             "rate": per_pto_values(plant, self.rate_max, [math.inf] * len(ptos), "rate_max"),
         }
@@ -175,7 +174,7 @@ class Mpc:
                               loss_damping=pto_impedance(cp, float(np.median(omega))),
                               force_penalty=self.force_penalty,
                               stroke_penalty=self.stroke_penalty, soft_stroke=self.soft_stroke,
-                              solver=self.solver, envelope=self.env.rows(cp))
+                              solver=self.solver, envelope=self.env.rows(cp), hull=hull)
         if self.estimator == "kalman":
             self.kalman = ExcitationKalman(cp, omega,
                                            measurement_noise=self.measurement_noise)
@@ -283,7 +282,8 @@ class Mpc:
     def _warm_up_damping(self, plant, cp, omega) -> np.ndarray:
         """The warm-up damper per PTO, N s/m: optimal_damping for the sea (linear theory, the
         other PTOs free), or |Z_i| at the wave model's median frequency (the regular-wave
-        optimum) without a wave or when the sea lies outside the hydro data."""
+        optimum) without a wave or when the sea lies outside the hydro data. A limit on the
+        hull is not held during the warm-up (the command clip holds a machine limit)."""
         out = pto_impedance(cp, float(np.median(omega)))
         if self.wave is not None:
             from .passive import optimal_damping

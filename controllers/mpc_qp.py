@@ -17,13 +17,17 @@ class CondensedQp:
     unlimited); L_s: the stroke limit (or 1 m). envelope: rows (ne, nz) of outputs of the
     control plant, each scaled by its limit, kept within +-1 at the ends of steps 1..N with a
     slack each (always soft: the sea alone may take a quantity beyond it); solve's offset
-    adds what no state holds (the forecast surface elevation). solve(z0, D, u_prev, warm,
-    offset) -> (U (N, nu) or None, status).
+    adds what no state holds (the forecast surface elevation). hull: per PTO whose limit is
+    on the force its drivetrain puts on the hull (force_max_on = "hull"), (index, gear^2 J,
+    gear^2 b, gear^2 K, limit): that force, u - gear^2 (J a + b v + K x), at the start and
+    the end of each held step kept within the limit (hard; soft in the soft form): within a
+    step it moves with the motion, smooth over a step much shorter than the wave's period.
+    solve(z0, D, u_prev, warm, offset) -> (U (N, nu) or None, status).
     """
 
     def __init__(self, cp, N: int, limits: dict, *, efficiency, loss_damping,
                  force_penalty: float, stroke_penalty: float, soft_stroke: bool, solver: str,
-                 winding=None, envelope=None):
+                 winding=None, envelope=None, hull=None):
         nu, nz = len(cp.ptos), cp.nz
         self.N, self.nu, self.solver = N, nu, solver
         # prediction of the positions at the ends of steps 1..N
@@ -36,6 +40,10 @@ class CondensedQp:
         if self.n_env:
             self.Phi_e, self.Psi_e, self.Om_e = _predictions(cp, np.asarray(envelope, float),
                                                              powers, N)
+        self.hull = list(hull or [])
+        if self.hull:
+            self.M_h, self.Phi_h, self.Om_h = _hull_rows(cp, self.hull, powers, N)
+        self.n_hull = len(self.hull)
         L = np.eye(N * nu) - np.eye(N * nu, k=-nu)       # P -> increments
         E = np.zeros((N * nu, nu))
         E[:nu] = np.eye(nu)
@@ -82,7 +90,7 @@ class CondensedQp:
         # it is infeasible
         self.soft_stroke = soft_stroke
         self.forms = [_QpForm(self, soft=False, backend=backend)]
-        if (soft_stroke and self.has_stroke) or self.n_env:
+        if (soft_stroke and self.has_stroke) or self.n_env or self.n_hull:
             self.forms.append(_QpForm(self, soft=True, backend=backend))
         self._last, self.soft_solves = 0, 0
 
@@ -97,6 +105,8 @@ class CondensedQp:
         if self.n_env:
             env = self.Phi_e @ z0 + self.Om_e @ D.reshape(-1)
             free.append(env if offset is None else env + np.asarray(offset, float).reshape(-1))
+        if self.n_hull:
+            free.append(self.Phi_h @ z0 + self.Om_h @ D.reshape(-1))
         q = self.Qz @ z0 + self.Qd @ D.reshape(-1)
         status = "not solved"
         # start with the form that solved last time: the hard QP is infeasible for stretches
@@ -115,7 +125,8 @@ class CondensedQp:
 class _QpForm:
     """One layout of the condensed QP: hard limits (variables U) or soft ones (U, slacks).
     Rows: stroke (Psi U, or Psi U -/+ s; soft in the soft form when soft_stroke), envelope
-    (always soft in the soft form), then force rate (differences of U)."""
+    (always soft in the soft form), hull force (soft in the soft form), then force rate
+    (differences of U)."""
 
     def __init__(self, qp, *, soft: bool, backend):
         N, nu = qp.N, qp.nu
@@ -125,6 +136,8 @@ class _QpForm:
             blocks.append((qp.Fs / qp.Ls * qp.Psi, soft and qp.soft_stroke))
         if qp.n_env:
             blocks.append((qp.Fs * qp.Psi_e, soft))
+        if qp.n_hull:
+            blocks.append((qp.Fs * qp.M_h, soft))
         self.blocks = [is_soft for _, is_soft in blocks]
         n_s = sum(M.shape[0] for M, is_soft in blocks if is_soft)
         self.n_var = N * nu + n_s
@@ -158,7 +171,8 @@ class _QpForm:
         g = self.g_slack.copy()
         g[:n] += q
         lba, uba = [], []
-        limits = ([qp.stroke] if qp.has_stroke else []) + ([1.0] if qp.n_env else [])
+        limits = ([qp.stroke] if qp.has_stroke else []) + ([1.0] if qp.n_env else []) \
+            + ([1.0] if qp.n_hull else [])
         for is_soft, f, lim in zip(self.blocks, free, limits):
             f = np.asarray(f, float)
             if is_soft:
@@ -233,7 +247,8 @@ class _CvxpyBackend:
         # which rows have finite bounds is fixed by the layout: probe it once
         qp = form.qp
         free = ([np.zeros(form.n_u)] if qp.has_stroke else []) + \
-            ([np.zeros(qp.N * qp.n_env)] if qp.n_env else [])
+            ([np.zeros(qp.N * qp.n_env)] if qp.n_env else []) + \
+            ([np.zeros(2 * qp.N * qp.n_hull)] if qp.n_hull else [])
         _, lba, uba = form.bounds(np.zeros(form.n_u), free, np.zeros(qp.nu))
         self.lo_rows, self.hi_rows = np.flatnonzero(np.isfinite(lba)), np.flatnonzero(np.isfinite(uba))
         self.lba, self.uba = cp.Parameter(self.lo_rows.size), cp.Parameter(self.hi_rows.size)
@@ -270,6 +285,44 @@ def _predictions(cp, C, powers, N):
             Psi[(k - 1) * nc:k * nc, j * nu:(j + 1) * nu] = step @ cp.Bu
             Om[(k - 1) * nc:k * nc, j * nd:(j + 1) * nd] = step @ cp.Bd
     return Phi, Psi, Om
+
+
+def _hull_rows(cp, hull, powers, N):
+    """(M, Phi, Om): each hull-limited PTO's force on the hull over its limit at the start and
+    at the end of each held step (rows: starts for steps 1..N, then ends), as M U + Phi z0 +
+    Om D. At a state z, with u and d held: u - gear^2 (J a + b v + K x), a = Cv (A z + Bu u +
+    Bd d) from the continuous model (the acceleration has the force's feedthrough)."""
+    nu, nd, nh = cp.Bu.shape[1], cp.nd, len(hull)
+    idx = [h[0] for h in hull]
+    J, b, K, limit = (np.array([h[i] for h in hull], float)[:, None] for i in (1, 2, 3, 4))
+    Cv, Cx = cp.Cv[idx], cp.Cp[idx]
+    Ch = J * (Cv @ cp.A) + b * Cv + K * Cx                   # (nh, nz): the state's part
+    S = np.zeros((nh, nu))
+    S[np.arange(nh), idx] = 1.0
+    Du, Dd = S - J * (Cv @ cp.Bu_c), -J * (Cv @ cp.Bd_c)     # the held force's and sea's
+    Phi, Psi, Om = _predictions(cp, Ch, powers, N)           # Ch z_k at the steps' ends
+    start = (np.vstack([Ch, Phi[:-nh]]), np.vstack([np.zeros((nh, N * nu)), Psi[:-nh]]),
+             np.vstack([np.zeros((nh, N * nd)), Om[:-nh]]))  # Ch z_k-1: the steps' starts
+    # the acceleration follows the sea at the instant, not its held (midpoint) value: over a
+    # step a sphere's excitation moves by ~15 % of its amplitude. d at the steps' ends is
+    # interpolated between the midpoints (extrapolated at the horizon's two ends)
+    at_start, at_end = _boundaries(N)
+    held_u = np.kron(np.eye(N), Du)
+    scale = np.tile(1.0 / limit, (2 * N, 1))
+    M = np.vstack([held_u - start[1], held_u - Psi]) * scale
+    Om_h = np.vstack([np.kron(at_start, Dd) - start[2], np.kron(at_end, Dd) - Om])
+    return M, -np.vstack([start[0], Phi]) * scale, Om_h * scale
+
+
+def _boundaries(N: int):
+    """(N, N) maps from step-midpoint values to the values at each step's start and end:
+    linear between midpoints, extrapolated beyond the first and the last."""
+    if N == 1:
+        return np.eye(1), np.eye(1)
+    mid = np.eye(N)
+    ends = 0.5 * (mid[:-1] + mid[1:])                      # between steps k and k+1
+    first, last = 1.5 * mid[0] - 0.5 * mid[1], 1.5 * mid[-1] - 0.5 * mid[-2]
+    return np.vstack([first, ends]), np.vstack([ends, last])
 
 
 class _Discard:

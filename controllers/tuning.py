@@ -41,7 +41,7 @@ def constrained_tuning(plant, wave, *, pto: str | None = None, params=None,
     -1, min |1 + L(i omega)| with L = Z_pto / Z_i over the hydro data's band and at rest, is at
     least that (0.52 gives a gain margin of 2.08 and a phase margin of 30.1 deg at the least).
     force_on: which force force_max limits (None: the scene PTO's force_max_on; with a
-    drivetrain "hull" is the force on the hull, the machine's less gear^2 (J a + b v)).
+    drivetrain "hull" is the force on the hull, the machine's less gear^2 (J a + b v + K x)).
 
     passive: stiffness 0, a 1-D search: a log grid of 400 dampings over `bounds` (default
     impedance.default_bounds), then Brent's method between the best feasible point's neighbours

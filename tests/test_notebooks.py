@@ -36,7 +36,8 @@ def test_notebooks_are_what_make_notebooks_writes():
     written = {"tour_hinged_barge": "TOUR", "controllers_sphere": "CONTROLLERS",
                "work_precision_rm3": "WORK_PRECISION", "identification_flume": "IDENTIFICATION",
                "power_matrix": "POWER_MATRIX", "electrical_sphere": "ELECTRICAL",
-               "export_fmu": "EXPORT", "farm_layouts": "FARM"}
+               "export_fmu": "EXPORT", "farm_layouts": "FARM",
+               "codesign": "CODESIGN"}
     assert sorted(written) == sorted(p.stem for p in NOTEBOOKS)
     for stem, cells in written.items():
         built = maker["build"](maker[cells])

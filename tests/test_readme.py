@@ -48,6 +48,8 @@ TABLES = {
     "device": ("test", "tests/controllers/test_electrical.py"),
     "optimum": ("measured", "benchmarks/wecopttool_electrical.py"),
     "keel radius r2 (m)": ("measured", "benchmarks/wecopttool_codesign.py"),
+    "drivetrain": ("measured", "benchmarks/wecopttool_tste.py"),
+    "r2 \\ J (kg m², scale 1)": ("measured", "notebooks/codesign.ipynb"),
     "data": ("measured", "benchmarks/radiation_fit.py"),
     "method": ("reference", "the integration methods by name"),
     "scenario": ("measured", "--stability"),

@@ -232,14 +232,15 @@ class PseudoSpectralProblem:
             return (basis @ alpha).real, np.hstack([eb.real, -eb.imag])
 
         # the limited force: the machine's, or (Pto.limited_force "hull") the force the
-        # drivetrain puts on the hull, F - Z_d V, Z_d = gear^2 (b - i omega J), V = (E + F) / Z
+        # drivetrain puts on the hull, F - Z_d V, V = (E + F) / Z, Z_d its reflected impedance
+        # gear^2 (J s + b + K / s) at s = -i omega (this module's exp(-i omega t))
         owner = next(p for p in plant.scene.ptos if p.name == _pto_name(plant, pto))
         self.force_on = owner.limited_force(force_on)
         alpha, self.force_gain = np.zeros(k.size), np.ones(k.size, complex)
         if self.force_on == "hull":
-            d = owner.drivetrain
-            z_d = d.gear_ratio ** 2 * (d.friction - 1j * self.omega * d.inertia)
+            z_d = owner.drivetrain.reflected_impedance(-1j * self.omega)
             alpha, self.force_gain = -z_d * E / Z, 1 - z_d / Z
+        self.force_offset = alpha        # the limited force's phasors: alpha + force_gain F_k
         self.force_map = affine(alpha, self.force_gain)
         self.velocity_map = affine(E / Z, 1 / Z)
         gain = 1j / (self.omega * Z)                                     # X = i V / omega
@@ -291,8 +292,10 @@ class PseudoSpectralProblem:
             raise ValueError(f"limits must be > 0, got force_max={force_max}, "
                              f"stroke_max={stroke_max}")
         key = (bool(np.isfinite(force_max)), bool(np.isfinite(stroke_max)))
-        if solver == "IPM" and any(key):
-            return self._solve_ipm(force_max, stroke_max, **solver_options)
+        if solver == "IPM":              # box_qp needs a box; without one cvxpy's default
+            if any(key):
+                return self._solve_ipm(force_max, stroke_max, **solver_options)
+            solver, solver_options = "CLARABEL", {}
         if key not in self._problems:
             self._problems[key] = self._build(*key)
         problem, z, limits = self._problems[key]

@@ -46,11 +46,14 @@ def dense_extremes(problem, F_k, force_max: float, stroke_max: float,
                    factor: int = DENSE_FACTOR) -> dict:
     """Largest |force| (N or N m) and |position| (m or rad) of the force with phasors F_k on
     `factor` times the problem's collocation grid, and their overshoots of the limits in %
-    (100 (max / limit - 1), <= 0 when the limit holds; nan for an infinite limit)."""
+    (100 (max / limit - 1), <= 0 when the limit holds; nan for an infinite limit). The force
+    is the one the limit acts on: the machine's F_k, or with the limit on the hull the force
+    the drivetrain puts on it (the problem's force_offset + force_gain F_k)."""
     k = np.rint(problem.omega * problem.period / (2 * np.pi)).astype(int)
     n = factor * problem.time.size
     X_k = 1j * (problem.E + F_k) / (problem.thevenin.impedance * problem.omega)
-    out = {"max_force_dense": float(np.max(np.abs(trig_samples(k, F_k, n)))),
+    L_k = problem.force_offset + problem.force_gain * F_k
+    out = {"max_force_dense": float(np.max(np.abs(trig_samples(k, L_k, n)))),
            "max_position_dense": float(np.max(np.abs(trig_samples(k, X_k, n))))}
     for name, key, limit in (("force", "max_force_dense", force_max),
                              ("position", "max_position_dense", stroke_max)):

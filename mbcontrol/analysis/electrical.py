@@ -41,9 +41,9 @@ def electrical_bound(plant, wave, *, pto: str | None = None, force_max: float = 
 
     force_on: which force force_max limits (None: the scene PTO's force_max_on): "machine"
     (the PTO force, the machine's), or "hull" ("wec" too: what the whole drivetrain puts on
-    the joint, the machine's force less the reflected inertia and friction forces gear^2 (J a
-    + b v): WecOptTool's PTO force; the result's force series and max_force are then that
-    force)."""
+    the joint, the machine's force less the reflected inertia, friction and shaft-spring
+    forces gear^2 (J a + b v + K x): WecOptTool's PTO force; the result's force series and
+    max_force are then that force)."""
     name = _pto_name(plant, pto)
     winding = winding_coefficient(plant, name)
     if winding is None:

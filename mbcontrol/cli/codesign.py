@@ -16,8 +16,11 @@ absorbed power any PTO force delivers in the wave within the PTO's force and str
 (non-causal; the force limit acts where the scene's force_max_on says: WecOptTool's co-design
 objective); controller, the mean power of a causal --controller designed for the wave (as
 `sweep --design`) and simulated; annual_energy, the --seas site's annual energy with the
-controller designed per sea, its 95 % interval the error bar. --per divides by a cost proxy:
-volume (m^3 displaced), rated_force (kN) or an arithmetic expression of the parameters.
+controller designed per sea, its 95 % interval the error bar. A bound with --seas instead of
+a wave is the site's annual energy of the bound (MWh). --per divides by a cost proxy: volume
+(m^3 displaced), rated_force (kN) or an arithmetic expression of the parameters. --against
+OBJECTIVE evaluates the same points under a second objective and says whether the optimum
+moves, with error bars (e.g. the causal annual energy against the bound's).
 
 Each geometry's BEM data and radiation fit are cached by content, so a geometry met again
 costs nothing; with --store DIR every evaluated point is kept (DIR/points), so an interrupted
@@ -27,13 +30,19 @@ study resumes and a rerun computes nothing. Grids run on Dask with --workers N o
 The --json output is a contract: {"points": [{"params", "objective", "valid", "error_95",
 "reasons", "wall_s", "reused", "details"}], "best": {"params", "objective", "error_95"},
 "objective_name", "search", "computed", "reused", "wall_time_s", "provenance": {"model",
-"scene", "spec", "roles"}}.
+"scene", "spec", "roles"}}; with --against also "against" (the second study, same form) and
+"comparison": {"best", "other_best", "at_other_best", "difference", "difference_95",
+"share_of_other", "verdict"}.
 
 Examples:
   mbcontrol codesign wavebot --vary r2=0.2,0.35,0.5 --objective electrical_bound \\
       --wave regular --height 0.125 --period 3.3333333 --json
   mbcontrol codesign wavebot --optimize r2=0.05:0.88 --objective electrical_bound \\
       --wave regular --height 0.125 --period 3.3333333 --plot out/r2.png
+  mbcontrol codesign wavebot --scene-param scale=10 --scene-param rated=1500 \
+      --vary r2=0.05,0.35,0.65,0.88 --objective annual_energy --controller reactive \
+      --against electrical_bound --omega-max 3 \
+      --seas ../shared/data/sites/pacwave_cluster_32.csv --store out/site --plot out/site.png
 """
 
 
@@ -53,7 +62,12 @@ def add_parser(sub, wave_options) -> None:
     p.add_argument("--objective", default="electrical_bound",
                    help="electrical_bound (default), mechanical_bound, controller, annual_energy")
     p.add_argument("--controller", help="the causal law (objectives controller, annual_energy)")
-    p.add_argument("--seas", metavar="FILE.csv", help="weighted seas (objective annual_energy)")
+    p.add_argument("--seas", metavar="FILE.csv",
+                   help="weighted seas: annual_energy, or a bound's annual energy (MWh)")
+    p.add_argument("--against", metavar="OBJECTIVE",
+                   help="the same points under a second objective (e.g. electrical_bound "
+                        "against annual_energy): both curves, both optima and whether the "
+                        "optimum moves, with error bars")
     p.add_argument("--per", help="a cost proxy to divide by: volume, rated_force or an "
                                  "expression")
     p.add_argument("--scene-param", action="append", default=[], metavar="NAME=VALUE",
@@ -65,6 +79,9 @@ def add_parser(sub, wave_options) -> None:
     p.add_argument("--duration", type=float, default=300.0,
                    help="simulated time per point, s (controller, annual_energy; 300)")
     p.add_argument("--dt", type=float, help=f"time step, s ({default_help('sweep.dt')})")
+    p.add_argument("--omega-max", type=float, metavar="RAD_S",
+                   help="bounds: the top frequency the force may hold (default: the hydro "
+                        "data's; lower is faster: the QP grows as its cube)")
     p.add_argument("--max-evals", type=int, default=40, help="optimiser's evaluations (40)")
     p.add_argument("--store", metavar="DIR", help="keep every evaluated point here (resumable)")
     p.add_argument("--workers", type=int, default=0, help="Dask workers for a grid (0: here)")
@@ -95,13 +112,14 @@ def run_codesign(args) -> int:
     from ..studies.codesign import Spec, codesign
     from .commands import _key_value, parse_settings
     wave = None
-    if args.wave != "none" and args.objective != "annual_energy":
+    if args.wave != "none" and args.objective != "annual_energy" and not args.seas:
         wave = {"kind": args.wave, "height": args.height, "period": args.period, "hs": args.hs,
                 "tp": args.tp, "gamma": args.gamma, "seed": args.seed}
     cls = REGISTRY.get(args.controller) if args.controller else None
     settings = parse_settings(args.set, inspect.signature(cls).parameters if cls else {})
     spec = Spec(model=args.model, objective=args.objective, wave=wave, seas=args.seas,
                 controller=args.controller, per=args.per, duration=args.duration, dt=args.dt,
+                omega_max=args.omega_max,
                 scene_params=tuple(sorted(dict(_key_value(s, "--scene-param")
                                                for s in args.scene_param).items())),
                 params=tuple(sorted(dict(_key_value(s, "--param") for s in args.param).items())),
@@ -112,7 +130,16 @@ def run_codesign(args) -> int:
     result = codesign(spec, vary=vary or None, optimize=optimize or None, store=args.store,
                       workers=args.workers, scheduler=args.scheduler,
                       max_evals=args.max_evals, progress=not args.json)
-    unit = "MWh" if args.objective == "annual_energy" else "W"
+    unit = spec.unit
+    if args.against:
+        import dataclasses
+
+        from ..studies.codesign.compare import compare_optima
+        other = dataclasses.replace(spec, objective=args.against)
+        kw = dict(vary=vary) if vary else dict(at=[p["params"] for p in result["points"]])
+        result["against"] = codesign(other, store=args.store, workers=args.workers,
+                                     scheduler=args.scheduler, progress=not args.json, **kw)
+        result["comparison"] = compare_optima(result, result["against"])
     if args.plot:
         from ..studies.codesign.plots import plot_codesign
         plot_codesign(result, args.plot, unit + (f" per {args.per}" if args.per else ""))
@@ -133,4 +160,7 @@ def run_codesign(args) -> int:
         return 1
     print(f"  best: {', '.join(f'{k} {v:.5g}' for k, v in best['params'].items())}: "
           f"{best['objective']:.6g} {unit}")
+    if "comparison" in result:
+        from ..studies.codesign.compare import describe
+        print("  " + describe(result["comparison"], unit))
     return 0

@@ -41,8 +41,9 @@ def pto_forces(scene: Scene, topo: Topology, q, s, u, params: Parameters):
     Joint PTOs act on their coordinate; point-to-point PTOs along the line between their two
     points (x: change of distance, m; equal and opposite forces on the two bodies). The force
     map takes a scalar PTO force to the generalised force (used for preloads). A drivetrain
-    adds its friction here and its inertia to the tree's coordinate inertia (so every mass
-    matrix taken from the tree afterwards holds it); the force stays the machine's.
+    adds its friction and shaft stiffness here, gear^2 (b v + K x), and its inertia to the
+    tree's coordinate inertia (so every mass matrix taken from the tree afterwards holds it);
+    the force stays the machine's.
     """
     tau = ca.SX.zeros(topo.tree.n_s)
     signals = {}
@@ -58,13 +59,26 @@ def pto_forces(scene: Scene, topo: Topology, q, s, u, params: Parameters):
             direction[j] = 1.0
         force = -(c * v + k * x) + u[i]
         tau += direction * force
-        if pto.drivetrain is not None:        # the machine's friction, reflected through the gear
-            tau -= direction * pto.drivetrain.gear_ratio ** 2 * pto.drivetrain.friction * v
+        if pto.drivetrain is not None:   # the machine's friction and shaft spring, geared
+            d = pto.drivetrain
+            tau -= direction * d.gear_ratio ** 2 * (d.friction * v + d.stiffness * x)
             if pto.drivetrain.inertia:
                 topo.tree.coordinate_inertia[topo.coordinate_of_joint[pto.joint]] += \
                     pto.drivetrain.gear_ratio ** 2 * pto.drivetrain.inertia
         signals[pto.name] = (x, v, force, direction)
     return tau, signals
+
+
+def drivetrain_spring_energy(scene: Scene, signals) -> ca.SX:
+    """The potential energy of the drivetrains' shaft springs, sum gear^2 K x^2 / 2 (J), from
+    pto_forces' signals: the drivetrain is part of the plant (its inertia is in the kinetic
+    energy, its friction in <pto>__friction_loss)."""
+    energy = ca.SX(0)
+    for pto in scene.ptos:
+        if pto.drivetrain is not None and pto.drivetrain.stiffness:
+            x = signals[pto.name][0]
+            energy += 0.5 * pto.drivetrain.gear_ratio ** 2 * pto.drivetrain.stiffness * x * x
+    return energy
 
 
 def _line(topo: Topology, q, s, pto):

@@ -139,6 +139,7 @@ def assemble_plant(scene: Scene | str, hydro: HydroModel | None = None, *,
     tau += restoring
     tau_pto, pto_signals = loads.pto_forces(scene, topo, q, s, u, params)
     tau += tau_pto + loads.friction_forces(scene, topo, s, params)
+    potential += loads.drivetrain_spring_energy(scene, pto_signals)
     tau += loads.drag_forces(scene, topo, q, s, params)
     tau_moor, mooring_energy, tensions = loads.mooring_forces(scene, topo, q, s, params)
     tau += tau_moor
@@ -267,12 +268,13 @@ def _outputs(scene, topo: Topology, q, s, pto_signals, power, tensions, s_dot):
         values += [position, velocity, force, -force * velocity]
         names += [f"{pto}__position", f"{pto}__velocity", f"{pto}__force", f"{pto}__power"]
         if pto in drivetrains:
-            values += drivetrain_signals(drivetrains[pto], velocity, force,
+            values += drivetrain_signals(drivetrains[pto], position, velocity, force,
                                          ca.dot(direction, s_dot))
             names += [f"{pto}__{kind}" for kind in DRIVETRAIN_SIGNALS]
     # energy audit: radiated (W, leaving the bodies), wave input (W), and the mechanical energy
-    # (J): kinetic + hydrostatic, gravity (dry bodies), mooring and end-stop potentials; PTO
-    # forces, springs included, are external: their power is <pto>__power
+    # (J): kinetic (drivetrain inertia included) + hydrostatic, gravity (dry bodies), mooring,
+    # end-stop and drivetrain shaft-spring potentials; PTO forces, the scene law's springs
+    # included, are external: their power is <pto>__power
     values += [power["radiated_power"], power["excitation_power"], power["energy"]]
     names += ["radiated_power", "excitation_power", "energy"]
     for line, signals in tensions.items():
@@ -291,18 +293,19 @@ DRIVETRAIN_SIGNALS = {"current": "A", "voltage": "V", "winding_loss": "W", "fric
                       "hull_force": "force"}   # N or N m, as the PTO's force
 
 
-def drivetrain_signals(d, v, force, acceleration) -> list:
-    """A drivetrain's signals (DRIVETRAIN_SIGNALS, in order) from the PTO velocity v, the
-    machine's force (the PTO force) and the PTO acceleration: current F / (gear kt'), voltage
-    R I + kt' gear v (a current-controlled drive; the inductive L dI/dt, whose mean power is
-    zero, is left out), winding loss R I^2, friction loss gear^2 b v^2, electrical power
-    delivered -F v - R I^2, and the mechanical power the joint puts in,
-    -(F - gear^2 (J a + b v)) v = electrical + losses + d/dt(gear^2 J v^2 / 2), and the
-    force on the hull F - gear^2 (J a + b v) (what force_max_on = "hull" limits)."""
+def drivetrain_signals(d, x, v, force, acceleration) -> list:
+    """A drivetrain's signals (DRIVETRAIN_SIGNALS, in order) from the PTO position x and
+    velocity v, the machine's force (the PTO force) and the PTO acceleration a: current
+    F / (gear kt'), voltage R I + kt' gear v (a current-controlled drive; the inductive
+    L dI/dt, whose mean power is zero, is left out), winding loss R I^2, friction loss
+    gear^2 b v^2, electrical power delivered -F v - R I^2, and the mechanical power the joint
+    puts in, -(F - gear^2 (J a + b v + K x)) v = electrical + losses + d/dt(gear^2 (J v^2 +
+    K x^2) / 2) (the shaft spring's part has mean zero over a periodic motion), and the force
+    on the hull F - gear^2 (J a + b v + K x) (what force_max_on = "hull" limits)."""
     current = force / d.force_per_current
     winding = d.winding_resistance * current ** 2
     friction = d.gear_ratio ** 2 * d.friction * v * v
-    shaft = d.gear_ratio ** 2 * (d.inertia * acceleration + d.friction * v)
+    shaft = d.gear_ratio ** 2 * (d.inertia * acceleration + d.friction * v + d.stiffness * x)
     return [current, d.winding_resistance * current + d.kt * d.gear_ratio * v, winding,
             friction, -force * v - winding, -(force - shaft) * v, force - shaft]
 

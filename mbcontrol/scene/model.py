@@ -18,6 +18,8 @@ import math
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
+import numpy as np
+
 DOF_NAMES = ("Surge", "Sway", "Heave", "Roll", "Pitch", "Yaw")
 JOINT_TYPES = ("revolute", "prismatic", "fixed", "free")
 
@@ -103,7 +105,7 @@ class Pto:
     drivetrain: "Drivetrain | None" = None   # None: an ideal PTO (efficiency applies)
     force_max_on: str = "machine"  # "machine": force_max limits the machine's force (the
                                    # command); "hull": the force the drivetrain puts on the
-                                   # hull, the machine's less gear^2 (J a + b v)
+                                   # hull, the machine's less gear^2 (J a + b v + K x)
 
     @property
     def between_points(self) -> bool:
@@ -128,8 +130,9 @@ class Drivetrain:
     PTO force F (the controller's command, its limits) is the machine's: current
     I = F / (gear_ratio kt'), kt' = torque_constant x sqrt(3/2) for a three-phase machine in dq
     (phases = 3), torque_constant for phases = 1; voltage V = R I + L dI/dt + kt' gear_ratio v;
-    electrical power delivered -F v - R I^2. The machine's inertia and friction act on the
-    joint as gear_ratio^2 inertia and gear_ratio^2 friction.
+    electrical power delivered -F v - R I^2. The machine's inertia J, friction b and shaft
+    stiffness K act on the joint as gear_ratio^2 J, gear_ratio^2 b and gear_ratio^2 K
+    (WecOptTool's drivetrain impedance, `reflected_impedance`).
     """
     gear_ratio: float = 1.0          # rad/s of the generator per m/s (or rad/s) of the PTO
     torque_constant: float = 1.0     # N m/A (N/A for a linear machine with gear_ratio 1)
@@ -137,6 +140,7 @@ class Drivetrain:
     winding_inductance: float = 0.0  # H
     inertia: float = 0.0             # kg m^2 at the generator
     friction: float = 0.0            # N m s/rad at the generator
+    stiffness: float = 0.0           # N m/rad at the generator (may be < 0)
     phases: int = 3                  # 3: the sqrt(3/2) dq factor; 1: none
     current_max: float = math.inf    # A
     voltage_max: float = math.inf    # V
@@ -151,6 +155,14 @@ class Drivetrain:
     def force_per_current(self) -> float:
         """N (or N m) of PTO force per A: gear_ratio x kt'."""
         return self.gear_ratio * self.kt
+
+    def reflected_impedance(self, s):
+        """gear_ratio^2 (J s + b + K / s): the drivetrain's inertia, friction and stiffness
+        seen at the joint (N s/m or N m s/rad) at the Laplace variable s; the force they take
+        from the joint is this times the PTO velocity. s = 1j omega for phasors of
+        exp(+i omega t) (WecOptTool's Z_d), -1j omega for exp(-i omega t)."""
+        s = np.asarray(s, complex)
+        return self.gear_ratio ** 2 * (self.inertia * s + self.friction + self.stiffness / s)
 
 
 @dataclass(frozen=True)

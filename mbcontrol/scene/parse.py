@@ -147,8 +147,9 @@ def _pto(r: Reader, kinds: dict) -> Pto:
     drivetrain = _drivetrain(r.table("drivetrain", required=False), joint is None)
     if force_max_on == "hull" and drivetrain is None:
         r.fail("force_max_on", "'hull' limits the force the drivetrain puts on the hull (the "
-                               "machine's less its reflected inertia and friction): it needs "
-                               "a [pto.drivetrain]; without one the two are the same force")
+                               "machine's less its reflected inertia, friction and stiffness): "
+                               "it needs a [pto.drivetrain]; without one the two are the same "
+                               "force")
     return Pto(name=r.name(), joint=joint,
                damping=r.nonnegative("damping", default=0.0),
                stiffness=r.finite("stiffness", default=0.0),
@@ -169,7 +170,8 @@ def _drivetrain(r: Reader, between_points: bool) -> Drivetrain | None:
     if r.empty:
         return None
     r.allow("gear_ratio", "torque_constant", "winding_resistance", "winding_inductance",
-            "inertia", "friction", "phases", "current_max", "voltage_max", "power_max")
+            "inertia", "friction", "stiffness", "phases", "current_max", "voltage_max",
+            "power_max")
     phases = r._get("phases", 3, shape="1 or 3")
     if phases not in (1, 3) or isinstance(phases, bool):
         r.fail("phases", f"expected 1 or 3 (3: a three-phase machine in dq), got {phases!r}")
@@ -183,6 +185,7 @@ def _drivetrain(r: Reader, between_points: bool) -> Drivetrain | None:
                       winding_resistance=r.nonnegative("winding_resistance", 0.0, "resistance"),
                       winding_inductance=r.nonnegative("winding_inductance", 0.0, "inductance"),
                       inertia=inertia, friction=r.nonnegative("friction", default=0.0),
+                      stiffness=r.finite("stiffness", default=0.0),
                       phases=int(phases), current_max=limit("current_max", "current"),
                       voltage_max=limit("voltage_max", "voltage"),
                       power_max=limit("power_max", "power"))

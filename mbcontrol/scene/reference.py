@@ -100,8 +100,9 @@ MEANING = {
     ("pto", "force_max_on"): "what `force_max` limits with a drivetrain: `machine` (the "
                              "machine's force, the command; the default) or `hull` (the force "
                              "the drivetrain puts on the hull, the machine's less its "
-                             "reflected inertia and friction, gear^2 (J a + b v): WecOptTool's "
-                             "PTO force); bounds, tuners, design and the MPC hold it",
+                             "reflected inertia, friction and stiffness, gear^2 (J a + b v + "
+                             "K x): WecOptTool's PTO force); bounds, tuners, design and the MPC "
+                             "hold it",
     ("pto", "stroke_max"): "stroke limit: a length (prismatic, between points) or an angle "
                            "(revolute)",
     ("pto", "efficiency"): "drivetrain efficiency in (0, 1] (electrical power)",
@@ -120,6 +121,10 @@ MEANING = {
     ("pto.drivetrain", "inertia"): "rotor and gear inertia at the generator, kg m^2 (acts as "
                                    "gear^2 x on the joint; joint PTOs only)",
     ("pto.drivetrain", "friction"): "at the generator, N m s/rad (gear^2 x on the joint)",
+    ("pto.drivetrain", "stiffness"): "a spring on the generator shaft, N m/rad at the "
+                                     "generator (N/m for a linear machine with gear 1; may be "
+                                     "negative): gear^2 x on the joint, gear^2 K x (WecOptTool's "
+                                     "drivetrain stiffness)",
     ("pto.drivetrain", "phases"): "3: a three-phase machine, kt x sqrt(3/2) in dq; 1: none",
     ("pto.drivetrain", "current_max"): "current limit (reported against; not yet imposed)",
     ("pto.drivetrain", "voltage_max"): "voltage limit (reported against; not yet imposed)",

@@ -9,6 +9,7 @@ import pytest
 from drivetrain_scenes import DRIVETRAIN, catalogue_copy
 from mbcontrol.cli import main
 from mbcontrol.studies.codesign import Spec, codesign
+from mbcontrol.studies.codesign.objectives import evaluate
 
 WAVE = {"kind": "regular", "height": 2.0, "period": 9.0}
 
@@ -121,3 +122,73 @@ def test_json_contract_and_figure(geared, tmp_path, capsys):
     code = main(["codesign", geared, "--vary", "gear=x", "--wave", "regular", "--height", "2",
                  "--period", "9"])
     assert code == 1 and "--vary gear=x: expected NAME=v1,v2" in capsys.readouterr().err
+
+
+def test_a_sites_bound_is_its_seas_conjugate_bounds_weighted(tmp_path):
+    """With seas instead of a wave, a bound objective is the site's annual energy of the
+    bound. Without force or stroke limits each sea's QP optimum is the closed-form complex-
+    conjugate bound sum a_k^2 |E_k|^2 / (8 Re Z_k); weighted by hand it gives the same MWh."""
+    from mbcontrol.analysis.bounds import complex_conjugate_bound
+    from mbcontrol.plant import build_plant
+    from mbcontrol.scene import load_scene
+    from mbcontrol.studies.sweep.runner import sea_wave
+    from mbcontrol.waves.sites import read_seas
+    scene = catalogue_copy(tmp_path, "sphere", "free", "")
+    scene.write_text("\n".join(line for line in scene.read_text().splitlines()
+                               if not line.startswith(("force_max", "stroke_max"))))
+    seas = tmp_path / "seas.csv"
+    seas.write_text("Hm0,Tp,weights\n1.0,7.0,0.5\n2.0,9.0,0.3\n3.0,11.0,0.2\n")
+    spec = Spec(model=str(scene), objective="mechanical_bound", seas=str(seas), duration=120.0)
+    got = evaluate(spec, {}, {})
+    plant = build_plant(load_scene(str(scene)))
+    by_hand = sum(sea.weight * complex_conjugate_bound(plant, sea_wave(plant, sea, 120.0)).power
+                  for sea in read_seas(seas)) * 8766 / 1e6
+    assert got["valid"] and got["objective"] == pytest.approx(by_hand, rel=1e-6)
+    assert len(got["details"]["mean_power_W"]) == 3
+    with pytest.raises(ValueError, match="a wave or --seas, not both"):
+        Spec(model=str(scene), objective="mechanical_bound", seas=str(seas), wave=WAVE)
+    with pytest.raises(ValueError, match="needs a wave"):
+        Spec(model=str(scene), objective="controller", seas=str(seas), controller="passive")
+
+
+def test_against_a_second_objective_compares_the_optima(geared, tmp_path, capsys):
+    """--against evaluates the same points under a second objective. The electrical bound
+    is the mechanical bound less the machine's losses, so it is the lower curve at every
+    gear; the verdict compares the optima with error bars (none for bounds)."""
+    png = tmp_path / "against.png"
+    code = main(["codesign", geared, "--vary", "gear=20,35,50,80", "--objective",
+                 "electrical_bound", "--against", "mechanical_bound", "--wave", "regular",
+                 "--height", "2", "--period", "9", "--plot", str(png), "--json"])
+    out = json.loads(capsys.readouterr().out)
+    assert code == 0 and out["against"]["objective_name"] == "mechanical_bound"
+    for mine, theirs in zip(out["points"], out["against"]["points"]):
+        assert mine["params"] == theirs["params"] and mine["objective"] < theirs["objective"]
+    shares = [s["share"] for s in out["comparison"]["share_of_other"]]
+    assert all(0 < s < 1 for s in shares)
+    verdict = out["comparison"]["verdict"]
+    same = out["best"]["params"] == out["against"]["best"]["params"]
+    assert verdict == ("same optimum" if same else "moved")    # no error bars: any gap counts
+    assert png.stat().st_size > 10_000
+
+
+def test_the_verdict_reads_the_error_bars():
+    from mbcontrol.studies.codesign.compare import compare_optima
+
+    def study(name, values, errors):
+        points = [{"params": {"r2": r}, "objective": v, "valid": True, "error_95": e}
+                  for r, v, e in zip((0.1, 0.5, 0.9), values, errors)]
+        top = max(points, key=lambda p: p["objective"])
+        return {"objective_name": name, "points": points,
+                "best": {k: top[k] for k in ("params", "objective", "error_95")}}
+    bound = study("electrical_bound", [10.0, 12.0, 14.0], [None] * 3)
+    clear = compare_optima(study("annual_energy", [9.0, 8.0, 6.0], [0.5] * 3), bound)
+    assert clear["verdict"] == "moved" and clear["difference"] == pytest.approx(3.0)
+    assert clear["difference_95"] == pytest.approx(0.5 * 2 ** 0.5)
+    close = compare_optima(study("annual_energy", [6.2, 6.1, 6.0], [0.5] * 3), bound)
+    assert close["verdict"] == "moved within the error bars"
+    failing = study("annual_energy", [9.0, 8.0, 6.0], [0.5] * 3)
+    failing["points"][2].update(valid=False, reasons=["31 seas failed"])
+    assert compare_optima(failing, bound)["verdict"] == "moved: the other optimum is not valid here"
+    same = compare_optima(study("annual_energy", [5.0, 6.0, 7.0], [0.5] * 3), bound)
+    assert same["verdict"] == "same optimum"
+    assert [s["share"] for s in same["share_of_other"]] == pytest.approx([0.5, 0.5, 0.5])

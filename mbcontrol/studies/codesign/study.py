@@ -28,14 +28,16 @@ from .objectives import Spec, evaluate
 
 def point_key(spec: Spec, point: dict, scene_text: str) -> str:
     """A hash of everything that decides a point's value: the scene file's text, the spec
-    and the point (resumed points are those with the same key)."""
+    (but omega_max, which only bounds read) and the point (resumed points are those with the
+    same key)."""
     from importlib import metadata
     try:
         version = metadata.version("mbcontrol")
     except metadata.PackageNotFoundError:      # a source tree never installed
         version = "unknown"
     record = {"scene": hashlib.sha256(scene_text.encode()).hexdigest(), "version": version,
-              "spec": {k: v for k, v in vars(spec).items()},
+              "spec": {k: None if k == "omega_max" and "bound" not in spec.objective else v
+                       for k, v in vars(spec).items()},
               "point": {k: float(v) for k, v in sorted(point.items())}}
     text = json.dumps(record, sort_keys=True, default=str)
     return hashlib.sha256(text.encode()).hexdigest()[:20]
@@ -77,24 +79,25 @@ def _evaluate_record(spec: Spec, point: dict, roles: dict) -> dict:
 
 
 def codesign(spec: Spec, *, vary: dict | None = None, optimize: dict | None = None,
-             store=None, workers: int | None = 0, scheduler: str | None = None,
-             max_evals: int = 40, progress: bool = False) -> dict:
+             at: list | None = None, store=None, workers: int | None = 0,
+             scheduler: str | None = None, max_evals: int = 40, progress: bool = False) -> dict:
     """Run a study; the JSON contract of `mbcontrol codesign --json`: {"points": [{"params",
     "objective", "valid", "error_95", "reasons", "wall_s", "reused"}], "best": {"params",
     "objective", "error_95"}, "objective_name", "search", "computed", "reused",
-    "wall_time_s", "provenance"}. vary: name -> values (a grid); optimize: name -> (lo, hi)."""
+    "wall_time_s", "provenance"}. vary: name -> values (a grid); optimize: name -> (lo, hi);
+    at: given points (name -> value each: another study's, to compare objectives)."""
     from mbcontrol.controllers import REGISTRY
 
     from ...plant import build_plant
     from ...scene import load_scene
     from ..sweep.cases import roles_for
-    if bool(vary) == bool(optimize):
+    if sum(bool(s) for s in (vary, optimize, at)) != 1:
         raise ValueError("codesign: give either --vary (a grid) or --optimize (a search), "
                          "one of them")
     start = time.perf_counter()
     scene = load_scene(spec.model, dict(spec.scene_params) or None)
     plant = build_plant(scene)
-    names = list(vary or optimize)
+    names = list(vary or optimize or at[0])
     roles = roles_for(names, scene, plant.parameters, REGISTRY.get(spec.controller))
     bad = [n for n in names if roles[n] not in ("scene", "param", "setting")]
     if bad:
@@ -122,6 +125,10 @@ def codesign(spec: Spec, *, vary: dict | None = None, optimize: dict | None = No
         grid = [dict(zip(names, values)) for values in itertools.product(*vary.values())]
         _grid(grid, run, spec, roles, text, cache, workers, scheduler, progress)
         search = "grid"
+    elif at:
+        for point in at:
+            run(dict(point))
+        search = "given points"
     else:
         search = _optimise(optimize, run, max_evals)
     best = _best(points)

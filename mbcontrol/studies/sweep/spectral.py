@@ -96,8 +96,11 @@ def expected_power(plant, wave, gains, *, params=None, statespace: bool = False)
 
 def radiation_fit_effect(plant, wave, gains, params=None) -> float:
     """P(fit) / P(BEM) - 1: how much the radiation fit the simulation steps moves a sea's
-    linear-theory power, relative."""
+    linear-theory power, relative (0 for a law that absorbs nothing: a sea the design left
+    idle)."""
     bem = expected_power(plant, wave, gains, params=params)
+    if bem == 0.0:
+        return 0.0
     return expected_power(plant, wave, gains, params=params, statespace=True) / bem - 1.0
 
 
