@@ -87,17 +87,24 @@ def fit(problem, method: str | None = None, *, starts: int = 1, seed: int = 0,
     bar = _bar(progress, method)
     cost_initial = problem.cost_value(first)
     best, evaluations = None, 0
+    # (r, J) of Gauss-Newton's latest point (least_squares asks for r, then J at the same
+    # point) and of its lowest-cost one: trf accepts every step that lowers the cost, so that
+    # is where it stops, and its (r, J) is needed again below for the uncertainty
+    # (time_blocks, which residuals() sets, depend only on the runs and the cost)
+    evaluated, lowest = {}, [math.inf, None]
     for start in points:
         if method == "gauss-newton":
-            cache = {}
-
             def both(theta):
                 key = tuple(theta)
-                if key not in cache:
-                    cache.clear()
-                    cache[key] = problem.residuals(theta, jacobian=True)
-                    _tick(bar, 0.5 * float(cache[key][0] @ cache[key][0]))
-                return cache[key]
+                if key not in evaluated:
+                    evaluated[key] = problem.residuals(theta, jacobian=True)
+                    value = 0.5 * float(evaluated[key][0] @ evaluated[key][0])
+                    if value < lowest[0]:
+                        lowest[:] = value, key
+                    for old in [k for k in evaluated if k not in (key, lowest[1])]:
+                        del evaluated[old]
+                    _tick(bar, value)
+                return evaluated[key]
 
             res = least_squares(lambda th: both(th)[0], start, jac=lambda th: both(th)[1],
                                 bounds=(lo, hi), method="trf", x_scale="jac", ftol=tol,
@@ -122,7 +129,8 @@ def fit(problem, method: str | None = None, *, starts: int = 1, seed: int = 0,
     if bar is not None:
         bar.close()
     theta, value = best
-    r, J = problem.residuals(theta, jacobian=True)
+    key = tuple(theta)
+    r, J = evaluated[key] if key in evaluated else problem.residuals(theta, jacobian=True)
     span = np.where(hi > lo, hi - lo, 1.0)
     bound = {p.name: side for p, t, l, h, w in zip(problem.fit, theta, lo, hi, span)
              for side, gap in (("lower", t - l), ("upper", h - t)) if gap <= AT_BOUND * w}

@@ -142,8 +142,12 @@ def calibration_files(folder, pp: int, height_code: int) -> list[Path]:
     return found
 
 
-def load_run(path, calibration, *, channels: dict | None = None) -> Run:
-    """One model run as a `Run` (see the module notes); RecordError names file and channel."""
+def load_run(path, calibration, *, channels: dict | None = None,
+             transfers: dict | None = None) -> Run:
+    """One model run as a `Run` (see the module notes); RecordError names file and channel.
+    transfers: a dict shared by calls (load_runs) that keeps each calibration's
+    `incident_transfer`, so that runs of one frequency and height read their calibration
+    runs once."""
     path = Path(path)
     info = parse_name(path)
     if info["series"] not in SERIES:
@@ -172,8 +176,11 @@ def load_run(path, calibration, *, channels: dict | None = None) -> Run:
         problem = channel_problem(record, channel, (open_, close))
         if problem:
             raise RecordError(f"{path}: {problem}")
-    transfer, spread = incident_transfer(calibration_files(calibration, info["pp"],
-                                                           info["height_code"]), omega)
+    files = tuple(calibration_files(calibration, info["pp"], info["height_code"]))
+    transfers = {} if transfers is None else transfers
+    if (files, omega) not in transfers:
+        transfers[files, omega] = incident_transfer(files, omega)
+    transfer, spread = transfers[files, omega]
     incident = transfer * _paddle(record, start, omega)
     return Run(name=path.name.split(".")[0], omega=omega, amplitude=abs(incident),
                phase=float(np.angle(incident)), window=(open_, close), time=record.time,
@@ -192,9 +199,10 @@ def load_runs(paths, calibration=None, *, drop_bad: bool = False) -> list[Run]:
         raise RecordError("no data files given")
     calibration = Path(calibration) if calibration else paths[0].parent.parent / "calibration"
     runs, dropped = [], []
+    transfers: dict = {}      # runs of one frequency and height share their calibration runs
     for path in paths:
         try:
-            runs.append(load_run(path, calibration))
+            runs.append(load_run(path, calibration, transfers=transfers))
         except RecordError as exc:
             if not drop_bad:
                 raise
