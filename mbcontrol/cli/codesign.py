@@ -41,7 +41,7 @@ Examples:
       --wave regular --height 0.125 --period 3.3333333 --plot out/r2.png
   mbcontrol codesign wavebot --scene-param scale=10 --scene-param rated=1500 \
       --vary r2=0.05,0.35,0.65,0.88 --objective annual_energy --controller reactive \
-      --against electrical_bound --omega-max 3 \
+      --against mechanical_bound \
       --seas ../shared/data/sites/pacwave_cluster_32.csv --store out/site --plot out/site.png
 """
 
@@ -65,7 +65,7 @@ def add_parser(sub, wave_options) -> None:
     p.add_argument("--seas", metavar="FILE.csv",
                    help="weighted seas: annual_energy, or a bound's annual energy (MWh)")
     p.add_argument("--against", metavar="OBJECTIVE",
-                   help="the same points under a second objective (e.g. electrical_bound "
+                   help="the same points under a second objective (e.g. mechanical_bound "
                         "against annual_energy): both curves, both optima and whether the "
                         "optimum moves, with error bars")
     p.add_argument("--per", help="a cost proxy to divide by: volume, rated_force or an "
@@ -110,6 +110,7 @@ def run_codesign(args) -> int:
     from mbcontrol.controllers import REGISTRY
 
     from ..studies.codesign import Spec, codesign
+    from ..studies.codesign.objectives import UNLIKE
     from .commands import _key_value, parse_settings
     wave = None
     if args.wave != "none" and args.objective != "annual_energy" and not args.seas:
@@ -127,6 +128,9 @@ def run_codesign(args) -> int:
     vary = dict(_floats(v, "--vary", ",") for v in args.vary or [])
     optimize = {n: tuple(v) for n, v in (_floats(o, "--optimize", ":")
                                          for o in args.optimize or [])}
+    if frozenset((args.objective, args.against)) in UNLIKE:   # before any work is done
+        raise ValueError(f"--against {args.against}: {args.objective} is absorbed "
+                         f"(mechanical) energy; compare it with mechanical_bound")
     result = codesign(spec, vary=vary or None, optimize=optimize or None, store=args.store,
                       workers=args.workers, scheduler=args.scheduler,
                       max_evals=args.max_evals, progress=not args.json)

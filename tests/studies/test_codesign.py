@@ -189,6 +189,18 @@ def test_the_verdict_reads_the_error_bars():
     failing = study("annual_energy", [9.0, 8.0, 6.0], [0.5] * 3)
     failing["points"][2].update(valid=False, reasons=["31 seas failed"])
     assert compare_optima(failing, bound)["verdict"] == "moved: the other optimum is not valid here"
+    flat = study("mechanical_bound", [14.0, 14.0, 14.0], [None] * 3)      # a tie: no move
+    assert compare_optima(study("annual_energy", [9.0, 8.0, 6.0], [0.5] * 3),
+                          flat)["verdict"] == "same optimum"
     same = compare_optima(study("annual_energy", [5.0, 6.0, 7.0], [0.5] * 3), bound)
     assert same["verdict"] == "same optimum"
     assert [s["share"] for s in same["share_of_other"]] == pytest.approx([0.5, 0.5, 0.5])
+
+
+def test_unlike_powers_are_not_compared(geared, capsys):
+    """annual_energy weighs absorbed (mechanical) power, as sweep does: set against the
+    electrical bound it would credit the controller with the machine's losses."""
+    code = main(["codesign", geared, "--vary", "gear=40", "--objective", "annual_energy",
+                 "--controller", "reactive", "--seas", "unused.csv", "--against",
+                 "electrical_bound"])
+    assert code == 1 and "compare it with mechanical_bound" in capsys.readouterr().err

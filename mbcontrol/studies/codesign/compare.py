@@ -12,8 +12,11 @@ from __future__ import annotations
 
 import math
 
+TIE = 1e-6      # relative: the other objective as good at my best as at its own (a flat one)
 
-def _key(params: dict) -> tuple:
+
+def params_key(params: dict) -> tuple:
+    """A point's values as a hashable key (rounded so that a JSON round trip matches)."""
     return tuple(sorted((k, round(float(v), 12)) for k, v in params.items()))
 
 
@@ -24,8 +27,8 @@ def compare_optima(result: dict, other: dict) -> dict:
     verdict: "same optimum", "moved" (by more than the difference's 95 % half-width), "moved
     within the error bars", or "moved: the other optimum is not valid here" (result's
     objective fails its checks there: at_other_best then carries the reasons)."""
-    mine = {_key(p["params"]): p for p in result["points"]}
-    theirs = {_key(p["params"]): p for p in other["points"]}
+    mine = {params_key(p["params"]): p for p in result["points"]}
+    theirs = {params_key(p["params"]): p for p in other["points"]}
     shares = []
     for key, p in mine.items():
         q = theirs.get(key)
@@ -40,7 +43,14 @@ def compare_optima(result: dict, other: dict) -> dict:
     if best is None or other_best is None:
         out["verdict"] = "no valid optimum on one side"
         return out
-    at = mine.get(_key(other_best["params"]))
+    tie = theirs.get(params_key(best["params"]))        # the other objective at my best
+    if tie is not None and tie["valid"] and tie["objective"] is not None and \
+            tie["objective"] >= other_best["objective"] - TIE * abs(other_best["objective"]):
+        out.update(other_best={k: tie[k] for k in ("params", "objective", "error_95")},
+                   difference=0.0, difference_95=0.0, verdict="same optimum")
+        out["at_other_best"] = out["best"]
+        return out
+    at = mine.get(params_key(other_best["params"]))
     if at is None:
         out["verdict"] = f"{other['objective_name']}'s optimum is not a point of this study"
         return out
@@ -51,7 +61,7 @@ def compare_optima(result: dict, other: dict) -> dict:
         return out
     out["at_other_best"] = {"params": at["params"], "objective": at["objective"],
                             "error_95": at["error_95"]}
-    if _key(best["params"]) == _key(other_best["params"]):
+    if params_key(best["params"]) == params_key(other_best["params"]):
         out.update(difference=0.0, difference_95=0.0, verdict="same optimum")
         return out
     diff = best["objective"] - at["objective"]

@@ -15,8 +15,9 @@ costs nothing) and one of:
 - controller: the mean power (electrical with a drivetrain, else mechanical; W) of a causal
   controller designed for the wave as `sweep --design` designs it
   (`controllers.sea_design`), simulated on the nonlinear plant and checked;
-- annual_energy: the site's annual energy (MWh) with the controller designed per sea
-  (`studies.sweep`, --design), its 95 % interval the error bar.
+- annual_energy: the site's annual absorbed energy (MWh: the PTOs' mechanical power, as
+  `sweep` weighs it) with the controller designed per sea (`studies.sweep`, --design), its
+  95 % interval the error bar; mechanical_bound is its ceiling, not electrical_bound.
 A cost proxy may divide it (`per`): "volume" (m^3 displaced at rest), "rated_force" (kN, the
 PTOs' force_max summed) or an arithmetic expression of the point's names and the scene's
 parameters. Each evaluation returns {"objective", "valid", "error_95" (half-width or None),
@@ -28,6 +29,8 @@ import dataclasses
 import math
 
 OBJECTIVES = ("electrical_bound", "mechanical_bound", "controller", "annual_energy")
+# objectives whose powers are not of one kind: annual_energy is absorbed (mechanical) energy
+UNLIKE = {frozenset(("annual_energy", "electrical_bound"))}
 
 
 @dataclasses.dataclass(frozen=True)
@@ -81,15 +84,15 @@ def evaluate(spec: Spec, point: dict, roles: dict) -> dict:
     if spec.objective == "annual_energy":
         out = _annual(spec, scene_params, params, settings)
     else:
-        scene = load_scene(spec.model, scene_params or None)
-        plant = build_plant(scene)
+        plant = build_plant(load_scene(spec.model, scene_params or None))
         if spec.seas:
-            return _finish(spec, _site_bound(spec, plant, params), scene_params, point)
-        wave = _wave(plant, spec.wave, spec.duration)
-        if spec.objective == "controller":
-            out = _controller(spec, plant, wave, params, settings)
+            out = _site_bound(spec, plant, params)
+        elif spec.objective == "controller":
+            out = _controller(spec, plant, _wave(plant, spec.wave, spec.duration), params,
+                              settings)
         else:
-            out = _bound(spec.objective, plant, wave, params, spec.omega_max)
+            out = _bound(spec.objective, plant, _wave(plant, spec.wave, spec.duration), params,
+                         spec.omega_max)
     return _finish(spec, out, scene_params, point)
 
 

@@ -3,6 +3,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .compare import params_key
+
 _AXIS = {"MWh": "annual energy, MWh", "W": "mean power, W"}
 
 
@@ -31,8 +33,8 @@ def plot_codesign(result: dict, path=None, unit: str = ""):
             tag = ", ".join(f"{m} = {v:.4g}" for m, v in group)
             drawn = _series(ax, members, name, colour, joined, tag or "points")
             if other is not None:
-                keys = {_key(p["params"]) for p in members}
-                _series(ax, [p for p in other["points"] if _key(p["params"]) in keys], name,
+                keys = {params_key(p["params"]) for p in members}
+                _series(ax, [p for p in other["points"] if params_key(p["params"]) in keys], name,
                         colour, joined, None if drawn else tag or None, dashed=True)
         bad = [p for p in points if not (p["valid"] and p["objective"] is not None)]
         if bad:                   # at the panel's foot: x in data, y in axes units
@@ -62,10 +64,6 @@ def plot_codesign(result: dict, path=None, unit: str = ""):
     if path is not None:
         save(fig, path)
     return fig
-
-
-def _key(params: dict) -> tuple:
-    return tuple(sorted((k, round(float(v), 12)) for k, v in params.items()))
 
 
 def _groups(points: list, rest: list) -> list:
