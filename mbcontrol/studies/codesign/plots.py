@@ -44,8 +44,10 @@ def plot_codesign(result: dict, path=None, unit: str = ""):
         if best is not None:
             ax.plot(best["params"][name], best["objective"], "o", ms=13, mfc="none",
                     mec="k", mew=2, label=f"best: {name} = {best['params'][name]:.4g}")
-        if other is not None and other.get("best") is not None:
-            b = other["best"]
+        # the comparison's optimum of the other objective (a tie resolved to ours), or its own
+        b = ((result.get("comparison") or {}).get("other_best") or other.get("best")
+             if other is not None else None)
+        if b is not None:
             ax.plot(b["params"][name], b["objective"], "*", ms=15, color="gold", mec="k",
                     label=f"best of {other['objective_name'].replace('_', ' ')} (dashed): "
                           f"{name} = {b['params'][name]:.4g}")
