@@ -19,21 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-
-def linear_params(plant, ptos, params=None) -> dict:
-    """Parameter overrides for linear theory seen from `ptos`: their own damping and
-    stiffness zero (the decision force is the PTO's whole force), Coulomb friction removed
-    (its smoothed slope at rest is not linear physics); `params` (dict or full vector) kept
-    for everything else."""
-    if params is not None and not isinstance(params, dict):
-        params = dict(zip(plant.parameters, np.asarray(params, float)))
-    out = dict(params or {})
-    for friction in plant.scene.frictions:
-        out[f"{friction.name}__coulomb"] = 0.0
-    for name in ptos:
-        out[f"{name}__damping"] = 0.0
-        out[f"{name}__stiffness"] = 0.0
-    return out
+from ..plant import linear_params  # noqa: F401 (its public home here too)
 
 
 def port_responses(plant, omega, ptos, direction: float = 0.0, params=None):

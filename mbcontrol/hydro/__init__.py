@@ -21,8 +21,8 @@ from .geometry import RIGID_DOFS, BemBody, hull_mesh, lid_mesh, validate_body
 from .model import HydroModel, fit_hydro_model, fit_method, geometry_dict, load_hydro_data, load_hydro_model
 from .passivity import PassivityReport, absorbed_energy, enforce_passivity, passivity_test
 from .array_fit import fit_radiation_columns
-from .radiation import (RadiationModel, convolution_force, fit_radiation, impulse_response,
-                        kernel_data)
+from .kernel import convolution_force, impulse_response, kernel_data
+from .radiation import RadiationModel, fit_radiation
 
 __all__ = [
     "read_netcdf", "write_netcdf_atomic",

@@ -36,7 +36,8 @@ from mbcontrol.errors import HydroError
 
 from .array_passivity import enforce_columns
 from .fit_error import _group_errors, _nerr
-from .radiation import RadiationModel, _cos_transform, _with_tail, kernel_data
+from .kernel import _cos_transform, _with_tail, kernel_data
+from .radiation import RadiationModel
 from .vector_fit import TAIL_POINTS, TAIL_WEIGHT, _basis, _relocate, _residues
 
 SYMMETRY_TOL = 1e-3     # columns equal to this (relative RMS) under a row permutation share a fit

@@ -25,8 +25,9 @@ import scipy.linalg as sla
 from mbcontrol.errors import HydroError
 
 from .passivity import passivity_test
-from .radiation import (ZERO_COUPLING, RadiationModel, _dof_list, _nerr, entry_error, impulse_response,
-                        kernel_data)
+from .fit_error import _nerr
+from .kernel import _dof_list, impulse_response, kernel_data
+from .radiation import ZERO_COUPLING, RadiationModel, entry_error
 
 __all__ = ["hankel_siso", "fit_radiation_hankel"]
 

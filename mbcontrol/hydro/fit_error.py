@@ -89,11 +89,16 @@ def miss_message(report) -> str:
     """The warning text of a fit that misses its tolerance, from its report."""
     wst, (lo, hi) = report["worst"], report["response_band"]
     at = f"{wst['part']} of K[{wst['entry'][0]}, {wst['entry'][1]}] at ω = {wst['omega']:.4g} rad/s"
-    if report["limited_by"] == "response band":
+    if report["limited_by"] == "device response":
+        rw = report["response_worst"]
+        where = (f"in the device's response (PTOs free): at ω = {rw['omega']:.4g} rad/s the response changes "
+                 f"by {rw['error']:.2%}, most the {rw['what']} (the kernel's own worst: {wst['error']:.2%}, {at})")
+    elif report["limited_by"] == "response band":
         where = f"in the {at} (response band {lo:.3g}-{hi:.3g} rad/s)"
     else:
         where = (f"as the global RMS error over the fit band (worst per frequency {wst['error']:.2%}, {at}"
                  + ("" if report.get("band_given") else "; [hydro] response_band judges it where the device moves")
                  + ")")
-    return (f"radiation fit misses its tolerance: error {report['fit_error']:.2%} > tol {report['tol']:.2%}, "
+    what = "response error" if report["limited_by"] == "device response" else "error"
+    return (f"radiation fit misses its tolerance: {what} {report['fit_error']:.2%} > tol {report['tol']:.2%}, "
             f"{where}, {report['n_states']} states; the model is used as it is")

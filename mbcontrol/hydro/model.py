@@ -23,13 +23,15 @@ from ..cache import cache_dir, status
 from ..errors import HydroError
 from ..scene import DOF_NAMES, Scene
 from ..waves import Wave, excitation_series, interpolate_complex
-from . import array_fit, array_passivity, fit_error, passive_order, passivity, radiation, sdp, vector_fit
+from . import (array_fit, array_passivity, fit_error, passive_order, passivity, radiation, response_error, sdp,
+               vector_fit)
 from ._io import read_netcdf
 from .bem import compute
 from .geometry import BemBody
 from .isolated import compute_isolated
 from .neighbours import compute_within
 from .radiation import RadiationModel, fit_radiation
+from .response_error import Device
 from .ssforms import modal_form
 
 
@@ -42,6 +44,7 @@ class HydroModel:
     fit_omega_max: float = np.inf      # rad/s, the scene's radiation fit band limit
     response_band: tuple | None = None  # rad/s, where the fit is judged per frequency (scene)
     fit_method: str = "coupled"        # "coupled" (module radiation) or "columns" (module array_fit)
+    device: Device | None = None       # the plant around the kernel, whose response judged the fit
 
     def _matrix(self, name: str) -> np.ndarray:
         """(..., influenced, radiating) array: rows are the DOFs the force acts on."""
@@ -142,12 +145,15 @@ class HydroModel:
                                     np.asarray(omega)).real)
 
 
-def load_hydro_model(scene: Scene, dofs, tol: float | None = None) -> HydroModel:
-    """Body-frame data for `dofs` (from scene.hydro.file, or a cached BEM run) and its fit."""
+def load_hydro_model(scene: Scene, dofs, tol: float | None = None, device=None) -> HydroModel:
+    """Body-frame data for `dofs` (from scene.hydro.file, or a cached BEM run) and its fit.
+    device: a callable (source, data) -> Device, the plant around the kernel whose response
+    judges the fit (mbcontrol.plant.device_around), or None to judge the kernel itself."""
     tol = scene.hydro.radiation_tol if tol is None else tol
     source, data = load_hydro_data(scene, dofs)
     return fit_hydro_model(data, dofs, tol, source, scene.hydro.fit_omega_max, scene.hydro.response_band,
-                           fit_method(scene.hydro.radiation_fit, dofs))
+                           fit_method(scene.hydro.radiation_fit, dofs),
+                           device(source, data) if device is not None else None)
 
 
 ARRAY_BODIES = 9   # "auto" fits column by column from this many bodies (module array_fit)
@@ -192,15 +198,16 @@ def _missing_file(scene: Scene) -> str:
 
 
 def fit_hydro_model(data: xr.Dataset, dofs, tol: float | None, source: str,
-                    fit_omega_max: float = np.inf, response_band=None, method: str = "coupled") -> HydroModel:
+                    fit_omega_max: float = np.inf, response_band=None, method: str = "coupled",
+                    device: Device | None = None) -> HydroModel:
     """A HydroModel of `data` on `dofs`, its radiation fitted to `tol` (cached on disk).
 
     For callers that change the data first (e.g. mbcontrol.plant.fidelity drops the coupling between
     bodies): the cache key is the data itself, so a changed dataset never serves an old fit.
     """
     _check_dofs(data, dofs, source)
-    fit = _fit_cached(data, tuple(dofs), tol, source, fit_omega_max, response_band, method)
-    return HydroModel(tuple(dofs), data, fit, source, fit_omega_max, response_band, method)
+    fit = _fit_cached(data, tuple(dofs), tol, source, fit_omega_max, response_band, method, device)
+    return HydroModel(tuple(dofs), data, fit, source, fit_omega_max, response_band, method, device)
 
 
 def _run_bem(scene: Scene, dofs):
@@ -278,9 +285,10 @@ FITS_SERVED: list = []      # the fit files asked for, in order (models/generate
 
 
 def _fit_cached(data: xr.Dataset, dofs, tol, source: str, omega_max: float = np.inf, response_band=None,
-                method: str = "coupled"):
-    """fit_radiation (``method`` "coupled") or fit_radiation_columns ("columns") with an on-disk
-    cache keyed by the data, the DOFs, the tolerance, the bands and the method."""
+                method: str = "coupled", device: Device | None = None):
+    """fit_radiation (``method`` "coupled", judged by ``device``'s response when given) or
+    fit_radiation_columns ("columns": the kernel's own error) with an on-disk cache keyed by the
+    data, the DOFs, the tolerance, the bands, the method and the device."""
     if method not in ("coupled", "columns"):
         raise HydroError(f"radiation fit method {method!r}: expected 'coupled' or 'columns'")
     tol = 0.01 if tol is None else tol
@@ -288,11 +296,14 @@ def _fit_cached(data: xr.Dataset, dofs, tol, source: str, omega_max: float = np.
     for var in ("added_mass", "radiation_damping", "added_mass_inf"):
         digest.update(np.ascontiguousarray(data[var].values).tobytes())
     # the fitting code is part of the key: a changed algorithm never serves an old fit
-    for module in (radiation, fit_error, vector_fit, passive_order, passivity, sdp):
+    for module in (radiation, fit_error, vector_fit, passive_order, passivity, sdp, response_error):
         digest.update(Path(module.__file__).read_bytes())
     band = fit_band_limit(data, omega_max)
     response_band = None if response_band is None else [float(x) for x in response_band]
     digest.update(json.dumps([list(dofs), tol, band] + ([response_band] if response_band else [])).encode())
+    device = device if method == "coupled" else None
+    if device is not None:
+        digest.update(json.dumps(device.key()).encode())
     if method == "columns":    # (the coupled fit's keys stay as they were: shipped fits still found)
         for module in (array_fit, array_passivity):
             digest.update(b"columns" + Path(module.__file__).read_bytes())
@@ -312,8 +323,9 @@ def _fit_cached(data: xr.Dataset, dofs, tol, source: str, omega_max: float = np.
     started = time.perf_counter()
     status(f"fitting the radiation model of {Path(source).name} ({len(dofs)} DOFs, tolerance "
            f"{tol:g}, {method}): typically 5-90 s, once; cached afterwards", __name__)
+    judged = {"device": device} if device is not None else {}
     fitter = fit_radiation if method == "coupled" else array_fit.fit_radiation_columns
-    model = fitter(data, dofs=list(dofs), tol=tol, omega_max=band, response_band=response_band)
+    model = fitter(data, dofs=list(dofs), tol=tol, omega_max=band, response_band=response_band, **judged)
     status(f"radiation model fitted in {time.perf_counter() - started:.1f} s: "
            f"{model.order} states, error {model.fit_error:.2%}", __name__)
     with atomic_path(path) as tmp, open(tmp, "wb") as fh:

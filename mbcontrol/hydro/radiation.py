@@ -21,28 +21,21 @@ whose transfer function is K(jω) = B(ω) + jω(A(ω) - A∞) (ERRATA §4 "Radia
    of C that makes the group passive (KYP-lemma SDP, :mod:`mbcontrol.hydro.passivity`), at a
    higher order if the enforced error misses the tolerance.
 
-Error (decides the order; ``tol`` bounds it) has two parts, and fit_error is the larger:
-- in the response band (``response_band``: where the device moves, its seas and its modes, low ones
-  included), per decoupled group, in D K D (D = diag(1/√max_ω|K_ii|): each DOF's peak 1, so units
-  drop out), at every BEM frequency ω and entry ij
+Error (decides the order; ``tol`` bounds it). With a ``device`` (every plant built from a scene
+passes one, :func:`mbcontrol.plant.device_around`) it is the error the fit causes in the device's
+own response, per BEM frequency: its admittance and its velocity per unit wave amplitude, each
+relative to the coordinate's peak, the device linear at rest with its joint stiffness and PTOs
+(module response_error); ``response_band`` then only limits where it is judged. A kernel error
+where the device does not move is then free (rm3's plate damping at 0.3 rad/s, 537 % off in K and
+nothing in the motion), and one at a lightly damped mode is not (the flap's hinge damping). The
+kernel's own errors are reported beside it. Without a device (a dataset fitted on its own):
+- in the response band (``response_band``), per decoupled group, in D K D (D = diag(1/√max_ω|K_ii|):
+  each DOF's peak 1, so units drop out), at every BEM frequency ω and entry ij
       e_ij(ω) = max(|Re δK_ij| / R(ω), |Im δK_ij| / I(ω)),   R = max(max_kl |Re K_kl(ω)|, FLOOR),
       I = max(max_kl |Im K_kl(ω)|, ω max_k A∞_kk, FLOOR);
-- over the whole fit band, the global sqrt(Σ|δK|²/Σ|K|²) (report "rms_error").
-The damping is judged relative to the damping at that ω, so the small damping of a low-frequency
-mode counts as much as the peak: a global norm alone, set by the large high-frequency damping, let
-the hinge damping of the issue's flap (B 0.3 % of |K| at 0.3 rad/s) be 96 % off. The added-mass part
-is relative to the added inertia ωA∞ where ω(A - A∞) is smaller: only an error of the total inertia
-moves the response. Sizes are per frequency over the group's entries, not per entry: a passive fit
-cannot follow each entry of a near-singular damping matrix, while D K D bounds the force error for
-any motion. FLOOR (1 % of the peak) keeps the vanishing K near ω = 0 from asking for more than the
-data hold. Above the response band (gap resonances, irregular frequencies, the mesh limit) the
-device hardly moves, and per-frequency errors there would spend states on numerical artefacts: the
-global norm holds there. Without a response band only the global norm gates (the worst
-per-frequency error over the fit band is reported). The band is opt-in because a passive fit
-cannot follow the small damping at every band edge (rm3's plate at 0.3 rad/s, array4's floats at
-12 rad/s), where it does not move the device either: weighting by the device's response would
-judge that, but needs the plant's joint-space stiffness (the data's CoG hydrostatics give the
-OSWEC's hinge a negative one). Interpolated points count at INTERP_WEIGHT. VF, the output refit and
+- over the whole fit band, the global sqrt(Σ|δK|²/Σ|K|²) (report "rms_error"), the larger of the two.
+These kernel errors are what the report shows as "band_error", "worst" and "rms_error" in either case.
+Interpolated points count at INTERP_WEIGHT. VF, the output refit and
 the passivity enforcement minimise the matching weighted least squares. A fit missing ``tol`` warns
 (:class:`RadiationFitWarning`: value, ω, entry, part), also when a shipped or cached one is loaded;
 it is not an error, so plants build with the best fit found, and ``mbcontrol hydro`` prints it.
@@ -63,6 +56,7 @@ import scipy.linalg as sla
 from mbcontrol.errors import HydroError
 
 from .bem import matrix
+from .kernel import _cos_transform, _with_tail, kernel_data
 from .passivity import _response, passivity_test
 from .fit_error import FLOOR, _group_errors, _nerr, _worst, miss_message
 from .vector_fit import SLOW_POLE, _best_scaled_fit
@@ -71,117 +65,13 @@ ZERO_COUPLING = 1e-6  # |K_ij| <= this * sqrt(max|K_ii| max|K_jj|): treated as a
 DENSE_STEP = 0.02  # fit on a grid refined (by interpolation) to Δω <= 2 % of ω
 
 
+RESPONSE_DEFINITION = ("the worst over the BEM ω (in the response band) of the change the fit makes in the "
+                       "device's admittance |δY_ij| / sqrt(peak|Y_ii| peak|Y_jj|) and in its velocity per unit wave "
+                       "amplitude |δH_i| / peak|H_i|, the device linear at rest with its PTOs (module response_error)")
+
+
 class RadiationFitWarning(UserWarning):
     """A radiation fit that misses its tolerance (the message says by how much, and where)."""
-
-
-def _dof_list(ds, dofs):
-    all_dofs = [str(d) for d in ds["radiating_dof"].values]
-    if dofs is None:
-        return all_dofs
-    missing = [d for d in dofs if d not in all_dofs]
-    if missing:
-        raise HydroError(f"radiation: DOFs {missing} not in the dataset; expected names among {all_dofs}")
-    return list(dofs)
-
-
-def kernel_data(ds, dofs=None, omega_max=None):
-    """(ω, K(jω)) from a hydro dataset: K = B + jω(A - A∞), shape (nω, n, n), ω in rad/s."""
-    dofs = _dof_list(ds, dofs)
-    w = np.asarray(ds["omega"].values, dtype=float)
-    keep = w <= omega_max if omega_max is not None else np.ones(w.size, bool)
-    A, B = matrix(ds["added_mass"], dofs)[keep], matrix(ds["radiation_damping"], dofs)[keep]
-    K = B + 1j * w[keep, None, None] * (A - matrix(ds["added_mass_inf"], dofs))
-    return w[keep], K, dofs
-
-
-def tail_exponent(w, B) -> float:
-    """Decay exponent p of B(ω) ∝ ω^-p above the band, from the diagonal over the top 40 % of ω.
-
-    Log-log least squares on Σ_i |B_ii|; clipped to [2, 6] (3-D bodies decay at least like ω⁻²;
-    a Capytaine hemisphere decays like ω^-3.6 at kR = 8). Returns 3 if fewer than 3 points.
-    """
-    w = np.asarray(w, dtype=float)
-    y = np.sum(np.abs(np.einsum("kii->ki", B)), axis=1)
-    sel = (w >= 0.6 * w.max()) & (y > 0)
-    if np.count_nonzero(sel) < 3:
-        return 3.0
-    slope = np.polyfit(np.log(w[sel]), np.log(y[sel]), 1)[0]
-    return float(np.clip(-slope, 2.0, 6.0))
-
-
-def _with_tail(w, B, tail):
-    """Frequency grid and B with B(0) = 0 prepended and, unless tail is None, the power-law tail
-    B_N (ω_N/ω)^p on a geometric grid up to 50 ω_N (the rest is < 2 % of the tail for p >= 2)."""
-    w0 = np.concatenate([[0.0], w])
-    B0 = np.concatenate([np.zeros((1,) + B.shape[1:]), B])
-    if tail is None:
-        return w0, B0, None
-    p = tail_exponent(w, B) if tail == "auto" else float(tail)
-    if not p > 1:
-        raise HydroError(f"impulse_response: tail = {tail!r}; expected 'auto', None or an exponent > 1")
-    u = np.geomspace(1.0, 50.0, 121)[1:]
-    return (np.concatenate([w0, w[-1] * u]),
-            np.concatenate([B0, B[-1][None] * u[:, None, None] ** -p]), p)
-
-
-def _cos_transform(w, f, t):
-    """(2/π)∫ f(ω) cos(ωt) dω over the grid w, f piecewise linear, each piece exact (Filon form
-    of the trapezoid rule: equal to it at t = 0, free of aliasing when Δω·t > 1)."""
-    slope = np.diff(f, axis=0) / np.diff(w)[:, None, None]
-    a, b = w[:-1], w[1:]
-    out = np.empty((t.size,) + f.shape[1:])
-    for k, tk in enumerate(t):
-        if tk == 0.0:
-            val = np.trapezoid(f, w, axis=0)
-        else:
-            # Σ β_k (cos b t - cos a t)/t², written with sines to avoid cancellation at small t
-            dcos = -2.0 * np.sin((a + b) * tk / 2) * np.sin((b - a) * tk / 2) / tk**2
-            val = (f[-1] * np.sin(w[-1] * tk) - f[0] * np.sin(w[0] * tk)) / tk + np.tensordot(dcos, slope, (0, 0))
-        out[k] = 2.0 / np.pi * val
-    return out
-
-
-def impulse_response(ds, t, dofs=None, *, tail="auto") -> np.ndarray:
-    """K(t) = (2/π)∫₀^∞ B(ω) cos(ωt) dω, shape (nt, n, n), layout [i_force, j_motion], SI per s.
-
-    Quadrature: B is piecewise linear between the BEM frequencies, with B(0) = 0 added (true for
-    every entry: damping vanishes at zero frequency), and each piece is integrated exactly against
-    cos(ωt) (Filon form of the trapezoid rule). Tail beyond the last frequency ω_N:
-    B_N (ω_N/ω)^p with p from :func:`tail_exponent` (``"auto"``) or given (a number > 1);
-    ``None`` truncates at ω_N.
-    """
-    dofs = _dof_list(ds, dofs)
-    t = np.atleast_1d(np.asarray(t, dtype=float))
-    if np.any(t < 0):
-        raise HydroError("impulse_response: t must be >= 0 (s)")
-    w, f, _ = _with_tail(np.asarray(ds["omega"].values, dtype=float), matrix(ds["radiation_damping"], dofs), tail)
-    return _cos_transform(w, f, t)
-
-
-def convolution_force(K, dt, nu_history) -> np.ndarray:
-    """Reference Cummins convolution μ(t_n) = ∫₀^{t_n} K(t_n - τ) ν(τ) dτ on a uniform grid.
-
-    K : (nt, n, n) kernel at t = 0, dt, 2dt, … (layout [i_force, j_motion]); dt : s;
-    nu_history : (nt, n) twists at the same instants. Trapezoid rule, evaluated with FFTs.
-    Returns μ, shape (nt, n).
-    """
-    from scipy.signal import fftconvolve
-
-    K, nu = np.asarray(K, dtype=float), np.asarray(nu_history, dtype=float)
-    if K.ndim != 3 or nu.ndim != 2 or K.shape[0] != nu.shape[0] or K.shape[2] != nu.shape[1]:
-        raise HydroError(f"convolution_force: K {K.shape} and nu_history {nu.shape}; "
-                         "expected (nt, n, n) and (nt, n)")
-    nt = nu.shape[0]
-    mu = np.zeros((nt, K.shape[1]))
-    for i in range(K.shape[1]):
-        for j in range(K.shape[2]):
-            if np.any(K[:, i, j]):
-                mu[:, i] += fftconvolve(K[:, i, j], nu[:, j])[:nt]
-    # trapezoid end corrections: half weight on τ = 0 and τ = t_n
-    mu -= 0.5 * (K[:, :, :] @ nu[0]) + 0.5 * (K[0] @ nu.T).T
-    mu[0] = 0.0
-    return dt * mu
 
 
 # ---------------------------------------------------------------- vector fitting core
@@ -265,12 +155,17 @@ def _groups(K):
 def fit_radiation(ds, dofs=None, *, tol: float = 0.02, max_order: int = 30, omega_max=None,
                   n_iter: int = 20, dc_zero: bool = True, refit: bool = True,
                   markov: bool = True, passive: bool = True,
-                  passive_max_states: int = 100, response_band=None) -> RadiationModel:
+                  passive_max_states: int = 100, response_band=None, device=None) -> RadiationModel:
     """Fit one coupled, strictly proper, stable state-space model to K(jω) of ``dofs``.
 
     tol : target error (RadiationModel.fit_error), met per decoupled group so the total meets it
         too. response_band : (lo, hi) rad/s where the error is judged per frequency (module
-        docstring, "Error"); None: the global error only (the worst per frequency is reported). max_order : most poles tried per group in vector fitting (the state
+        docstring, "Error"); None: the global error only (the worst per frequency is reported). With a
+        ``device``, the band where the device's response is judged instead.
+    device : a :class:`mbcontrol.hydro.response_error.Device` (the plant around the kernel, from
+        :func:`mbcontrol.plant.device_around`): the error that chooses the order and passivity is
+        the error the fit causes in the device's response (module response_error); the kernel's own
+        errors are reported beside it. max_order : most poles tried per group in vector fitting (the state
         count before truncation is poles × group size). omega_max : fit only ω <= omega_max
         (rad/s), e.g. the mesh limit ``ds.attrs["omega_max_mesh"]``. n_iter : pole relocations.
         dc_zero : impose K(0) = 0 (vector fit and output refit). refit : after truncating to r states,
@@ -310,32 +205,41 @@ def fit_radiation(ds, dofs=None, *, tol: float = 0.02, max_order: int = 30, omeg
     given = response_band is not None
     lo, hi = (-np.inf, np.inf) if not given else map(float, response_band)
     inband = (w >= lo) & (w <= hi) & given     # where the per-frequency error gates the order
+    if device is not None:                     # the response gates; the kernel's errors are shown
+        device = device.restricted(dofs)
+        gate_f, gate_w = device.at(wf, Kf), device.at(w, Ks)
+        inband = (w >= lo) & (w <= hi)
     # the groups are fitted on the refined grid; their gate takes the BEM frequencies at full weight
     # (interpolated ones at INTERP_WEIGHT), so it is the error reported here
     parts, pre, info = [], [], []  # pre: the unconstrained fits (what passive=False returns)
     for gidx in groups:
         common = (wf, Kf[:, gidx][:, :, gidx], link[np.ix_(gidx, gidx)], np.isin(wf, w), ainf[gidx],
-                  (wf >= lo) & (wf <= hi) & given)
+                  (wf >= lo) & (wf <= hi) & given & (device is None))
         rest = (tol, max_order, n_iter, dc_zero, refit, group_markov(gidx),
                 p_tail, passive_max_states if passive else 0)
-        abc, rep, before = _best_scaled_fit(common, rest, [dofs[i] for i in gidx], passive)
+        abc, rep, before = _best_scaled_fit(common, rest, [dofs[i] for i in gidx], passive,
+                                            None if device is None else gate_f.on(gidx))
         parts.append((gidx, *abc))
         pre.append((gidx, *before))
         info.append({"dofs": [dofs[i] for i in gidx], **rep})
     model, entry, err = _assemble(parts, w, Ks, dofs, groups, ainf, inband)
+    if device is not None:
+        err = float(np.max(gate_w.errors(model.frequency_response(w))))
     A, B, C, order = model.A, model.B, model.C, model.order
     k0_data = _cos_transform(*_with_tail(w, K.real, None)[:2], np.zeros(1))[0]
     pas = {"enforce": bool(passive), "enforced": any(g.get("passivity", {}).get("enforced") for g in info),
            **passivity_test(A, B, C).as_dict()}
     if pas["enforced"]:  # the unconstrained fit's numbers, for comparison
         m0, _, e0 = _assemble(pre, w, Ks, dofs, groups, ainf, inband)
+        if device is not None:
+            e0 = float(np.max(gate_w.errors(m0.frequency_response(w))))
         t0 = passivity_test(m0.A, m0.B, m0.C).as_dict()
         pas.update(before={"fit_error": e0, "n_states": m0.order, **{k: t0[k] for k in (
             "passive", "margin", "min_eig", "omega_at_min", "max_eig", "bands", "grid_min_eig")}},
             fit_error_growth=err / e0 if e0 > 0 else 1.0,
             enforcement_seconds=sum(g["passivity"]["seconds"] for g in info if "passivity" in g))
     fit = model.frequency_response(w)
-    shown = inband if given else np.ones(w.size, bool)   # no band given: the worst shown, not gated
+    shown = inband if given or device is not None else np.ones(w.size, bool)  # the worst shown, not gated
     worst = _worst(fit, Ks, w, dofs, groups, ainf, shown) if shown.any() else None
     rms = _nerr(fit, K)
     ev = np.linalg.eigvals(A) if order else np.zeros(0)
@@ -343,14 +247,17 @@ def fit_radiation(ds, dofs=None, *, tol: float = 0.02, max_order: int = 30, omeg
         "method": "relaxed vector fitting, common poles per coupled DOF group, K(0)=0 and CB=K(0+) imposed; "
                   "balanced truncation with output refit" + ("; passivity by KYP-lemma SDP on C" if passive else ""),
         "n_states": int(order), "poles_per_group": [g["history"][-1]["poles"] for g in info],
-        "fit_error": err, "error_definition": "the larger of: in the response band, the worst over the BEM ω and "
-                                              "coupled entries of |Re δK| / largest |Re K| and |Im δK| / max(largest "
-                                              "|Im K|, ωA∞) at that ω, DOF peaks normalised to 1, sizes at least "
-                                              f"{FLOOR:g}; the global RMS error over the fit band (module radiation)",
+        "fit_error": err, "error_definition": RESPONSE_DEFINITION if device is not None else (
+            "the larger of: in the response band, the worst over the BEM ω and coupled entries of |Re δK| / "
+            "largest |Re K| and |Im δK| / max(largest |Im K|, ωA∞) at that ω, DOF peaks normalised to 1, sizes "
+            f"at least {FLOOR:g}; the global RMS error over the fit band (module radiation)"),
         "response_band": [float(max(lo, w.min())), float(min(hi, w.max()))],
         "band_given": given,
         "band_error": worst["error"] if worst else 0.0, "worst": worst, "rms_error": rms,
-        "limited_by": "response band" if given and worst and worst["error"] >= rms else "global RMS",
+        "limited_by": ("device response" if device is not None else
+                       "response band" if given and worst and worst["error"] >= rms else "global RMS"),
+        "response_error": err if device is not None else None,
+        "response_worst": gate_w.worst(fit) if device is not None else None,
         "slowest_decay": float(-np.max(ev.real)) if order else None, "decay_floor": SLOW_POLE * float(w.min()),
         "dofs": list(dofs), "entry_errors": entry.tolist(),
         "groups": info, "symmetrized": bool(asym < 1e-2), "asymmetry": float(asym),

@@ -19,6 +19,7 @@ from mbcontrol.errors import HydroError
 from .fit_error import INTERP_WEIGHT, _gate, _nerr, part_errors, part_sizes
 from .passive_order import make_passive
 from .passivity import _response
+from .response_error import LS_FLOOR
 
 TAIL_POINTS, TAIL_WEIGHT = 40, 0.3  # extrapolated K(jω) on 1.02-10 ω_max, weight per point
 SLOW_POLE = 0.1    # every pole decays at least at SLOW_POLE × the lowest data frequency (1/s)
@@ -205,8 +206,12 @@ def _unit_class(dof: str) -> str:
 
 
 def _fit_group(w, Kg, pattern, bem, ainf, inband, unit_class, tol, max_order, n_iter, dc_zero, refit, M1=None, p_tail=3.0,
-               passive_states=0, vf_frac=0.7):
-    """VF of one coupled group (scaled) to vf_frac·tol, column realisation, balanced truncation to tol."""
+               passive_states=0, vf_frac=0.7, judge=None):
+    """VF of one coupled group (scaled) to vf_frac·tol, column realisation, balanced truncation to tol.
+
+    judge (a :class:`mbcontrol.hydro.response_error.GroupJudge`, or None): the error that gates is
+    the device's response error, and the least squares weigh each ω by the response's sensitivity;
+    None: the kernel's own error (module radiation, "Error")."""
     m = Kg.shape[1]
     sc = _congruence_scale(Kg, unit_class)
     G = Kg * sc[None, :, None] * sc[None, None, :]
@@ -232,16 +237,32 @@ def _fit_group(w, Kg, pattern, bem, ainf, inband, unit_class, tol, max_order, n_
     ainf_s = ainf * sc**2  # A∞ scaled like G
     re, im = part_sizes(np.where(pattern[None], Ge, 0.0), we, ainf_s,
                         np.concatenate([inband, np.zeros(we.size - nd, bool)]))  # the tail: absolute
-    Wr = np.broadcast_to((tw / re)[:, None, None], Ge.shape)
-    Wi = np.broadcast_to((tw / im)[:, None, None], Ge.shape)
-    wt = tw / re   # passivity enforcement: one weight per ω, as the LS fit (relative in band)
+    wr, wi = tw / re, tw / im
+    if judge is not None:      # where the response feels the kernel (relative; LS_FLOOR elsewhere)
+        feel = judge.sensitivity(sc)
+        feel = np.maximum(feel / max(feel.max(), 1e-300), LS_FLOOR)
+        wr = wi = tw * np.concatenate([feel, np.full(we.size - nd, feel[-1])])
+    Wr = np.broadcast_to(wr[:, None, None], Ge.shape)
+    Wi = np.broadcast_to(wi[:, None, None], Ge.shape)
+    wt = wr   # passivity enforcement: one weight per ω, as the LS fit
+    u = sc[None, :, None] * sc[None, None, :]
+    Gp = np.where(pattern[None], G, 0.0)
+
+    def per_omega(fit):        # the gate's error per data ω (interpolated rows at INTERP_WEIGHT)
+        e = judge(fit / u) if judge is not None else np.max(part_errors(fit, Gp, w, ainf_s), axis=(1, 2)) * inband
+        return e * np.where(bem, 1.0, INTERP_WEIGHT)
+
+    def gate(fit):
+        if judge is None:
+            return _gate(fit, Gp, w, ainf_s, bem, inband, sc)
+        return float(np.max(per_omega(fit)))
     He = np.stack([Ge[:, i, j] for i, j in ent], axis=1)
     pick = (slice(None), [i for i, _ in ent], [j for _, j in ent])
 
     def err_fn(rows):  # entries of the fitted data rows -> the worst part error
         fit = np.zeros_like(G)
         fit[pick] = rows
-        return _gate(fit, np.where(pattern[None], G, 0.0), w, ainf_s, bem, inband, sc)
+        return gate(fit)
     # most of the error budget for the fit, the rest for the truncation (errors add ~ in quadrature)
     poles, Cr, history = _vector_fit(we, He, Wr[pick], Wi[pick], nd, err_fn, vf_frac * tol, max_order,
                                      n_iter, dc_zero, None if M1s is None else np.array([M1s[i, j] for i, j in ent]))
@@ -257,13 +278,12 @@ def _fit_group(w, Kg, pattern, bem, ainf, inband, unit_class, tol, max_order, n_
     def error(Ar, Br, Cr_):
         fit = _response(Ar, Br, Cr_, None, w, 1e10)
         fit[:, ~pattern] = 0.0
-        return _gate(fit, np.where(pattern[None], G, 0.0), w, ainf_s, bem, inband, sc)
+        return gate(fit)
 
-    def profile(Ar, Br, Cr_):   # in-band error / target per enforcement frequency (the tail: 0)
+    def profile(Ar, Br, Cr_):   # gated error / target per enforcement frequency (the tail: 0)
         fit = _response(Ar, Br, Cr_, None, w, 1e10)
         fit[:, ~pattern] = 0.0
-        e = np.max(part_errors(fit, np.where(pattern[None], G, 0.0), w, ainf_s), axis=(1, 2))
-        return np.concatenate([e * np.where(bem, 1.0, INTERP_WEIGHT) * inband, np.zeros(we.size - nd)]) / target
+        return np.concatenate([per_omega(fit), np.zeros(we.size - nd)]) / target
 
     def trial(r):
         Ar, Br = Ab[:r, :r], Bb[:r]
@@ -301,7 +321,7 @@ def _fit_group(w, Kg, pattern, bem, ainf, inband, unit_class, tol, max_order, n_
     return Ar, Br / sc[None, :], Cr_ / sc[:, None], info, before
 
 
-def _best_scaled_fit(common, rest, dofs, passive):
+def _best_scaled_fit(common, rest, dofs, passive, judge=None):
     """Fit one group under each distinct congruence scaling (per unit class, per DOF) and keep the
     model that meets tol, then one whose passivity enforcement kept C B = K(0+), then the fewest
     states, then the most accurate (error on the group's data).
@@ -316,14 +336,16 @@ def _best_scaled_fit(common, rest, dofs, passive):
     best, tried = None, []
     for label, classes in options.items():
         args = (*common, classes, *rest)
-        *abc, rep, before = _fit_group(*args)
+        *abc, rep, before = _fit_group(*args, judge=judge)
         # passive fits may need more poles: fit deeper, retry; only if the unconstrained fit met
         # the target (else more poles do not help, and the retry doubles a long fit's time)
         if passive and not rep["passivity"]["met"] and rep["error_gate"] <= rest[0]:
-            *abc2, rep2, _ = _fit_group(*args, vf_frac=0.15)
+            *abc2, rep2, _ = _fit_group(*args, vf_frac=0.15, judge=judge)
             if rep2["passivity"]["error_after"] < rep["passivity"]["error_after"]:
                 abc, rep = abc2, {**rep2, "deeper_vector_fit": True}
-        err = _gate(_response(*abc, None, w, 1e10), Kg, w, ainf, bem, inband)
+        fit = _response(*abc, None, w, 1e10)
+        err = (_gate(fit, Kg, w, ainf, bem, inband) if judge is None
+               else float(np.max(judge(fit) * np.where(bem, 1.0, INTERP_WEIGHT))))
         markov_dropped = rep.get("passivity", {}).get("markov_kept") is False
         tried.append({"scaling": label, "n_states": int(abc[0].shape[0]), "error": float(err),
                       "markov_dropped": markov_dropped})

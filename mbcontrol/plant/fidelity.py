@@ -155,8 +155,9 @@ def _hydro_model(scene, frozen, fidelity, hydro, waves, notes) -> HydroModel | N
         notes["couplings"] = coupling_size(data, dofs, band)
         data = drop_couplings(data)
         source = f"{source} (couplings between bodies dropped)"
+    from .mechanical import device_around
     return fit_hydro_model(data, dofs, tol, source, limit, scene.hydro.response_band,
-                           fit_method(scene.hydro.radiation_fit, dofs))
+                           fit_method(scene.hydro.radiation_fit, dofs), device_around(frozen, source, data, dofs))
 
 
 # ----------------------------------------------------------------------------- couplings

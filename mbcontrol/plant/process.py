@@ -98,7 +98,9 @@ def assemble_plant(scene: Scene | str, hydro: HydroModel | None = None, *,
 
     hydro_dofs = active_hydro_dofs(scene, topo)
     if hydro is None and hydro_dofs:
-        hydro = load_hydro_model(scene, hydro_dofs, tol=radiation_tol)
+        from .mechanical import device_around      # (it builds this plant without radiation)
+        hydro = load_hydro_model(scene, hydro_dofs, tol=radiation_tol,
+                                 device=lambda source, data: device_around(scene, source, data, hydro_dofs))
     elif hydro is not None:
         hydro = hydro.restricted(hydro_dofs)
     n_w = len(hydro_dofs)

@@ -287,7 +287,7 @@ def test_radiation_fit(barges):
 
 
 def test_state_space_impulse_response(barges, hemisphere):
-    from mbcontrol.hydro.radiation import _cos_transform
+    from mbcontrol.hydro.kernel import _cos_transform
 
     # (1) realisation check on the coupled barge model: C e^{At} B is the cosine transform of the
     # model's own Re K(jω) (a causal real kernel); Filon quadrature on 0-2e5 rad/s
