@@ -65,6 +65,7 @@ bench: $(VENV)/.installed-test
 	$(PY) benchmarks/wecopttool_electrical.py --out $(OUT)/bench/wecopttool
 	$(PY) benchmarks/wecopttool_codesign.py --out $(OUT)/bench/wecopttool_codesign
 	$(PY) benchmarks/wecopttool_tste.py --out $(OUT)/bench/wecopttool_tste
+	$(PY) benchmarks/wavebot_hull_fit.py --out $(OUT)/bench/wavebot_hull
 	$(PY) benchmarks/export_qp.py
 	$(PY) benchmarks/export_step.py --out $(OUT)/bench/export
 

@@ -1,6 +1,6 @@
 """What an interaction cut-off costs and saves: array_grid solved with every float coupled, and
 with each float coupled only to those within R (array_grid's `cutoff` parameter, i.e. `[hydro]
-interaction_radius`, module mbcontrol.hydro.neighbours), for several R (`make bench`).
+interaction_radius`, module mbcontrol.hydro.bem.neighbours), for several R (`make bench`).
 
 Per R, on a cold cache (a fresh folder each, as on a user's first run), one run on this machine:
   - BEM: wall time, distinct clusters solved and the largest;
@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from mbcontrol.hydro import load_hydro_data, matrix
-from mbcontrol.hydro.neighbours import cut_error
+from mbcontrol.hydro.bem.neighbours import cut_error
 from mbcontrol.scene import load_scene
 from mbcontrol.waves.spectra import jonswap_spectrum
 

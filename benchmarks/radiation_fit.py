@@ -76,7 +76,7 @@ def main(argv=None) -> int:
     args = ap.parse_args(argv)
 
     from mbcontrol.hydro import fit_radiation
-    from mbcontrol.hydro.baseline import fit_radiation_hankel
+    from mbcontrol.hydro.fit.baseline import fit_radiation_hankel
 
     ds = load(args.file, json.loads(args.read_kw))
     all_dofs = [str(d) for d in ds["radiating_dof"].values]

@@ -88,7 +88,7 @@ def convert(scene, out: Path) -> None:
 
 def fit_report(path: Path, tol: float, omega_max: str | None) -> None:
     from mbcontrol.hydro import fit_radiation
-    from mbcontrol.hydro._io import read_netcdf
+    from mbcontrol.hydro.data.netcdf import read_netcdf
 
     ds = read_netcdf(path)
     wmax = None if omega_max is None else ds.attrs["omega_max_mesh"] if omega_max == "mesh" else float(omega_max)
@@ -157,7 +157,7 @@ def main(argv=None) -> int:
 
     import numpy as np
     from mbcontrol.hydro import compute, write_netcdf_atomic
-    from mbcontrol.hydro.isolated import compute_isolated
+    from mbcontrol.hydro.bem.isolated import compute_isolated
 
     for file, scene in catalogue(args.models).items():
         out = Path(file)

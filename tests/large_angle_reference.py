@@ -9,7 +9,7 @@ from scipy.integrate import quad
 from scipy.spatial import ConvexHull
 from scipy.spatial.transform import Rotation
 
-from mbcontrol.hydro.large_angle import buoyancy
+from mbcontrol.hydro.mesh.large_angle import buoyancy
 
 RHO, G = 1025.0, 9.81
 BOX = {"type": "box", "size": [2.0, 1.0, 1.0], "center": [0.0, 0.0, 0.0]}

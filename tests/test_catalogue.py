@@ -53,14 +53,11 @@ def test_radiation_fit_meets_scene_tolerance(name):
     assert plant.hydro.radiation.fit_error <= tol
 
 
-# flume_section: its heave data are a 2-D strip's (models/flume_section_2d.py), and a 2-D section's
-# heave kernel is not that of a finite-order causal body: its damping does not vanish at low ω and
-# its added mass grows like log(1/ω), so K(0) = 0 and the Markov sum rule C B = (2/π)∫B dω, taken
-# with a power-law tail from the fit band's top (6.67 rad/s, the mesh limit), cannot both hold.
-# Judged by the response (issue 37) the fit says so: 7.2 % at 6.67 rad/s in the heave admittance,
-# 4-7 % over 1.5-6.7 rad/s; sway and roll 0.74 %. Measured without the sum rule and K(0) = 0 the
-# heave reaches 2.3 % (a 2-D data set, not a device's): the shortfall is the data's, stated here.
-KNOWN_FIT_SHORTFALL = {"flume_section": 0.072}
+# flume_section: its strip heave damping wiggles below 4.5 rad/s (a residue of differencing two
+# prisms, models/flume_section_2d.py) which no passive fit follows: the heave group alone is 9.6 %
+# (it warns, loudly, on every load), sway and roll 0.75 %, total 4.24 % at 24 states (3.65 % at 50
+# before issue 20, whose fits no longer retarget every group when one cannot meet tol)
+KNOWN_FIT_SHORTFALL = {"flume_section": 0.043}
 
 
 # wave band per model (rad/s): where its seas carry energy (tank models: periods 0.5-3 s)
@@ -105,7 +102,8 @@ def test_linearisation_matches_frequency_domain(name):
         assert np.all((np.abs(ss / np.where(strong, fd, 1) - 1) <= tol)[strong]), (name, direction)
 
 
-# flume_section's heave: the strip data's fit (KNOWN_FIT_SHORTFALL above) is 4-7 % off in the heave
-# response over its band, and this test sees it: measured 5.3 % of the peak (amplitude) and 6.8 %
-# (ratio); sway and roll are held to 2 %
+# flume_section's heave: the strip data's wiggles below 4.5 rad/s (above) pull its radiation
+# fit off: measured 5.3 % of the peak (amplitude) and 6.8 % (ratio) since issue 20's fits (2.3 %
+# and 3.2 % before: its heave group then got more states, retargeted with the others); sway and
+# roll are held to 2 %
 KNOWN_LTI_SHORTFALL = {("flume_section", "heave"): 0.07}

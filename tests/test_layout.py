@@ -103,6 +103,37 @@ def test_imports_run_one_way_along_the_flow():
     assert not upstream, "\n".join(sorted(upstream))
 
 
+HYDRO_STAGES = ("mesh", "data", ("bem", "readers"), "fit", "model")   # issue 37: hydro's rooms
+
+
+def _hydro_rank(module: str):
+    """Rank of a module inside mbcontrol.hydro along HYDRO_STAGES; None for the package itself."""
+    parts = module.split(".")
+    if parts[:2] != ["mbcontrol", "hydro"] or len(parts) < 3:
+        return None
+    for rank, names in enumerate(HYDRO_STAGES):
+        if parts[2] in ((names,) if isinstance(names, str) else names):
+            return rank
+    raise AssertionError(f"{module}: not in a stage of mbcontrol.hydro {HYDRO_STAGES}")
+
+
+def test_hydro_imports_only_go_down_its_stages():
+    """Inside mbcontrol.hydro, a module imports only from its own sub-package or earlier stages:
+    mesh < data < bem, readers < fit < model (the package's __init__ is its public face)."""
+    graph = import_graph()
+    bad = []
+    for module, targets in graph.items():
+        rank = _hydro_rank(module)
+        if rank is None:
+            continue
+        for target in targets:
+            target_rank = _hydro_rank(target)
+            same_room = target.split(".")[:3] == module.split(".")[:3]
+            if target == "mbcontrol.hydro" or (target_rank is not None and target_rank >= rank and not same_room):
+                bad.append(f"{module} imports {target}")
+    assert not bad, "\n".join(sorted(bad))
+
+
 def test_common_modules_import_no_stage():
     graph = import_graph()
     bad = [f"{m} imports {t}" for m, targets in graph.items() if stage(m)[0] == -1
@@ -200,7 +231,7 @@ def test_cited_test_files_exist():
 
 
 def _package(module: str) -> str:
-    """The stage (or common module) a module belongs to: mbcontrol.hydro.bem -> hydro."""
+    """The stage (or common module) a module belongs to: mbcontrol.hydro.bem.solve -> hydro."""
     parts = module.split(".")
     return parts[1] if len(parts) > 1 else parts[0]
 

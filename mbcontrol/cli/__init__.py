@@ -228,8 +228,12 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("hydro", help="load or compute a model's BEM data and fit its radiation "
                                      "model; print the fit report")
     _model_options(p)
-    p.add_argument("--tol", type=float, help="radiation fit tolerance (e.g. 0.01): the larger of the worst relative "
-                   "error per frequency in the scene's response_band and the global RMS error")
+    p.add_argument("--tol", type=float, help="radiation fit tolerance (e.g. 0.01) on the error that judges it: "
+                   "the device's response error, or the kernel's (the larger of the worst relative error per "
+                   "frequency in the scene's response_band and the global RMS error)")
+    p.add_argument("--judged-by", choices=("response", "kernel"),
+                   help="judge the fit by the device's response or by the kernel's own error "
+                        "(default: the scene's [hydro] fit_judged_by)")
     p.add_argument("--json", action="store_true", help="print the report as JSON")
     p.set_defaults(run=run_hydro)
 

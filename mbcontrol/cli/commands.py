@@ -22,7 +22,11 @@ def _plant(args, **kwargs):
     values = dict(_key_value(item, "--scene-param") for item in args.scene_param)
     if any(item.split("=")[0].endswith(HYDRO_SCALES) for item in getattr(args, "param", [])):
         kwargs.setdefault("hydro_corrections", True)
-    return build_plant(load_scene(args.model, values or None), **kwargs)
+    scene = load_scene(args.model, values or None)
+    if getattr(args, "judged_by", None):
+        import dataclasses
+        scene = dataclasses.replace(scene, hydro=dataclasses.replace(scene.hydro, fit_judged_by=args.judged_by))
+    return build_plant(scene, **kwargs)
 
 
 def run_models(args) -> int:

@@ -1,5 +1,10 @@
 """Hydrodynamics: Capytaine BEM runs, frame maps to NED body frames, radiation models.
 
+Sub-packages by stage, each importing only those before it (tests/test_layout.py):
+``mesh`` (the wetted surfaces) < ``data`` (the body-frame dataset, frame maps, NetCDF) <
+``bem`` (Capytaine runs) and ``readers`` (WAMIT, BEMIO, Capytaine files) < ``fit`` (radiation
+kernel, fits judged by the device's response, passivity) < ``model`` (the HydroModel a plant uses).
+
 Dataset layout returned by :func:`compute` (SI units, NED body frames at each CoG,
 time convention e^{-iωt}, excitation per unit wave amplitude at the n-frame origin):
 
@@ -10,19 +15,20 @@ time convention e^{-iωt}, excitation per unit wave amplitude at the n-frame ori
 - ``excitation_force`` = ``froude_krylov_force`` + ``diffraction_force`` (wave_direction, omega, influenced_dof)
 - ``displaced_volume``, ``waterplane_area``, ``mass`` (body); ``center_of_buoyancy``, ``cog`` (body, xyz)
 
-Arrays: a mirror-symmetric layout is solved on its planes (module array_bem); many bodies' radiation
-is fitted column by column (module array_fit, :func:`fit_radiation_columns`).
+Arrays: a mirror-symmetric layout is solved on its planes (module bem.array_bem); many bodies' radiation
+is fitted column by column (module fit.array_fit, :func:`fit_radiation_columns`).
 """
-from ._io import read_netcdf, write_netcdf_atomic
-from .baseline import fit_radiation_hankel
-from .bem import cache_key, compute, matrix
-from .frames import dof_map, shift_matrix, skew, to_body_frames, zup_to_ned
-from .geometry import RIGID_DOFS, BemBody, hull_mesh, lid_mesh, validate_body
+from .data.netcdf import read_netcdf, write_netcdf_atomic
+from .fit.baseline import fit_radiation_hankel
+from .bem.solve import cache_key, compute
+from .data.dataset import matrix
+from .data.frames import dof_map, shift_matrix, skew, to_body_frames, zup_to_ned
+from .mesh.geometry import RIGID_DOFS, BemBody, hull_mesh, lid_mesh, validate_body
 from .model import HydroModel, fit_hydro_model, fit_method, geometry_dict, load_hydro_data, load_hydro_model
-from .passivity import PassivityReport, absorbed_energy, enforce_passivity, passivity_test
-from .array_fit import fit_radiation_columns
-from .kernel import convolution_force, impulse_response, kernel_data
-from .radiation import RadiationModel, fit_radiation
+from .fit.passivity import PassivityReport, absorbed_energy, enforce_passivity, passivity_test
+from .fit.array_fit import fit_radiation_columns
+from .fit.kernel import convolution_force, impulse_response, kernel_data
+from .fit.radiation import RadiationModel, fit_radiation
 
 __all__ = [
     "read_netcdf", "write_netcdf_atomic",

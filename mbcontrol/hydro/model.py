@@ -23,16 +23,16 @@ from ..cache import cache_dir, status
 from ..errors import HydroError
 from ..scene import DOF_NAMES, Scene
 from ..waves import Wave, excitation_series, interpolate_complex
-from . import (array_fit, array_passivity, fit_error, passive_order, passivity, radiation, response_error, sdp,
-               vector_fit)
-from ._io import read_netcdf
-from .bem import compute
-from .geometry import BemBody
-from .isolated import compute_isolated
-from .neighbours import compute_within
-from .radiation import RadiationModel, fit_radiation
-from .response_error import Device
-from .ssforms import modal_form
+from .fit import (array_fit, array_passivity, fit_error, passive_order, passivity, radiation, response_error, sdp,
+                  vector_fit)
+from .data.netcdf import read_netcdf
+from .bem.solve import compute
+from .mesh.geometry import BemBody
+from .bem.isolated import compute_isolated
+from .bem.neighbours import compute_within
+from .fit.radiation import RadiationModel, fit_radiation
+from .fit.response_error import Device
+from .fit.ssforms import modal_form
 
 
 @dataclass(frozen=True)

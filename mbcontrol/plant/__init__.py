@@ -5,8 +5,7 @@ symbolic parameters. Modules: `process` (ProcessPlant and its assembly), `loads`
 friction, moorings, drag, end stops, gravity, hydrostatics), `catenary` and `catenary_line`
 (quasi-static mooring lines), `checks` (rest checks), `fidelity` (simplified models),
 `freeze` (DOFs removed: blocked by a rig, or not excited by the waves),
-`jacobians` (exact Jacobians, shared downstream), `mechanical` (the linear mechanics at rest,
-and the device a radiation fit is judged by), `provenance` (content hashes of what
+`jacobians` (exact Jacobians, shared downstream), `mechanical` (the linear mechanics at rest), `provenance` (content hashes of what
 made a plant), `build` (the entry point).
 """
 from .build import build_plant
@@ -14,8 +13,8 @@ from .catenary import CatenarySolution, solve_catenary
 from .catenary_line import CatenaryLine, catenary_line
 from .fidelity import Fidelity, FidelityError, plant_for
 from .jacobians import jacobians
-from .mechanical import MechanicalMatrices, device_around, linear_params, mechanical_matrices
-from .process import ProcessPlant, active_hydro_dofs, dof_selector
+from .mechanical import MechanicalMatrices, dof_selector, linear_params, mechanical_matrices
+from .process import ProcessPlant, active_hydro_dofs, device_around
 from .provenance import provenance
 
 __all__ = ["build_plant", "ProcessPlant", "active_hydro_dofs", "dof_selector", "jacobians",

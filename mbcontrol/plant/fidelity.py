@@ -29,7 +29,7 @@ from ..hydro import HydroModel, fit_hydro_model, fit_method, load_hydro_data
 from ..multibody import build_topology
 from ..scene import DOF_NAMES, Scene, load_scene
 from .freeze import FREEZE_THRESHOLD, as_wave_list, freeze_report, frozen_scene
-from .process import ProcessPlant, active_hydro_dofs, assemble_plant
+from .process import ProcessPlant, active_hydro_dofs, assemble_plant, device_around
 
 AUDIT_OUTPUTS = ("energy", "excitation_power", "radiated_power")   # plus "<pto>__power"
 
@@ -155,9 +155,9 @@ def _hydro_model(scene, frozen, fidelity, hydro, waves, notes) -> HydroModel | N
         notes["couplings"] = coupling_size(data, dofs, band)
         data = drop_couplings(data)
         source = f"{source} (couplings between bodies dropped)"
-    from .mechanical import device_around
     return fit_hydro_model(data, dofs, tol, source, limit, scene.hydro.response_band,
-                           fit_method(scene.hydro.radiation_fit, dofs), device_around(frozen, source, data, dofs))
+                           fit_method(scene.hydro.radiation_fit, dofs),
+                           device_around(frozen, source, data, dofs) if scene.hydro.fit_judged_by == "response" else None)
 
 
 # ----------------------------------------------------------------------------- couplings

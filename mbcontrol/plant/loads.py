@@ -217,13 +217,13 @@ def restoring_forces(topo: Topology, q, stiffness_by_body: dict):
 def large_angle_hydrostatics(scene: Scene, topo: Topology, q):
     """Weight and buoyancy of each hydro body from its immersed part at the current pose.
 
-    Buoyancy comes from the body's primitive (box, cylinder, sphere; mbcontrol.hydro.large_angle)
+    Buoyancy comes from the body's primitive (box, cylinder, sphere; mbcontrol.hydro.mesh.large_angle)
     cut by the calm free surface, so restoring stays right at large heel, heave and pitch
     where the linear stiffness G^b does not. It replaces the linear restoring and the static
     loads. Returns (generalised force, potential energy relative to rest, J).
     """
     from ..hydro import geometry_dict
-    from ..hydro.large_angle import buoyancy
+    from ..hydro.mesh.large_angle import buoyancy
 
     tree, tau, energy = topo.tree, ca.SX.zeros(topo.tree.n_s), 0
     rho, g = scene.water.rho, scene.water.g

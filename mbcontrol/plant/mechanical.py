@@ -1,5 +1,6 @@
-"""The plant's linear mechanics at rest, read off its exact Jacobians, and the device a
-radiation fit is judged by (:mod:`mbcontrol.hydro.response_error`).
+"""The plant's linear mechanics at rest, read off its exact Jacobians: what the frequency-domain
+solution, the PTO ports and the device a radiation fit is judged by
+(:func:`mbcontrol.plant.process.device_around`) are made of.
 
 With M_tot = M + P A∞ Pᵀ, the linearised s' row is -M_tot⁻¹ (K q + B s) + radiation, so the
 generalised stiffness K = -M_tot ds'/dq and damping B = -M_tot ds'/ds: hydrostatics and gravity
@@ -12,10 +13,18 @@ from dataclasses import dataclass
 import casadi as ca
 import numpy as np
 
-from ..hydro import HydroModel, RadiationModel
-from ..hydro.response_error import Device
+from ..multibody import Topology
+from ..scene import DOF_NAMES
 from .jacobians import jacobians
-from .process import assemble_plant, dof_selector
+
+
+def dof_selector(topo: Topology, dofs: list[str]) -> np.ndarray:
+    """Rows pick hydro DOFs out of the 6N body-twist vector."""
+    select = np.zeros((len(dofs), 6 * len(topo.bodies)))
+    for row, dof in enumerate(dofs):
+        body, name = dof.split("__")
+        select[row, 6 * topo.body_index(body) + DOF_NAMES.index(name)] = 1.0
+    return select
 
 
 @dataclass(frozen=True)
@@ -73,20 +82,3 @@ def linear_params(plant, ptos, params=None) -> dict:
         out[f"{name}__damping"] = 0.0
         out[f"{name}__stiffness"] = 0.0
     return out
-
-
-def device_around(scene, source: str, data, dofs) -> Device:
-    """The device a radiation fit of ``data`` on ``dofs`` sits in: the scene's plant without
-    radiation states, linear at rest, seen from its PTOs (their own damping and stiffness zero,
-    Coulomb friction removed: `linear_params`), with its joints' stiffness and its drivetrains,
-    and the data's excitation at every heading."""
-    n = len(dofs)
-    none = RadiationModel(A=np.zeros((0, 0)), B=np.zeros((0, n)), C=np.zeros((n, 0)), D=np.zeros((n, n)),
-                          dofs=tuple(dofs), order=0, fit_error=0.0, entry_errors=np.zeros((n, n)))
-    plant = assemble_plant(scene, HydroModel(tuple(dofs), data, none, source), radiation=False)
-    mech = mechanical_matrices(plant, linear_params(plant, [pto.name for pto in scene.ptos]))
-    excitation = data["excitation_force"].sel(influenced_dof=list(dofs)).transpose(
-        "wave_direction", "omega", "influenced_dof").values
-    return Device(tuple(plant.topology.tree.coordinate_names), tuple(dofs), mech.mass + mech.added_mass_inf,
-                  mech.damping, mech.stiffness, mech.P_hydro, excitation, data["omega"].values,
-                  data["wave_direction"].values, scene.hydro.response_band)

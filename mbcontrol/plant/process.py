@@ -16,10 +16,12 @@ from dataclasses import dataclass, field
 import casadi as ca
 import numpy as np
 
-from ..hydro import HydroModel, load_hydro_model
+from ..hydro import HydroModel, RadiationModel, load_hydro_model
+from ..hydro.fit.response_error import Device
 from ..multibody import Topology, build_topology
 from ..scene import DOF_NAMES, Scene, load_scene
 from . import checks, loads
+from .mechanical import dof_selector, linear_params, mechanical_matrices
 
 
 @dataclass(frozen=True, eq=False)      # identity semantics: compiled code is cached per plant
@@ -98,9 +100,9 @@ def assemble_plant(scene: Scene | str, hydro: HydroModel | None = None, *,
 
     hydro_dofs = active_hydro_dofs(scene, topo)
     if hydro is None and hydro_dofs:
-        from .mechanical import device_around      # (it builds this plant without radiation)
-        hydro = load_hydro_model(scene, hydro_dofs, tol=radiation_tol,
-                                 device=lambda source, data: device_around(scene, source, data, hydro_dofs))
+        judged = scene.hydro.fit_judged_by == "response"
+        hydro = load_hydro_model(scene, hydro_dofs, tol=radiation_tol, device=(
+            lambda source, data: device_around(scene, source, data, hydro_dofs)) if judged else None)
     elif hydro is not None:
         hydro = hydro.restricted(hydro_dofs)
     n_w = len(hydro_dofs)
@@ -247,15 +249,6 @@ def active_hydro_dofs(scene: Scene, topo: Topology) -> list[str]:
     return dofs
 
 
-def dof_selector(topo: Topology, dofs: list[str]) -> np.ndarray:
-    """Rows pick hydro DOFs out of the 6N body-twist vector."""
-    select = np.zeros((len(dofs), 6 * len(topo.bodies)))
-    for row, dof in enumerate(dofs):
-        body, name = dof.split("__")
-        select[row, 6 * topo.body_index(body) + DOF_NAMES.index(name)] = 1.0
-    return select
-
-
 def _outputs(scene, topo: Topology, q, s, pto_signals, power, tensions, s_dot):
     tree = topo.tree
     q_rest = ca.DM.zeros(tree.n_q)
@@ -349,3 +342,20 @@ def _units(plant, signal: str) -> str:
             signal.split("__")[0] in plant.topology.bodies:
         return _BODY_UNITS[signal.split("__")[-1]][0]
     return _coordinate_unit(plant, signal)
+
+
+def device_around(scene, source: str, data, dofs) -> Device:
+    """The device a radiation fit of ``data`` on ``dofs`` sits in: the scene's plant without
+    radiation states, linear at rest, seen from its PTOs (their own damping and stiffness zero,
+    Coulomb friction removed: `linear_params`), with its joints' stiffness and its drivetrains,
+    and the data's excitation at every heading."""
+    n = len(dofs)
+    none = RadiationModel(A=np.zeros((0, 0)), B=np.zeros((0, n)), C=np.zeros((n, 0)), D=np.zeros((n, n)),
+                          dofs=tuple(dofs), order=0, fit_error=0.0, entry_errors=np.zeros((n, n)))
+    plant = assemble_plant(scene, HydroModel(tuple(dofs), data, none, source), radiation=False)
+    mech = mechanical_matrices(plant, linear_params(plant, [pto.name for pto in scene.ptos]))
+    excitation = data["excitation_force"].sel(influenced_dof=list(dofs)).transpose(
+        "wave_direction", "omega", "influenced_dof").values
+    return Device(tuple(plant.topology.tree.coordinate_names), tuple(dofs), mech.mass + mech.added_mass_inf,
+                  mech.damping, mech.stiffness, mech.P_hydro, excitation, data["omega"].values,
+                  data["wave_direction"].values, scene.hydro.response_band)

@@ -230,8 +230,10 @@ class HydroSettings:
     omega: tuple[float, ...] = ()              # rad/s, BEM frequencies
     headings: tuple[float, ...] = (0.0,)       # rad, NED wave directions
     lid: bool = True
-    radiation_tol: float = 0.01                # radiation fit error (hydro.radiation, "Error")
-    radiation_fit: str = "auto"                # "coupled" | "columns" (hydro.array_fit) | "auto"
+    radiation_tol: float = 0.01                # radiation fit error (hydro.fit.radiation, "Error")
+    radiation_fit: str = "auto"                # "coupled" | "columns" (hydro.fit.array_fit) | "auto"
+    fit_judged_by: str = "response"            # "response": the device's (hydro.fit.response_error);
+                                               # "kernel": K(jω)'s own error (hydro.fit.fit_error)
     fit_omega_max: float = math.inf            # rad/s: fit the radiation model below this
     response_band: tuple[float, float] | None = None  # rad/s: where the device moves (its seas
                                                # and modes); radiation fit judged per ω there
@@ -240,8 +242,8 @@ class HydroSettings:
                                                # Capytaine .nc) that `file` is converted from
     source_bodies: tuple[str, ...] = ()        # scene body per body of the source, in order
     source_options: dict = field(default_factory=dict)   # reader/cleaning options, see below
-    interaction: bool = True                   # False: each body solved alone (hydro.isolated)
-    interaction_radius: float = math.inf       # m: couple bodies only within it (hydro.neighbours)
+    interaction: bool = True                   # False: each body solved alone (hydro.bem.isolated)
+    interaction_radius: float = math.inf       # m: couple bodies only within it (hydro.bem.neighbours)
     hydrostatics: str = "linear"               # "linear" | "large_angle" (box, cylinder, sphere)
 
 

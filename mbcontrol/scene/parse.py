@@ -267,7 +267,7 @@ def _hydro(r: Reader, path: Path) -> HydroSettings:
         return HydroSettings()
     r.allow("file", "panel_size", "omega", "headings", "lid", "radiation_tol", "dofs",
             "source", "source_bodies", "source_options", "fit_omega_max", "response_band", "interaction",
-            "interaction_radius", "hydrostatics", "radiation_fit")
+            "interaction_radius", "hydrostatics", "radiation_fit", "fit_judged_by")
     band = r.finite_list("response_band", "frequency", default=()) or None
     if band is not None and not (len(band) == 2 and 0 <= band[0] < band[1]):
         r.fail("response_band", f"expected [low, high] in rad/s with 0 <= low < high, got {band}")
@@ -288,6 +288,7 @@ def _hydro(r: Reader, path: Path) -> HydroSettings:
         radiation_tol=r.positive("radiation_tol", None,
                                  default=defaults.get("hydro.radiation_tol")),
         radiation_fit=r.choice("radiation_fit", ("auto", "coupled", "columns"), default="auto"),
+        fit_judged_by=r.choice("fit_judged_by", ("response", "kernel"), default="response"),
         dofs=r.dof_list("dofs", default=DOF_NAMES),
         fit_omega_max=r.positive("fit_omega_max", "frequency", default=math.inf, finite=False),
         response_band=tuple(band) if band is not None else None,

@@ -176,7 +176,7 @@ MEANING = {
     ("hydro", "lid"): "a lid on each waterplane against irregular frequencies",
     ("hydro", "interaction"): "false: each body solved alone (no coupling)",
     ("hydro", "interaction_radius"): ("m: bodies couple only within it, each solved among its "
-                                      "neighbours (mbcontrol.hydro.neighbours); inf: all coupled"),
+                                      "neighbours (mbcontrol.hydro.bem.neighbours); inf: all coupled"),
     ("hydro", "dofs"): "the DOFs solved per body",
     ("hydro", "radiation_tol"): "radiation fit error tolerance (default: the 'hydro.radiation_tol' "
                                 "of `mbcontrol defaults`)",
@@ -184,7 +184,9 @@ MEANING = {
                                 "column, symmetric columns shared: arrays and farms) or `auto` "
                                 "(columns from 9 bodies)",
     ("hydro", "fit_omega_max"): "highest frequency the radiation fit sees",
-    ("hydro", "response_band"): "[low, high]: where the fit is judged per frequency",
+    ("hydro", "fit_judged_by"): "\"response\": the radiation fit's order is set by the error it causes in "
+                                "the device's response; \"kernel\": by K(jω)'s own error",
+    ("hydro", "response_band"): "[low, high]: limits where the fit's response error is judged",
     ("hydro", "hydrostatics"): "`large_angle`: buoyancy of the immersed primitive at its pose",
     ("hydro.omega", "min"): "first frequency",
     ("hydro.omega", "max"): "last frequency",

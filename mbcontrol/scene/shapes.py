@@ -3,7 +3,7 @@
 A revolution profile is a polyline of ``(r, z)`` points in the body frame (NED: z positive
 down, m), from the top to the keel, revolved about the body's z axis through the geometry's
 ``center``. Both ends are closed to the axis by flat discs when their radius is not 0 (a deck
-on top, a flat keel below). The BEM mesher (:mod:`mbcontrol.hydro.revolution`) and
+on top, a flat keel below). The BEM mesher (:mod:`mbcontrol.hydro.mesh.revolution`) and
 ``mass = "displaced"`` use the same immersed profile from :func:`immersed_profile`, so the
 mass and the mesh's buoyancy agree.
 """
@@ -17,7 +17,7 @@ from .checks import _REQUIRED   # the scene readers' own marker of a required ke
 from .units import UnitError, to_si
 
 # mass = "displaced" needs the immersed volume the BEM mesh will have: a box's mesh is exact,
-# a revolution's is made volume-exact (mbcontrol.hydro.revolution); the faceted cylinders and
+# a revolution's is made volume-exact (mbcontrol.hydro.mesh.revolution); the faceted cylinders and
 # spheres of the other primitives hold a few per mille less than their closed form
 DISPLACED_KINDS = ("box", "revolution")
 

@@ -1,10 +1,11 @@
-"""BEM of arrays on the layout's mirror planes (mbcontrol.hydro.array_bem): the same numbers as the
+"""BEM of arrays on the layout's mirror planes (mbcontrol.hydro.bem.array_bem): the same numbers as the
 plain coupled solve, and used only where the symmetry is exact. Coarse meshes, few frequencies."""
 import numpy as np
 import pytest
 
-from mbcontrol.hydro import BemBody, bem
-from mbcontrol.hydro.array_bem import symmetric_array_body
+from mbcontrol.hydro import BemBody
+from mbcontrol.hydro.bem import solve as bem
+from mbcontrol.hydro.bem.array_bem import symmetric_array_body
 
 OMEGAS = np.array([2.0, 5.0, 9.0])
 

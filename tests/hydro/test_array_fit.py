@@ -1,4 +1,4 @@
-"""The column-wise radiation fit for arrays (mbcontrol.hydro.array_fit), checked against the data
+"""The column-wise radiation fit for arrays (mbcontrol.hydro.fit.array_fit), checked against the data
 it fits, the exact passivity test of module passivity, the kernel's own cosine transform and the
 layout's symmetry; and the choice of fit by a scene."""
 import numpy as np
@@ -6,9 +6,9 @@ import pytest
 
 from mbcontrol.errors import HydroError, SceneError
 from mbcontrol.hydro import fit_method, impulse_response, kernel_data
-from mbcontrol.hydro._io import read_netcdf
-from mbcontrol.hydro.array_fit import column_classes, fit_radiation_columns
-from mbcontrol.hydro.passivity import passivity_test
+from mbcontrol.hydro.data.netcdf import read_netcdf
+from mbcontrol.hydro.fit.array_fit import column_classes, fit_radiation_columns
+from mbcontrol.hydro.fit.passivity import passivity_test
 from mbcontrol.scene import catalogue_dir, load_scene
 
 OMEGA_MAX = 12.0    # rad/s: array4's 40 mm mesh is resolved below this
@@ -117,7 +117,7 @@ def test_a_scene_chooses_the_fit(tmp_path):
 def test_the_shunt_alone_makes_a_fit_passive(data, monkeypatch):
     """With no residue passes the band-pass terms added to the diagonal must cover every
     violation: the exact test agrees, and their real part is never negative (positive real)."""
-    from mbcontrol.hydro import array_passivity
+    from mbcontrol.hydro.fit import array_passivity
     monkeypatch.setattr(array_passivity, "RESIDUE_PASSES", 0)
     model = fit_radiation_columns(data, tol=0.5, omega_max=OMEGA_MAX)
     terms = model.report["passivity"]["shunt_terms"]

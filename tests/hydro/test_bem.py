@@ -15,9 +15,11 @@ import pytest
 import xarray as xr
 
 from mbcontrol.errors import HydroError
-from mbcontrol.hydro import (BemBody, _io, bem, compute, convolution_force, fit_radiation,
-                             impulse_response, matrix, to_body_frames)
-from mbcontrol.hydro.frames import dof_map
+from mbcontrol.hydro import (BemBody, compute, convolution_force, fit_radiation, impulse_response, matrix,
+                             to_body_frames)
+from mbcontrol.hydro.bem import solve as bem
+from mbcontrol.hydro.data import netcdf
+from mbcontrol.hydro.data.frames import dof_map
 
 RHO, G = 1000.0, 9.81
 DOFS6 = ("Surge", "Sway", "Heave", "Roll", "Pitch", "Yaw")
@@ -287,7 +289,7 @@ def test_radiation_fit(barges):
 
 
 def test_state_space_impulse_response(barges, hemisphere):
-    from mbcontrol.hydro.kernel import _cos_transform
+    from mbcontrol.hydro.fit.kernel import _cos_transform
 
     # (1) realisation check on the coupled barge model: C e^{At} B is the cosine transform of the
     # model's own Re K(jω) (a causal real kernel); Filon quadrature on 0-2e5 rad/s
@@ -333,15 +335,15 @@ def test_cache_hit_does_not_solve(barges, cache_dir, monkeypatch):
 
 def test_atomic_write_leaves_nothing_on_failure(tmp_path, monkeypatch):
     ds = xr.Dataset({"x": ("a", np.array([1 + 2j, 3 - 1j]))}, attrs={"depth": np.inf, "flag": True})
-    path = _io.write_netcdf_atomic(ds, tmp_path / "ok.nc")
-    xr.testing.assert_identical(_io.read_netcdf(path), ds)  # complex, inf and bool round-trip
+    path = netcdf.write_netcdf_atomic(ds, tmp_path / "ok.nc")
+    xr.testing.assert_identical(netcdf.read_netcdf(path), ds)  # complex, inf and bool round-trip
 
     def fail(_):
         raise OSError("disk full")
 
-    monkeypatch.setattr(_io, "_encode", fail)
+    monkeypatch.setattr(netcdf, "_encode", fail)
     with pytest.raises(OSError):
-        _io.write_netcdf_atomic(ds, tmp_path / "bad.nc")
+        netcdf.write_netcdf_atomic(ds, tmp_path / "bad.nc")
     assert sorted(os.listdir(tmp_path)) == ["ok.nc"]
 
 

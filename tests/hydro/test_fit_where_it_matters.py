@@ -1,6 +1,6 @@
-"""Radiation fits judged where the device responds (issues 20 and 37): the error that sets the
-order is the device's response error, per frequency, so a low-frequency mode's small damping
-counts; the kernel's own errors are shown beside it; a fit that
+"""Radiation fits judged where the device responds (issue 20, item 2): the error that sets the
+order is relative per frequency in the response band, so a low-frequency mode's small damping
+counts (and the global norm holds above it); a fit that
 misses its tolerance says so, with the value and where; no pole is slower than the data can
 resolve. Uses the shipped catalogue data and fits only (a few seconds)."""
 import warnings
@@ -9,11 +9,10 @@ import numpy as np
 import pytest
 
 from mbcontrol.hydro import model as hydro_model
-from mbcontrol.hydro.kernel import kernel_data
-from mbcontrol.hydro.radiation import RadiationFitWarning, fit_radiation
-from mbcontrol.hydro.fit_error import part_errors
-from mbcontrol.hydro.response_error import MOVES
-from mbcontrol.hydro.vector_fit import SLOW_POLE
+from mbcontrol.hydro.fit.kernel import kernel_data
+from mbcontrol.hydro.fit.radiation import RadiationFitWarning, fit_radiation
+from mbcontrol.hydro.fit.fit_error import part_errors
+from mbcontrol.hydro.fit.vector_fit import SLOW_POLE
 from mbcontrol.plant import build_plant
 from mbcontrol.scene import list_models, load_scene
 
@@ -30,41 +29,46 @@ def _quiet_plant(name):
         return build_plant(name)
 
 
-def test_oswec_hinge_response_per_frequency_in_its_response_band(empty_cache):
+def test_oswec_damping_per_frequency_in_its_response_band(empty_cache):
     """The flap's pitch mode (~0.35 rad/s, 18 s) lies in its response band (0.3-2 rad/s): the
-    fitted plant's hinge admittance with the PTO free (the linearised CasADi plant), against the
-    BEM-direct one (mbcontrol.analysis.ports), within the tolerance asked for at every BEM
-    frequency there where the flap moves in waves (its free hinge velocity per unit wave amplitude
-    at least MOVES of its most; weighted by that share above). A global norm let the response at
-    the mode be ~16 % off (the hinge damping there is 1e-3 of the kernel's peak). Measured 0.96 %
-    at 0.328 rad/s (25 states; the kernel-judged fit before issue 37: 51 states)."""
-    from mbcontrol.analysis import linearize
-    from mbcontrol.analysis.ports import port_responses
-    from mbcontrol.plant import linear_params
-
+    fitted damping, against the BEM data at every frequency there, within the tolerance asked
+    for. A global error norm alone let the hinge damping be off by ~100 % near the mode (where it
+    is 1e-3 of its peak): measured before this change, 14.2 % at 0.31 rad/s (tol 0.5 %, global)."""
     scene = load_scene("oswec")
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         plant = build_plant("oswec")
+    hydro = plant.hydro
+    rad, tol = hydro.radiation, scene.hydro.radiation_tol
+    assert scene.hydro.response_band == (0.3, 2.0) and rad.report["response_band"] == [0.3, 2.0]
+    w, K, dofs = kernel_data(hydro.data, list(rad.dofs), rad.report["omega_fit"][1])
+    assert dofs == ["flap__Surge", "flap__Pitch"]
+    K = 0.5 * (K + np.swapaxes(K, 1, 2))                       # as fitted (BEM reciprocity)
+    fit = rad.frequency_response(w)
+    band = (w >= 0.3) & (w <= 2.0)
+    # the damping part of the error, recomputed here from its definition: per frequency, in
+    # D K D (each DOF's peak 1), relative to the largest damping entry there (at least 1 %)
+    d = 1 / np.sqrt(np.max(np.abs(np.einsum("kii->ki", K)), axis=0))
+    dd = np.outer(d, d)[None]
+    size = np.maximum(np.max(np.abs((K * dd).real), axis=(1, 2)), 0.01)
+    damping = np.max(np.abs(((fit - K) * dd).real), axis=(1, 2)) / size
+    assert damping[band].max() <= tol
     assert not [c for c in caught if issubclass(c.category, RadiationFitWarning)]
-    rad, tol = plant.hydro.radiation, scene.hydro.radiation_tol
-    assert rad.report["limited_by"] == "device response" and rad.report["response_band"] == [0.3, 2.0]
-    w = plant.hydro.omega[(plant.hydro.omega >= 0.3) & (plant.hydro.omega <= 2.0)]
-    sys = linearize(plant, params=linear_params(plant, ["pto"]))
-    A, B, C = (np.asarray(m) for m in (sys.A, sys.B, sys.C))
-    iu, iy = sys.input_labels.index("u__pto"), sys.output_labels.index("pto__velocity")
-    fitted = np.conj([C[iy] @ np.linalg.solve(1j * x * np.eye(A.shape[0]) - A, B[:, iu]) for x in w])
-    data, free = (x[:, 0, ...].reshape(w.size, -1)[:, 0] for x in port_responses(plant, w, ["pto"]))
-    # full weight where the hinge moves in waves at least MOVES of its most (0.3-1.6 rad/s), less above
-    moves = np.minimum(1.0, np.abs(free) / (MOVES * np.abs(free).max()))
-    assert np.max(np.abs(fitted / data - 1) * moves) <= tol
-    assert np.max(np.abs(fitted / data - 1)[moves == 1.0]) <= tol
+    # the hinge's own damping Jᵀ B J (hinge below the CoG: pitch rate θ' moves the CoG at
+    # -lever θ' in surge), which has cancellation between the entries; around the mode (0.3-0.5
+    # rad/s) and over the band. Measured 0.42 % and 0.53 % (51 states); the global-norm fit before
+    # this change (0.45 %, 42 states): 15.8 % near the mode, 14.2 % per-frequency damping error
+    lever = scene.joints[0].point[2] - scene.bodies[0].cog[2]
+    J = np.array([-lever, 1.0])
+    b_bem = np.einsum("i,kij,j->k", J, K.real, J)
+    b_fit = np.einsum("i,kij,j->k", J, fit.real, J)
+    rel = np.abs(b_fit / b_bem - 1)
+    assert rel[(w >= 0.3) & (w <= 0.5)].max() <= 0.01 and rel[band].max() <= 0.02
 
 
-def test_oswec_error_is_the_response_and_the_kernel_is_shown(empty_cache):
-    """fit_error is the response error (module response_error); the kernel's own errors are
-    reported beside it: the worst per-frequency part error in the response band (recomputed here
-    from its definition) and the global RMS error, and where the worst lies."""
+def test_oswec_error_is_per_frequency_in_band_or_global(empty_cache):
+    """fit_error is the larger of the in-band per-frequency error and the global RMS error; the
+    report locates the worst in-band point."""
     hydro = _quiet_plant("oswec").hydro
     rad = hydro.radiation
     w, K, dofs = kernel_data(hydro.data, list(rad.dofs), rad.report["omega_fit"][1])
@@ -75,8 +79,7 @@ def test_oswec_error_is_the_response_and_the_kernel_is_shown(empty_cache):
     rms = np.sqrt(np.sum(np.abs(fit - K) ** 2) / np.sum(np.abs(K) ** 2))
     assert rad.report["band_error"] == pytest.approx(e.max(), rel=1e-6)
     assert rad.report["rms_error"] == pytest.approx(rms, rel=1e-6)
-    assert rad.fit_error == rad.report["response_error"] == rad.report["response_worst"]["error"]
-    assert rad.fit_error == pytest.approx(np.max(hydro.device.at(w, Ks).errors(fit)), rel=1e-9)
+    assert rad.fit_error == pytest.approx(max(e.max(), rms), rel=1e-6)
     worst = rad.report["worst"]
     k, i, j = np.unravel_index(np.argmax(e), e.shape)
     assert worst["omega"] == pytest.approx(w[k]) and worst["entry"] == [dofs[i], dofs[j]]
@@ -132,8 +135,8 @@ def test_no_pole_slower_than_the_data(name, empty_cache):
 
 
 def test_hydro_command_reports_where_the_fit_is_judged(capsys):
-    """`mbcontrol hydro`: text and --json show the tolerance, the response error and where, and
-    beside it the kernel's worst in-band error (value, ω, entry, part) and its global RMS error."""
+    """`mbcontrol hydro`: text and --json show the tolerance, the response band, the worst
+    in-band error (value, ω, entry, part) and the global RMS error, from the fit's own report."""
     import json
 
     from mbcontrol.cli import main
@@ -145,12 +148,10 @@ def test_hydro_command_reports_where_the_fit_is_judged(capsys):
         assert main(["hydro", "oswec"]) == 0
         text = capsys.readouterr().out
     assert rep["response_band"] == [0.3, 2.0] and rep["tol"] == 0.01 and rep["tol_met"] is True
-    worst, response = rep["worst"], rep["response_worst"]
-    assert rep["fit_error"] == rep["response_error"] and rep["limited_by"] == "device response"
-    assert 0.3 <= response["omega"] <= 2.0 and response["what"].startswith("velocity of hinge")
+    worst = rep["worst"]
+    assert rep["fit_error"] == max(rep["band_error"], rep["rms_error"]) and worst["error"] == rep["band_error"]
     assert 0.3 <= worst["omega"] <= 2.0 and worst["entry"][0].startswith("flap__")
-    assert f"response error {rep['fit_error']:.2%} (tol 1.00%)" in text and f"at {response['omega']:.4g} rad/s" in text
-    assert "kernel's own error" in text and "in 0.3-2 rad/s" in text
+    assert f"fit error {rep['fit_error']:.2%} (tol 1.00%)" in text and "in 0.3-2 rad/s" in text
     assert f"at {worst['omega']:.4g} rad/s" in text and f"global RMS {rep['rms_error']:.2%}" in text
 
 

@@ -11,9 +11,9 @@ shortcut does not inherit.
 import numpy as np
 import pytest
 
-import mbcontrol.hydro.bem as bem
+import mbcontrol.hydro.bem.solve as bem
 from mbcontrol.hydro import BemBody, compute
-from mbcontrol.hydro.isolated import canonical_body, compute_isolated
+from mbcontrol.hydro.bem.isolated import canonical_body, compute_isolated
 
 OMEGAS = np.array([3.0, 6.0, 9.0])
 HEADINGS = (0.0, 0.6, -2.0)            # rad, NED: +x, towards starboard, from starboard aft

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from mbcontrol.hydro import BemBody, compute
-from mbcontrol.hydro.bem import matrix
-from mbcontrol.hydro.isolated import compute_isolated
+from mbcontrol.hydro import matrix
+from mbcontrol.hydro.bem.isolated import compute_isolated
 
 RHO, G = 1000.0, 9.81
 OMEGAS = np.array([2.0, 3.0, 4.5])

@@ -1,4 +1,4 @@
-"""Tests of mbcontrol.hydro.large_angle: nonlinear hydrostatic restoring of primitives (the
+"""Tests of mbcontrol.hydro.mesh.large_angle: nonlinear hydrostatic restoring of primitives (the
 references are in tests/large_angle_reference.py; stiffness and potential in
 test_large_angle_potential.py).
 
@@ -26,7 +26,7 @@ from large_angle_reference import (ALL, BOX, HCYL, RHO, VCYL, G, cylinder_refere
                                    draft_for_fraction, evaluate, pose, prism_reference, reference,
                                    size, sphere_reference, total_volume)
 from mbcontrol.errors import HydroError
-from mbcontrol.hydro.large_angle import DEFAULT_N
+from mbcontrol.hydro.mesh.large_angle import DEFAULT_N
 
 
 # ------------------------------------------------------------------ sphere: exact formulas

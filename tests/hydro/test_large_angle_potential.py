@@ -1,4 +1,4 @@
-"""Large-angle hydrostatics (mbcontrol.hydro.large_angle) as a potential: its small-angle
+"""Large-angle hydrostatics (mbcontrol.hydro.mesh.large_angle) as a potential: its small-angle
 stiffness against closed-form waterplane integrals, the wrench as minus the gradient of the
 potential, zero work round closed loops, and the CasADi builds against numpy.
 """
@@ -13,7 +13,7 @@ from scipy.spatial.transform import Rotation
 
 from large_angle_reference import (ALL, BOX, HCYL, RHO, G, evaluate, pose, reference, size,
                                    sphere_reference, total_volume)
-from mbcontrol.hydro.large_angle import buoyancy, potential
+from mbcontrol.hydro.mesh.large_angle import buoyancy, potential
 
 
 # ------------------------------------------------------------------ small-angle consistency

@@ -1,12 +1,13 @@
-"""Interaction cut at a radius (mbcontrol.hydro.neighbours) against the plain coupled solve and
+"""Interaction cut at a radius (mbcontrol.hydro.bem.neighbours) against the plain coupled solve and
 the isolated one (two independent paths through Capytaine). Coarse meshes, few frequencies."""
 import numpy as np
 import pytest
 
 from mbcontrol.errors import HydroError, SceneError
-from mbcontrol.hydro import BemBody, bem
-from mbcontrol.hydro.isolated import compute_isolated
-from mbcontrol.hydro.neighbours import compute_within, cut_error
+from mbcontrol.hydro import BemBody
+from mbcontrol.hydro.bem import solve as bem
+from mbcontrol.hydro.bem.isolated import compute_isolated
+from mbcontrol.hydro.bem.neighbours import compute_within, cut_error
 from mbcontrol.scene import load_scene
 
 KW = dict(rho=1000.0, g=9.81, depth=np.inf, omegas=np.array([2.0, 5.0, 9.0]), headings=[0.0, 0.6],

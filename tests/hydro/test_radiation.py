@@ -18,8 +18,8 @@ import scipy.linalg as sla
 from scipy.optimize import brentq, minimize_scalar
 
 from mbcontrol.hydro import fit_radiation, impulse_response, kernel_data, read_netcdf
-from mbcontrol.hydro.baseline import fit_radiation_hankel, hankel_siso
-from mbcontrol.hydro.passivity import (absorbed_energy, enforce_passivity, hermitian_eigs,
+from mbcontrol.hydro.fit.baseline import fit_radiation_hankel, hankel_siso
+from mbcontrol.hydro.fit.passivity import (absorbed_energy, enforce_passivity, hermitian_eigs,
                                        passivity_test, psd_least_squares)
 from mbcontrol.scene import catalogue_dir
 
@@ -322,7 +322,7 @@ def test_hankel_baseline_on_the_barge(barge):
 
 # ------------------------------------------------------------------ congruence scaling
 def test_congruence_scale_per_unit_class():
-    from mbcontrol.hydro.vector_fit import _congruence_scale, _unit_class
+    from mbcontrol.hydro.fit.vector_fit import _congruence_scale, _unit_class
     dofs = ["a__Heave", "b__Surge", "a__Pitch", "b__Roll"]
     K = np.diag([4.0, 1.0, 9.0, 16.0])[None] * (1 + 0.5j)
     sc = _congruence_scale(K, [_unit_class(d) for d in dofs])

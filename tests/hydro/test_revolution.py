@@ -18,8 +18,8 @@ import pytest
 from mbcontrol.errors import HydroError, LinearizationError, SceneError
 from mbcontrol.hydro import BemBody, compute, hull_mesh, load_hydro_data
 from mbcontrol.hydro.model import HydroModel
-from mbcontrol.hydro.radiation import RadiationModel
-from mbcontrol.hydro.revolution import azimuthal_panels
+from mbcontrol.hydro.fit.radiation import RadiationModel
+from mbcontrol.hydro.mesh.revolution import azimuthal_panels
 from mbcontrol.scene import load_scene, parse_scene
 
 RHO, G = 1025.0, 9.81
@@ -48,7 +48,7 @@ CLOSED = {"cylinder": (CYLINDER, frusta([(0.0, DRAFT, R, R)])),
 @pytest.mark.parametrize("case", sorted(CLOSED))
 def test_hydrostatics_match_closed_forms(case):
     """Volume, waterplane area, heave and roll/pitch stiffness of the mesh Capytaine sees
-    (its hydrostatics, GL2 quadrature as mbcontrol.hydro.bem uses) against closed forms."""
+    (its hydrostatics, GL2 quadrature as mbcontrol.hydro.bem.solve uses) against closed forms."""
     profile, (vol, z_b, r_wl) = CLOSED[case]
     z_g = 0.1                                       # CoG 0.1 m below the waterline (NED)
     body = BemBody("float", {"type": "revolution", "profile": profile}, (0.0, 0.0, z_g), RHO * vol, 0.1)

@@ -5,7 +5,7 @@ singular and B_m of 7.5e15). Reference: the original (A, B, C)'s own frequency r
 import numpy as np
 import pytest
 
-from mbcontrol.hydro.ssforms import modal_form
+from mbcontrol.hydro.fit.ssforms import modal_form
 
 
 def _response(A, B, C, omega):

@@ -85,7 +85,7 @@ def test_an_interrupted_study_resumes(geared, tmp_path, monkeypatch):
 def test_a_geometry_met_again_is_not_solved_again(tmp_path, monkeypatch):
     """Two studies without a store share only the BEM cache (by content): the drum of radius
     1 m, solved in the first, is not solved in the second; the new radius is."""
-    import mbcontrol.hydro.bem as bem
+    import mbcontrol.hydro.bem.solve as bem
     import mbcontrol.hydro.model as model
     scene = tmp_path / "drum.toml"
     scene.write_text(DRUM)

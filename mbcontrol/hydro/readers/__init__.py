@@ -39,7 +39,7 @@ import numpy as np
 import xarray as xr
 
 from mbcontrol.errors import HydroError
-from mbcontrol.hydro.frames import to_body_frames, zup_to_ned
+from mbcontrol.hydro.data.frames import to_body_frames, zup_to_ned
 
 from .bemio import read_bemio
 from .capytaine_nc import read_capytaine

@@ -25,9 +25,9 @@ import numpy as np
 import xarray as xr
 
 from mbcontrol.errors import HydroError
-from mbcontrol.hydro import _io
-from mbcontrol.hydro.frames import to_body_frames, zup_to_ned
-from mbcontrol.hydro.geometry import RIGID_DOFS
+from mbcontrol.hydro.data import netcdf
+from mbcontrol.hydro.data.frames import to_body_frames, zup_to_ned
+from mbcontrol.hydro.mesh.geometry import RIGID_DOFS
 
 from .checks import clean
 from .layout import body_name_list, build_dataset, finish_attrs
@@ -70,7 +70,7 @@ def _single(ds: xr.Dataset, name: str, src: str, default=None) -> float:
 
 
 def _from_mbcontrol(path: Path, src: str, body_names) -> xr.Dataset:
-    ds = _io.read_netcdf(path)
+    ds = netcdf.read_netcdf(path)
     frame = str(ds.attrs.get("frame", ""))
     notes = list(ds.attrs.get("notes", []))
     if frame.startswith("NED body frames"):

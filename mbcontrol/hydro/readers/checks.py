@@ -1,7 +1,7 @@
 """Validation and cleaning shared by the hydrodynamic data readers.
 
 Every reader builds its result with :func:`~mbcontrol.hydro.readers.layout.build_dataset` (the
-data-frame layout that :func:`mbcontrol.hydro.bem.compute` assembles before
+data-frame layout that :func:`mbcontrol.hydro.bem.solve.compute` assembles before
 :func:`~mbcontrol.hydro.to_body_frames`) and passes it through :func:`clean`, which checks and
 repairs it the same way for every format.
 
@@ -18,7 +18,7 @@ import numpy as np
 import xarray as xr
 
 from ...errors import HydroError
-from ..frames import split_dof
+from ..data.frames import split_dof
 from .damping import repair_negative_damping
 from .layout import MAT, HydroCleaningWarning, fmt_omega, force_first, kind_scales, set_force_first
 

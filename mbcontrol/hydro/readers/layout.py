@@ -1,5 +1,5 @@
 """The data-frame layout every reader builds (before `clean` checks it): names, dimensions,
-units and attributes, as `mbcontrol.hydro.bem.compute` assembles them before the map to body
+units and attributes, as `mbcontrol.hydro.bem.solve.compute` assembles them before the map to body
 frames."""
 from __future__ import annotations
 
@@ -9,9 +9,9 @@ import numpy as np
 import xarray as xr
 
 from ...errors import HydroError
-from ..bem import _UNITS as BODY_FRAME_UNITS
-from ..frames import split_dof
-from ..geometry import RIGID_DOFS
+from ..data.dataset import BODY_FRAME_UNITS
+from ..data.frames import split_dof
+from ..mesh.geometry import RIGID_DOFS
 
 MAT = ("radiating_dof", "influenced_dof")
 

@@ -1,6 +1,8 @@
-"""The error that decides a radiation fit's order (module :mod:`mbcontrol.hydro.radiation`, "Error"):
-per-frequency relative errors of the damping and added-mass parts in the response band, the
-global RMS error over the fit band, and where the worst one lies.
+"""The kernel's own error (module :mod:`mbcontrol.hydro.fit.radiation`, "Error"): per-frequency
+relative errors of the damping and added-mass parts in the response band, the global RMS error
+over the fit band, and where the worst one lies. It decides a fit's order only when no device is
+given (a dataset fitted on its own); with one, it is reported beside the response error
+(module response_error), and the miss message names whichever decided.
 """
 from __future__ import annotations
 

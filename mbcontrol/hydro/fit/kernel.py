@@ -9,7 +9,7 @@ import numpy as np
 
 from mbcontrol.errors import HydroError
 
-from .bem import matrix
+from ..data.dataset import matrix
 
 
 def _dof_list(ds, dofs):

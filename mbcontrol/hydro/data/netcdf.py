@@ -20,7 +20,7 @@ import xarray as xr
 
 from mbcontrol.errors import HydroError
 
-from ..atomic import atomic_path
+from ...atomic import atomic_path
 
 _ENC_KEY = "mbc_encoded_attrs"
 

@@ -1,8 +1,8 @@
 """Order selection around passivity enforcement for one radiation-fit DOF group.
 
-:func:`make_passive` is called by :mod:`mbcontrol.hydro.vector_fit` with the group's refit and
+:func:`make_passive` is called by :mod:`mbcontrol.hydro.fit.vector_fit` with the group's refit and
 error gate; the enforcement itself (KYP-lemma SDP on C) and the exact test are in
-:mod:`mbcontrol.hydro.passivity`.
+:mod:`mbcontrol.hydro.fit.passivity`.
 """
 from __future__ import annotations
 

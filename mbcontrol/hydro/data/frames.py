@@ -20,7 +20,7 @@ import xarray as xr
 
 from mbcontrol.errors import HydroError
 
-from .geometry import NED_TO_ZUP, RIGID_DOFS
+from ..mesh.geometry import NED_TO_ZUP, RIGID_DOFS
 
 MATRIX_DIMS = ("radiating_dof", "influenced_dof")
 

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .geometry import NED_TO_ZUP, hull_mesh, lid_mesh
+from ..mesh.geometry import NED_TO_ZUP, hull_mesh, lid_mesh
 
 MATCH_TOL = 1e-9    # m per m of the array's extent: reflected panel centres must coincide
 AXES = {"xOz": 1, "yOz": 0}   # the coordinate a plane's reflection flips

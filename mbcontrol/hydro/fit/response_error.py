@@ -32,7 +32,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..waves import interpolate_complex
+from ...waves import interpolate_complex
 
 SIGNIFICANT = 6        # digits of the device's matrices in a fit's cache key
 MOVES = 0.1            # full weight where the device's wave motion is at least this share of its peak
@@ -93,8 +93,9 @@ class ResponseGate:
         h = np.linalg.norm(self.d[None, :, None] * V, axis=1).max(axis=1)
         lo, hi = device.band if device.band else (-np.inf, np.inf)
         judged = (w >= lo) & (w <= hi)
-        peak = max(h[judged].max(initial=0.0), 1e-300)
-        self.weight = np.minimum(1.0, h / (MOVES * peak)) * judged
+        peak = h[judged].max(initial=0.0)
+        # no wave motion at all (no excitation in the data): every frequency counts in full
+        self.weight = (np.minimum(1.0, h / (MOVES * peak)) if peak > 0 else np.ones(w.size)) * judged
 
     def _relative(self, fit, group):
         """D Z'⁻¹ δZ D⁻¹ (nω, n_s, n_s) for a fit (nω, m, m) of the entries ``group`` (None: all)."""

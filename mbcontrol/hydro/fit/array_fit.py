@@ -1,6 +1,6 @@
 """Radiation fits that grow with the number of matrix entries: arrays and farms of bodies.
 
-:func:`mbcontrol.hydro.radiation.fit_radiation` fits a coupled DOF group with one common pole set
+:func:`mbcontrol.hydro.fit.radiation.fit_radiation` fits a coupled DOF group with one common pole set
 and enforces passivity with a dense SDP; at 16 bodies that costs hours and ~10 GB. Here
 (:func:`fit_radiation_columns`):
 

@@ -25,9 +25,9 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from ..errors import HydroError
-from .bem import compute
-from .geometry import BemBody
+from ...errors import HydroError
+from .solve import compute
+from ..mesh.geometry import BemBody
 from .isolated import merge, shifted
 
 _PAIR = ("radiating_dof", "influenced_dof")
@@ -67,7 +67,7 @@ def compute_within(bodies, radius: float, **kwargs) -> xr.Dataset:
     B = out["radiation_damping"].transpose("omega", *_PAIR).values
     ev = np.linalg.eigvalsh(B)      # over the largest on all ω (near ω = 0, B is noise-sized)
     out.attrs.update(
-        interaction=f"within {radius:g} m: each body solved with its neighbours (mbcontrol.hydro.neighbours)",
+        interaction=f"within {radius:g} m: each body solved with its neighbours (mbcontrol.hydro.bem.neighbours)",
         interaction_radius=float(radius), distinct_clusters=len(solved),
         largest_cluster=max(len(near) for _, near, _, _ in clusters),
         cut_min_damping_eig=float(ev[:, 0].min() / max(ev[:, -1].max(), 1e-300)),

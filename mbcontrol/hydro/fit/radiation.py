@@ -18,7 +18,7 @@ whose transfer function is K(jω) = B(ω) + jω(A(ω) - A∞) (ERRATA §4 "Radia
    truncation to the smallest order that still meets the tolerance, with the output matrix
    refitted (poles kept) at each trial order.
 4. Passivity (``passive=True``): exact test, and if violated, the smallest data-weighted change
-   of C that makes the group passive (KYP-lemma SDP, :mod:`mbcontrol.hydro.passivity`), at a
+   of C that makes the group passive (KYP-lemma SDP, :mod:`mbcontrol.hydro.fit.passivity`), at a
    higher order if the enforced error misses the tolerance.
 
 Error (decides the order; ``tol`` bounds it). With a ``device`` (every plant built from a scene
@@ -55,7 +55,7 @@ import scipy.linalg as sla
 
 from mbcontrol.errors import HydroError
 
-from .bem import matrix
+from ..data.dataset import matrix
 from .kernel import _cos_transform, _with_tail, kernel_data
 from .passivity import _response, passivity_test
 from .fit_error import FLOOR, _group_errors, _nerr, _worst, miss_message
@@ -162,7 +162,7 @@ def fit_radiation(ds, dofs=None, *, tol: float = 0.02, max_order: int = 30, omeg
         too. response_band : (lo, hi) rad/s where the error is judged per frequency (module
         docstring, "Error"); None: the global error only (the worst per frequency is reported). With a
         ``device``, the band where the device's response is judged instead.
-    device : a :class:`mbcontrol.hydro.response_error.Device` (the plant around the kernel, from
+    device : a :class:`mbcontrol.hydro.fit.response_error.Device` (the plant around the kernel, from
         :func:`mbcontrol.plant.device_around`): the error that chooses the order and passivity is
         the error the fit causes in the device's response (module response_error); the kernel's own
         errors are reported beside it. max_order : most poles tried per group in vector fitting (the state

@@ -1,13 +1,14 @@
 """Vector fitting of a coupled radiation kernel group: common poles, realisation, truncation.
 
-The machinery behind :func:`mbcontrol.hydro.radiation.fit_radiation` for one group of coupled
+The machinery behind :func:`mbcontrol.hydro.fit.radiation.fit_radiation` for one group of coupled
 DOFs: relaxed vector fitting with common stable poles (Gustavsen 2006; fast QR form of
 Deschrijver et al. 2008), a column realisation, square-root balanced truncation with the output
 matrix refitted, the congruence scaling that makes DOFs of different units comparable, and
-passivity enforcement around it (:mod:`mbcontrol.hydro.passivity`). Every least-squares step
-weighs each frequency in the response band by the inverse size of its damping and added-mass parts
-(:func:`mbcontrol.hydro.fit_error.part_sizes`), the relative error by which the order is chosen
-(module radiation, "Error").
+passivity enforcement around it (:mod:`mbcontrol.hydro.fit.passivity`). Every least-squares step
+weighs each frequency by what the order is chosen by (module radiation, "Error"): with a device,
+how much its response feels the kernel there (:meth:`ResponseGate.sensitivity`, at least LS_FLOOR
+of the most); without one, in the response band, the inverse size of the damping and added-mass
+parts (:func:`mbcontrol.hydro.fit.fit_error.part_sizes`).
 """
 from __future__ import annotations
 
@@ -209,7 +210,7 @@ def _fit_group(w, Kg, pattern, bem, ainf, inband, unit_class, tol, max_order, n_
                passive_states=0, vf_frac=0.7, judge=None):
     """VF of one coupled group (scaled) to vf_frac·tol, column realisation, balanced truncation to tol.
 
-    judge (a :class:`mbcontrol.hydro.response_error.GroupJudge`, or None): the error that gates is
+    judge (a :class:`mbcontrol.hydro.fit.response_error.GroupJudge`, or None): the error that gates is
     the device's response error, and the least squares weigh each ω by the response's sensitivity;
     None: the kernel's own error (module radiation, "Error")."""
     m = Kg.shape[1]

@@ -146,7 +146,7 @@ def _parse(geometry: dict, cog_rest) -> tuple:
             dims = (float(geometry["radius"]),)
     except (KeyError, TypeError, ValueError) as exc:
         raise HydroError(f"large_angle: geometry {geometry!r} / cog {cog_rest!r}: expected the fields of "
-                         f"mbcontrol.hydro.geometry.BemBody.geometry and a 3-vector cog ({exc})") from exc
+                         f"mbcontrol.hydro.mesh.geometry.BemBody.geometry and a 3-vector cog ({exc})") from exc
     if not all(math.isfinite(d) and d > 0 for d in dims) or not np.all(np.isfinite(centre - cog)):
         raise HydroError(f"large_angle: geometry {geometry!r}: expected finite sizes > 0 (m)")
     axis = geometry.get("axis", "z") if kind == "cylinder" else "z"
@@ -304,7 +304,7 @@ def buoyancy(geometry: dict, cog_rest, R, r_cog, rho: float, g: float, *, n=DEFA
     Parameters
     ----------
     geometry : ``{"type": "box"|"cylinder"|"sphere", ...}`` as in
-        :class:`mbcontrol.hydro.geometry.BemBody` (n-frame at rest, m).
+        :class:`mbcontrol.hydro.mesh.geometry.BemBody` (n-frame at rest, m).
     cog_rest : CoG at rest, n-frame, m (3).
     R : rotation body -> n-frame (3x3; numpy or CasADi).
     r_cog : current CoG position, n-frame, m (3).

@@ -22,9 +22,9 @@ import json
 import numpy as np
 import xarray as xr
 
-from ..waves.dispersion import wavenumber
-from .bem import _geometry_for_key, compute
-from .geometry import BemBody
+from ...waves.dispersion import wavenumber
+from .solve import _geometry_for_key, compute
+from ..mesh.geometry import BemBody
 
 _PAIR = ("radiating_dof", "influenced_dof")
 _CANONICAL = "body"     # the canonical body's name: DOF names do not key the cache per scene
@@ -115,7 +115,7 @@ def merge(parts: list[xr.Dataset]) -> xr.Dataset:
         if key in first.attrs:
             ds.attrs[key] = {k: v for p in parts for k, v in p.attrs[key].items()}
     ds.attrs.update(
-        interaction="none: each body solved alone (mbcontrol.hydro.isolated)",
+        interaction="none: each body solved alone (mbcontrol.hydro.bem.isolated)",
         omega_max_mesh=float(min(p.attrs.get("omega_max_mesh", np.inf) for p in parts)),
         solve_seconds=float(sum(p.attrs.get("solve_seconds", 0.0) for p in parts)),
         cache_key=[p.attrs.get("cache_key") for p in parts])

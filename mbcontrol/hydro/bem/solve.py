@@ -23,12 +23,13 @@ import xarray as xr
 
 from mbcontrol.errors import HydroError
 
-from ..cache import progress_bar
-from . import _io
-from .frames import to_body_frames
+from ...cache import progress_bar
+from ..data import netcdf
+from ..data.dataset import BODY_FRAME_UNITS
+from ..data.frames import to_body_frames
 from .array_bem import symmetric_array_body
-from .geometry import NED_TO_ZUP, RIGID_DOFS, BemBody, hull_mesh, lid_mesh, mirror_symmetric, validate_body
-from .obstacles import drop_seabed_faces, refine, remove_contact_faces
+from ..mesh.geometry import NED_TO_ZUP, RIGID_DOFS, BemBody, hull_mesh, lid_mesh, mirror_symmetric, validate_body
+from ..mesh.obstacles import drop_seabed_faces, refine, remove_contact_faces
 
 LOG = logging.getLogger(__name__)
 CACHE_VERSION = 2  # bump when the dataset layout or content for given inputs changes: old caches miss
@@ -37,18 +38,6 @@ CONTACT_TOL = 1e-3    # m per m of panel size: a face centre this close to a fac
 REQUIRED_VARS = ("added_mass", "radiation_damping", "added_mass_inf", "added_mass_zero", "excitation_force",
                  "froude_krylov_force", "diffraction_force", "hydrostatic_stiffness", "displaced_volume",
                  "waterplane_area", "center_of_buoyancy")
-_UNITS = {
-    "added_mass": "kg, kg m, kg m^2 (translation/rotation DOF pairs)",
-    "added_mass_inf": "kg, kg m, kg m^2 (translation/rotation DOF pairs)",
-    "added_mass_zero": "kg, kg m, kg m^2 (translation/rotation DOF pairs)",
-    "radiation_damping": "kg/s, kg m/s, kg m^2/s (translation/rotation DOF pairs)",
-    "excitation_force": "N/m, N m/m (per m of wave amplitude)",
-    "froude_krylov_force": "N/m, N m/m (per m of wave amplitude)",
-    "diffraction_force": "N/m, N m/m (per m of wave amplitude)",
-    "hydrostatic_stiffness": "N/m, N, N m (translation/rotation DOF pairs; rotations in rad)",
-    "displaced_volume": "m^3", "waterplane_area": "m^2", "center_of_buoyancy": "m (n-frame, NED)",
-    "cog": "m (n-frame, NED)", "mass": "kg",
-}
 
 
 def _capytaine_version() -> str:
@@ -275,7 +264,7 @@ def compute(bodies: list[BemBody], *, rho: float, g: float, depth: float, omegas
     xarray.Dataset, every body referred to its CoG in NED body axes (see module docs of
     :mod:`mbcontrol.hydro` for the layout). Time convention e^{-iωt}: a wave η(t) = Re(a e^{-iωt})
     at the n-frame origin (η positive up) gives the excitation wrench Re(F̂ a e^{-iωt}).
-    Matrices are stored (…, radiating_dof, influenced_dof); use :func:`matrix` for the usual
+    Matrices are stored (…, radiating_dof, influenced_dof); use :func:`mbcontrol.hydro.matrix` for the usual
     row = force, column = motion layout.
     """
     omegas, headings = _check_inputs(bodies, rho, g, depth, omegas, headings)
@@ -283,7 +272,7 @@ def compute(bodies: list[BemBody], *, rho: float, g: float, depth: float, omegas
     key = cache_key(bodies, rho=rho, g=g, depth=depth, omegas=omegas, headings=headings, lid=lid)
     path = Path(cache_dir) / f"bem_{key[:16]}.nc" if cache_dir is not None else None
     if path is not None and path.exists():
-        ds = _io.read_netcdf(path, required=REQUIRED_VARS)
+        ds = netcdf.read_netcdf(path, required=REQUIRED_VARS)
         if ds.attrs.get("cache_key") != key:
             raise HydroError(f"{path}: cache_key attribute {ds.attrs.get('cache_key')!r} does not match the "
                              f"inputs ({key}); expected the dataset of these inputs — delete the file")
@@ -330,7 +319,7 @@ def compute(bodies: list[BemBody], *, rho: float, g: float, depth: float, omegas
     ds["hull_panel_count"] = (("body",), np.array([fb.mesh.nb_faces for fb in fbs]))
     ds["lid_panel_count"] = (("body",), np.array([fb.lid_mesh.nb_faces if fb.lid_mesh is not None else 0
                                                  for fb in fbs]))
-    for v, u in _UNITS.items():
+    for v, u in BODY_FRAME_UNITS.items():
         ds[v].attrs["units"] = u
     if depth != np.inf:
         ds["added_mass_zero"].attrs["note"] = "NaN: Capytaine 3.0 cannot solve ω = 0 in finite depth"
@@ -355,12 +344,6 @@ def compute(bodies: list[BemBody], *, rho: float, g: float, depth: float, omegas
         "created": datetime.datetime.now().isoformat(timespec="seconds"),
     })
     if path is not None:
-        _io.write_netcdf_atomic(ds, path)
+        netcdf.write_netcdf_atomic(ds, path)
     return ds
 
-
-def matrix(da: xr.DataArray, dofs=None) -> np.ndarray:
-    """Numpy array in the usual layout X[..., i_force, j_motion] (influenced, radiating), for ``dofs``."""
-    if dofs is not None:
-        da = da.sel(radiating_dof=list(dofs), influenced_dof=list(dofs))
-    return da.transpose(..., "influenced_dof", "radiating_dof").values
