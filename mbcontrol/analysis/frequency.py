@@ -64,14 +64,14 @@ def frequency_domain_response(plant, omega, *, direction: float = 0.0, params=No
     """Complex response per unit wave amplitude (n_omega, n_outputs), exp(+i omega t).
 
     Straight from the BEM data (no radiation fit): A(omega), B(omega) and the excitation are
-    interpolated linearly on the BEM grid. outputs: names (default all plant outputs).
+    interpolated linearly on the BEM grid. direction (rad): one, or one per omega (a spread
+    sea's components; `HydroModel.excitation_at`). outputs: names (default all plant outputs).
     """
     omega = np.atleast_1d(np.asarray(omega, float))
     mech = mechanical_matrices(plant, params)
     hyd = plant.hydro
     A_w, B_w = hyd.frequency_domain_matrices(omega)
-    from ..waves import interpolate_complex
-    F = np.conj(interpolate_complex(hyd.omega, hyd.excitation_coefficients(direction), omega))
+    F = np.conj(hyd.excitation_at(omega, direction))
     P = mech.P_hydro
     idx = [plant.outputs.index(o) for o in (outputs or plant.outputs)]
     out = np.empty((omega.size, len(idx)), dtype=complex)
@@ -89,10 +89,9 @@ def statespace_response(sys, plant, omega, *, direction: float = 0.0, outputs=No
 
     Drives the w inputs of `sys` with the conjugated BEM excitation (exp(+i omega t)).
     """
-    from ..waves import interpolate_complex
     omega = np.atleast_1d(np.asarray(omega, float))
     hyd = plant.hydro
-    F = np.conj(interpolate_complex(hyd.omega, hyd.excitation_coefficients(direction), omega))
+    F = np.conj(hyd.excitation_at(omega, direction))
     w_idx = [sys.input_labels.index(f"w__{d}") for d in hyd.dofs]
     names = outputs or sys.output_labels
     y_idx = [sys.output_labels.index(o) for o in names]

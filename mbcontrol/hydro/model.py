@@ -22,11 +22,12 @@ from ..atomic import atomic_path
 from ..cache import cache_dir, status
 from ..errors import HydroError
 from ..scene import DOF_NAMES, Scene
-from ..waves import Wave, excitation_series, interpolate_complex
+from ..waves import Wave, coefficient_series, excitation_series, interpolate_complex
 from . import array_fit, array_passivity, fit_error, passive_order, passivity, radiation, sdp, vector_fit
 from ._io import read_netcdf
 from .bem import compute
 from .geometry import BemBody
+from .headings import excitation_over_headings, heading_weights, headings_line
 from .isolated import compute_isolated
 from .neighbours import compute_within
 from .radiation import RadiationModel, fit_radiation
@@ -72,14 +73,43 @@ class HydroModel:
         i = int(np.argmin(np.abs(directions - direction)))
         if abs(directions[i] - direction) > 1e-6:
             raise HydroError(f"{self.source}: no excitation data for wave direction "
-                             f"{direction:.4g} rad; the data has {np.round(directions, 4)}")
+                             f"{direction:.4g} rad; the data has {np.round(directions, 4)} "
+                             f"(to compute it, the scene's [hydro] table: "
+                             f"{headings_line([direction])})")
         da = self.data["excitation_force"].isel(wave_direction=i)
         return da.sel(influenced_dof=list(self.dofs)).transpose("omega", "influenced_dof").values
 
+    def excitation_at(self, omega, direction=0.0) -> np.ndarray:
+        """Complex excitation per unit amplitude (n, n_dof), exp(-i omega t), at frequencies
+        omega (rad/s, n) travelling in `direction` (rad, NED): one float (the data's heading,
+        matched exactly, as `excitation_coefficients`) or one direction per frequency (a spread
+        sea's components), interpolated between the data's headings (module headings).
+        Frequencies are interpolated linearly, never extrapolated (ValueError outside the
+        band); a direction outside the data's headings raises HydroError."""
+        omega = np.asarray(omega, float)
+        if np.ndim(direction) == 0:
+            return interpolate_complex(self.omega, self.excitation_coefficients(direction), omega)
+        direction = np.asarray(direction, float)
+        if direction.shape != omega.shape:
+            raise ValueError(f"{self.source}: one wave direction per frequency expected, got "
+                             f"{direction.size} directions for {omega.size} frequencies")
+        lo, hi, t = heading_weights(self.data["wave_direction"].values, direction, self.source)
+        data = self.data["excitation_force"].sel(influenced_dof=list(self.dofs)).transpose(
+            "wave_direction", "omega", "influenced_dof").values
+        used = np.union1d(lo, hi)
+        per_heading = np.zeros((data.shape[0], omega.size, data.shape[2]), complex)
+        for j in used:
+            per_heading[j] = interpolate_complex(self.omega, data[j], omega)
+        return excitation_over_headings(per_heading, lo, hi, t)
+
     def excitation(self, wave: Wave, t) -> np.ndarray:
         try:
+            if wave.directional:
+                return coefficient_series(wave, self.excitation_at(wave.omega, wave.direction), t)
             return excitation_series(wave, self.omega, self.excitation_coefficients(
                 wave.direction), t)
+        except HydroError:
+            raise
         except ValueError as exc:
             raise HydroError(f"{self.source}: {exc}") from None
 

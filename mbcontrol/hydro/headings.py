@@ -1,0 +1,115 @@
+"""Excitation at any wave direction from data at a few headings, and the headings a spread
+sea needs from a BEM.
+
+Between two of the data's headings the per-unit-amplitude excitation (already interpolated to
+the wanted frequency) is interpolated linearly in the complex plane. Complex, not magnitude and
+unwrapped phase: DOFs antisymmetric about the mean direction (sway, roll, yaw in head seas)
+pass through zero as the heading crosses it, where the phase jumps by pi and a
+magnitude/phase interpolation would invent a force; the complex one is continuous there and its
+error is second order in the heading step (the catalogue bodies sit near the n-frame origin,
+where the plane wave's own phase k (x cos b + y sin b) varies slowly with b; for a body far from
+the origin the step must keep k r db small). Where the data's headings cover the whole circle
+(the gap across +-pi no wider than the widest gap between them) the interpolation wraps;
+otherwise a direction outside them is refused, naming the source and its headings.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..errors import HydroError
+
+TOL = 1e-6                  # rad: a direction this close to a heading is that heading
+SECTOR_SIGMAS = 3.0         # a spread sea's directions are kept within mean +- 3 sigma
+STEP = math.radians(15.0)   # rad: the largest heading step `headings_for_spread` gives
+
+
+def headings_for_spread(mean: float, spread: float, step: float = STEP,
+                        sigmas: float = SECTOR_SIGMAS) -> np.ndarray:
+    """The BEM headings (rad, NED) a sea spread by sigma = `spread` (rad) about `mean` (rad)
+    needs: mean +- sigmas sigma on a uniform step no larger than `step` (rad), or the whole
+    circle [-pi, pi) on such a step when that sector reaches +-pi."""
+    if not (step > 0 and spread > 0 and math.isfinite(mean)):
+        raise ValueError(f"headings_for_spread: expected spread > 0 and step > 0 (rad), got "
+                         f"{spread!r}, {step!r}")
+    half = sigmas * spread
+    if half >= math.pi - 1e-9:
+        n = math.ceil(2 * math.pi / step)
+        return -math.pi + 2 * math.pi * np.arange(n) / n
+    n = math.ceil(2 * half / step)
+    return mean + np.linspace(-half, half, n + 1)
+
+
+def headings_line(headings) -> str:
+    """The scene's `[hydro] headings = [...]` line for `headings` (rad), in degrees."""
+    return "headings = [" + ", ".join(f'"{math.degrees(float(h)):.4g} deg"'
+                                      for h in headings) + "]"
+
+
+def _layout(headings):
+    """(h0, r, periodic): the first heading, the others' offsets from it in [0, 2 pi), sorted,
+    and whether the data cover the circle (the gap across the wrap no wider than the widest
+    gap between neighbouring headings)."""
+    h = np.asarray(headings, float)
+    h0 = float(h.min())
+    r = (h - h0) % (2 * math.pi)
+    order = np.argsort(r)
+    r = r[order]
+    if r.size < 3:
+        return h0, r, order, False
+    wrap_gap = 2 * math.pi - r[-1]
+    return h0, r, order, bool(wrap_gap <= np.max(np.diff(r)) * (1 + 1e-6))
+
+
+def covering_headings(direction, step: float = STEP) -> np.ndarray:
+    """Headings (rad) on a uniform step <= `step` spanning all of `direction` (rad) about
+    their circular mean (the whole circle when they reach +-pi from it)."""
+    d = np.atleast_1d(np.asarray(direction, float))
+    mean = float(np.angle(np.mean(np.exp(1j * d))))
+    half = float(np.max(np.abs((d - mean + math.pi) % (2 * math.pi) - math.pi)))
+    if half >= math.pi - step:
+        return headings_for_spread(mean, math.pi, step, sigmas=1.0)
+    n = max(1, math.ceil(2 * half / step))
+    return mean + np.linspace(-half, half, n + 1) if half > TOL else np.array([mean])
+
+
+def heading_weights(headings, direction, source: str) -> tuple:
+    """(lo, hi, t): for each direction (rad) the data headings (indices) it lies between and the
+    weight t of `hi` (complex linear interpolation: (1 - t) F_lo + t F_hi). HydroError naming
+    `source` and the data's headings when a direction lies outside them."""
+    d = np.atleast_1d(np.asarray(direction, float))
+    h0, r, order, periodic = _layout(headings)
+    phi = (d - h0) % (2 * math.pi)
+    phi = np.where(phi > 2 * math.pi - TOL, 0.0, phi)        # just below the first heading
+    if periodic:
+        ext = np.concatenate([r, [2 * math.pi]])
+        idx = np.concatenate([order, [order[0]]])
+    else:
+        ext, idx = r, order
+    k = np.clip(np.searchsorted(ext, phi, side="right") - 1, 0, max(ext.size - 2, 0))
+    if ext.size == 1:
+        bad = np.abs(phi - ext[0]) > TOL
+        lo = hi = np.full(d.size, idx[0])
+        t = np.zeros(d.size)
+    else:
+        bad = phi > ext[-1] + TOL
+        t = np.clip((phi - ext[k]) / (ext[k + 1] - ext[k]), 0.0, 1.0)
+        lo, hi = idx[k], idx[k + 1]
+    if np.any(bad):
+        shown = np.degrees(np.asarray(headings, float))
+        worst = np.degrees(d[bad])
+        raise HydroError(
+            f"{source}: wave directions {worst.min():.4g}..{worst.max():.4g} deg "
+            f"({int(bad.sum())} of {d.size} components) lie outside the excitation data's "
+            f"headings {np.round(shown, 2).tolist()} deg and cannot be interpolated; compute "
+            f"the headings the sea needs: in the scene's [hydro] table, "
+            f"{headings_line(covering_headings(d))} (or mbcontrol.hydro.headings_for_spread)")
+    return lo, hi, t
+
+
+def excitation_over_headings(per_heading, lo, hi, t) -> np.ndarray:
+    """Per-component coefficients (n, n_dof) from per_heading (n_headings, n, n_dof) (the
+    data at each heading, already at the components' frequencies) and `heading_weights`."""
+    n = np.arange(t.size)
+    return ((1 - t)[:, None] * per_heading[lo, n] + t[:, None] * per_heading[hi, n])
