@@ -41,6 +41,12 @@ def headings_for_spread(mean: float, spread: float, step: float = STEP,
     return mean + np.linspace(-half, half, n + 1)
 
 
+def covers_circle(headings) -> bool:
+    """True when headings (rad) cover the whole circle: three or more, and the gap across
+    the wrap no wider than the widest gap between neighbours (interpolation wraps there)."""
+    return _layout(headings)[3]
+
+
 def headings_line(headings) -> str:
     """The scene's `[hydro] headings = [...]` line for `headings` (rad), in degrees."""
     return "headings = [" + ", ".join(f'"{math.degrees(float(h)):.4g} deg"'

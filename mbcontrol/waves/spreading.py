@@ -27,7 +27,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.special import gammaln
+from scipy.special import betainc, gammaln
 
 KINDS = ("cos2s", "mitsuyasu")
 SIGMA_MAX = math.sqrt(2.0)      # rad: s = 0, the uniform distribution
@@ -82,23 +82,20 @@ class Spreading:
         return d
 
     def _cdf(self, s):
-        """(x, F): relative directions over the sector and the CDF of cos^(2s)(x/2) per s."""
+        """(x, F): relative directions over the sector and the (unnormalised over the sector)
+        CDF of D per s, exact at the points: the share of cos^(2s)(u/2) within |u| <= |x| is
+        I(sin^2(x/2); 1/2, s + 1/2) (the regularised incomplete beta function; t = sin^2)."""
         x = np.linspace(-self.sector, self.sector, GRID)
-        logd = 2 * s[:, None] * np.log(np.maximum(np.cos(x / 2), 1e-300))[None, :]
-        d = np.exp(logd - logd.max(axis=1, keepdims=True))
-        F = np.concatenate([np.zeros((s.size, 1)),
-                            np.cumsum(0.5 * (d[:, 1:] + d[:, :-1]) * np.diff(x), axis=1)], axis=1)
-        return x, F
+        F = 0.5 + 0.5 * np.sign(x)[None, :] * betainc(0.5, s[:, None] + 0.5,
+                                                      np.sin(x / 2)[None, :] ** 2)
+        return x, F - F[:, :1]
 
     def outside(self, omega=None, omega_p: float | None = None) -> np.ndarray:
         """Share of D beyond the sector at each omega (0 for the whole circle)."""
         s = self.s(omega, omega_p)
         if self.sector >= math.pi:
             return np.zeros(s.shape)
-        x = np.linspace(-math.pi, math.pi, 2 * GRID - 1)
-        d = np.cos(x / 2)[None, :] ** (2 * s[:, None])
-        inside = np.abs(x) <= self.sector
-        return 1.0 - np.trapezoid(d * inside, x, axis=1) / np.trapezoid(d, x, axis=1)
+        return 1.0 - betainc(0.5, s + 0.5, math.sin(self.sector / 2) ** 2)
 
     def quantile(self, u, omega=None, omega_p: float | None = None) -> np.ndarray:
         """The direction theta (rad, mean + offset, not wrapped) below which a share u of D

@@ -1,0 +1,69 @@
+"""Short-crested seas in a sweep: the wave a sea with a direction and a spread runs in, and the
+expected power of a linear law there from the frequency-domain solution.
+
+A spread sea's realisation gives each component one direction (waves.Spreading); its mean
+power over a repeat period is the sum over those components. The expected power over all
+realisations is the spreading-weighted integral over directions of the per-direction power
+spectra (components in different directions have independent phases, so their powers add):
+P = sum_i sum_k W_ik 1/2 c a_i^2 |V(omega_i, theta_k)|^2, with W_ik the share of
+D(theta | omega_i) in direction theta_k's bin. The response V is linear in the excitation,
+which is linear in direction between two of the hydro data's headings (hydro.headings), so V
+is computed at the data's headings only and interpolated the same way: exact, not a further
+approximation. Powers in W, angles in rad.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+QUADRATURE_STEP = math.radians(1.0)  # rad: direction bins of the expected power
+SECTOR_SIGMAS = 3.0                  # directions kept within mean +- 3 sigma unless the data
+                                     # cover the circle (hydro.headings.SECTOR_SIGMAS)
+
+
+def spread_sector(headings, spread: float) -> float:
+    """Half-width (rad) of the directions a sea of spread sigma (rad) keeps about its mean:
+    the whole circle (pi) where the hydro data's headings (rad) cover it, else 3 sigma (at
+    most pi); the share of D cut off is recorded in the wave's settings."""
+    from ...hydro.headings import covers_circle
+    if covers_circle(headings):
+        return math.pi
+    return min(math.pi, SECTOR_SIGMAS * spread)
+
+
+def sea_spreading(plant, sea, direction: float):
+    """The waves.Spreading of a short-crested sea (sea.spread > 0) about `direction` (rad),
+    or None for a long-crested one."""
+    from ...waves import Spreading
+    if not sea.spread_given:
+        return None
+    headings = plant.hydro.data["wave_direction"].values
+    return Spreading(sea.spreading, direction, sea.spread, spread_sector(headings, sea.spread))
+
+
+def spread_power(plant, wave, velocities, damping) -> float:
+    """The expected mean power (W) of linear dampers `damping` (N s/m or N m s/rad, one per
+    PTO) in the spread sea `wave` (a realisation's frequencies and amplitudes, its settings'
+    spreading): velocities(direction) gives (n_omega, n_pto) velocities per unit amplitude
+    for one direction (rad) per frequency."""
+    from ...hydro.headings import heading_weights
+    from ...waves.spreading import from_settings
+    spreading = from_settings(wave.settings)
+    omega = np.asarray(wave.omega, float)
+    omega_p = 2 * math.pi / wave.settings["tp"]
+    n = max(2, math.ceil(2 * spreading.sector / QUADRATURE_STEP))
+    theta = spreading.mean - spreading.sector + (np.arange(n) + 0.5) * 2 * spreading.sector / n
+    W = spreading.bin_weights(theta, omega, omega_p)                  # (n_omega, n)
+    headings = plant.hydro.data["wave_direction"].values
+    lo, hi, t = heading_weights(headings, theta, plant.hydro.source)
+    at = {}
+    for j in np.union1d(lo, hi):                                       # the data's headings
+        at[int(j)] = velocities(np.full(omega.size, float(headings[j])))
+    a2 = np.asarray(wave.amplitude, float) ** 2
+    c = np.asarray(damping, float)
+    total = 0.0
+    for k in range(n):
+        V = (1 - t[k]) * at[int(lo[k])] + t[k] * at[int(hi[k])]        # (n_omega, n_pto)
+        total += float(np.sum(W[:, k, None] * 0.5 * c[None, :] * a2[:, None] * np.abs(V) ** 2))
+    return total
