@@ -1,22 +1,26 @@
 """Excitation at any wave direction from data at a few headings, and the headings a spread
 sea needs from a BEM.
 
-Between two of the data's headings the per-unit-amplitude excitation (already interpolated to
-the wanted frequency) is interpolated linearly in the complex plane. Complex, not magnitude and
+Between the data's headings the per-unit-amplitude excitation (already interpolated to the
+wanted frequency) is interpolated in heading as complex values by a cubic spline (periodic
+where the headings cover the whole circle: the gap across +-pi no wider than the widest gap
+between them; straight lines with fewer than four headings). Complex, not magnitude and
 unwrapped phase: DOFs antisymmetric about the mean direction (sway, roll, yaw in head seas)
-pass through zero as the heading crosses it, where the phase jumps by pi and a
-magnitude/phase interpolation would invent a force; the complex one is continuous there and its
-error is second order in the heading step (the catalogue bodies sit near the n-frame origin,
-where the plane wave's own phase k (x cos b + y sin b) varies slowly with b; for a body far from
-the origin the step must keep k r db small). Where the data's headings cover the whole circle
-(the gap across +-pi no wider than the widest gap between them) the interpolation wraps;
-otherwise a direction outside them is refused, naming the source and its headings.
+pass through zero as the heading crosses it, where the phase jumps by pi and a magnitude/phase
+interpolation would invent a force; complex values are smooth there. A spline, not straight
+lines: a chord cuts inside the curve F(b) traces, so |F|^2 and the power dip between headings;
+on the OSWEC (15 deg headings, cos-2s sigma 30 deg) straight lines put the expected power 1.2 %
+below the periodic trapezoid over the data's headings, the spline within 0.1 %. Error grows
+with the plane wave's own phase k (x cos b + y sin b) over a step: the catalogue bodies sit
+near the n-frame origin; a body far from it needs k r db small. A direction outside the data's
+headings is refused, naming the source, its headings and the `[hydro] headings` line to add.
 """
 from __future__ import annotations
 
 import math
 
 import numpy as np
+from scipy.interpolate import CubicSpline
 
 from ..errors import HydroError
 
@@ -80,28 +84,22 @@ def covering_headings(direction, step: float = STEP) -> np.ndarray:
     return mean + np.linspace(-half, half, n + 1) if half > TOL else np.array([mean])
 
 
-def heading_weights(headings, direction, source: str) -> tuple:
-    """(lo, hi, t): for each direction (rad) the data headings (indices) it lies between and the
-    weight t of `hi` (complex linear interpolation: (1 - t) F_lo + t F_hi). HydroError naming
-    `source` and the data's headings when a direction lies outside them."""
+def heading_matrix(headings, direction, source: str) -> np.ndarray:
+    """(n_directions, n_headings): the weights that give the excitation at each direction (rad)
+    from the data's at each heading (F(theta) = sum_j M_j(theta) F_j): a cubic spline's
+    cardinal functions (periodic where the headings cover the circle, not-a-knot otherwise)
+    with four headings or more, straight lines between two or three, the heading itself with
+    one. HydroError naming `source` and the data's headings when a direction lies outside
+    them (or the data repeat a heading)."""
     d = np.atleast_1d(np.asarray(direction, float))
     h0, r, order, periodic = _layout(headings)
+    if np.any(np.diff(r) < TOL):
+        raise HydroError(f"{source}: the excitation data repeat a heading "
+                         f"({np.round(np.degrees(np.asarray(headings, float)), 3).tolist()} deg)")
     phi = (d - h0) % (2 * math.pi)
     phi = np.where(phi > 2 * math.pi - TOL, 0.0, phi)        # just below the first heading
-    if periodic:
-        ext = np.concatenate([r, [2 * math.pi]])
-        idx = np.concatenate([order, [order[0]]])
-    else:
-        ext, idx = r, order
-    k = np.clip(np.searchsorted(ext, phi, side="right") - 1, 0, max(ext.size - 2, 0))
-    if ext.size == 1:
-        bad = np.abs(phi - ext[0]) > TOL
-        lo = hi = np.full(d.size, idx[0])
-        t = np.zeros(d.size)
-    else:
-        bad = phi > ext[-1] + TOL
-        t = np.clip((phi - ext[k]) / (ext[k + 1] - ext[k]), 0.0, 1.0)
-        lo, hi = idx[k], idx[k + 1]
+    ext, idx = (np.append(r, 2 * math.pi), np.append(order, order[0])) if periodic else (r, order)
+    bad = np.abs(phi - ext[0]) > TOL if ext.size == 1 else phi > ext[-1] + TOL
     if np.any(bad):
         shown = np.degrees(np.asarray(headings, float))
         worst = np.degrees(d[bad])
@@ -111,11 +109,19 @@ def heading_weights(headings, direction, source: str) -> tuple:
             f"headings {np.round(shown, 2).tolist()} deg and cannot be interpolated; compute "
             f"the headings the sea needs: in the scene's [hydro] table, "
             f"{headings_line(covering_headings(d))} (or mbcontrol.hydro.headings_for_spread)")
-    return lo, hi, t
+    n = len(headings)
+    basis = np.zeros((ext.size, n))
+    basis[np.arange(ext.size), idx] = 1.0
+    phi = np.clip(phi, ext[0], ext[-1])
+    if ext.size >= 4 + periodic:
+        spline = CubicSpline(ext, basis, bc_type="periodic" if periodic else "not-a-knot")
+        return spline(phi)
+    if ext.size == 1:
+        return np.repeat(basis, d.size, axis=0)
+    return np.stack([np.interp(phi, ext, basis[:, j]) for j in range(n)], axis=1)
 
 
-def excitation_over_headings(per_heading, lo, hi, t) -> np.ndarray:
+def excitation_over_headings(per_heading, weights) -> np.ndarray:
     """Per-component coefficients (n, n_dof) from per_heading (n_headings, n, n_dof) (the
-    data at each heading, already at the components' frequencies) and `heading_weights`."""
-    n = np.arange(t.size)
-    return ((1 - t)[:, None] * per_heading[lo, n] + t[:, None] * per_heading[hi, n])
+    data at each heading, already at the components' frequencies) and `heading_matrix`."""
+    return np.einsum("ih,hid->id", weights, per_heading)

@@ -27,7 +27,7 @@ from . import array_fit, array_passivity, fit_error, passive_order, passivity, r
 from ._io import read_netcdf
 from .bem import compute
 from .geometry import BemBody
-from .headings import excitation_over_headings, heading_weights, headings_line
+from .headings import excitation_over_headings, heading_matrix, headings_line
 from .isolated import compute_isolated
 from .neighbours import compute_within
 from .radiation import RadiationModel, fit_radiation
@@ -93,14 +93,13 @@ class HydroModel:
         if direction.shape != omega.shape:
             raise ValueError(f"{self.source}: one wave direction per frequency expected, got "
                              f"{direction.size} directions for {omega.size} frequencies")
-        lo, hi, t = heading_weights(self.data["wave_direction"].values, direction, self.source)
+        weights = heading_matrix(self.data["wave_direction"].values, direction, self.source)
         data = self.data["excitation_force"].sel(influenced_dof=list(self.dofs)).transpose(
             "wave_direction", "omega", "influenced_dof").values
-        used = np.union1d(lo, hi)
         per_heading = np.zeros((data.shape[0], omega.size, data.shape[2]), complex)
-        for j in used:
+        for j in np.flatnonzero(np.any(weights != 0, axis=0)):
             per_heading[j] = interpolate_complex(self.omega, data[j], omega)
-        return excitation_over_headings(per_heading, lo, hi, t)
+        return excitation_over_headings(per_heading, weights)
 
     def excitation(self, wave: Wave, t) -> np.ndarray:
         try:

@@ -31,7 +31,7 @@ from scipy.special import betainc, gammaln
 
 KINDS = ("cos2s", "mitsuyasu")
 SIGMA_MAX = math.sqrt(2.0)      # rad: s = 0, the uniform distribution
-BLOCK = 16                      # components per stratification block (`component_directions`)
+GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0   # the Weyl sequence's step (`component_directions`)
 GRID = 4001                     # points of the numerical CDF over the sector
 
 
@@ -144,15 +144,16 @@ def from_settings(settings: dict) -> Spreading | None:
 
 
 def component_directions(spreading: Spreading, omega, omega_p: float, seed: int) -> np.ndarray:
-    """One direction per component (rad, mean + offset), stratified in frequency: each block
-    of BLOCK consecutive components takes the quantiles (j + 1/2) / m, j < m (m the block's
-    size) of D(theta | omega_i), in an order drawn from `seed`. Every stretch of BLOCK
-    components so samples the whole distribution, and a linear device's power (a smooth
-    function of frequency and direction) sums close to the spreading-weighted integral."""
+    """One direction per component (rad, mean + offset): component i takes the quantile
+    u_i = frac(u_0 + i (sqrt 5 - 1) / 2) of D(theta | omega_i), u_0 drawn from `seed` (its own
+    stream: the phases are those of the long-crested sea). This Weyl (golden-ratio) sequence
+    is equidistributed over every run of consecutive components (discrepancy O(log m / m) over
+    m of them), so the realisation's sum over components is a low-discrepancy quadrature of
+    the spreading-weighted power: a linear device's mean power over a repeat period lies close
+    to the expected one. Measured on the OSWEC (a damper, cos-2s sigma 30 deg, four seeds):
+    within 0.4 % for 600 s records at Tp 6-12 s, 1.6 % at Tp 16 s (127 components), 0.2 % at
+    1200 s; random permutations in blocks of 16 components scattered by 4-16 %."""
     omega = np.asarray(omega, float)
-    rng = np.random.default_rng([int(seed), 0xD1])   # its own stream: the phases are unchanged
-    u = np.empty(omega.size)
-    for start in range(0, omega.size, BLOCK):
-        m = min(BLOCK, omega.size - start)
-        u[start:start + m] = (rng.permutation(m) + 0.5) / m
+    u0 = np.random.default_rng([int(seed), 0xD1]).uniform()
+    u = (u0 + np.arange(omega.size) * GOLDEN) % 1.0
     return spreading.quantile(u, omega, omega_p)

@@ -8,7 +8,7 @@ import pytest
 
 from mbcontrol.errors import HydroError
 from mbcontrol.hydro import HydroModel, headings_for_spread, read_netcdf
-from mbcontrol.hydro.headings import covers_circle, heading_weights
+from mbcontrol.hydro.headings import covers_circle, heading_matrix
 
 MODELS = Path(__file__).resolve().parents[2] / "models"
 
@@ -55,13 +55,23 @@ def test_direction_outside_the_headings_names_the_file_and_the_fix(array4):
 
 def test_headings_wrap_only_where_they_cover_the_circle():
     circle = np.radians(np.arange(-180, 180, 15))
-    assert covers_circle(circle) and not covers_circle(np.radians(np.arange(-90, 91, 15)))
-    # 172.5 deg between 165 and 180 (= -180) deg: half way, across the wrap
-    lo, hi, t = heading_weights(circle, [math.radians(172.5), math.radians(-172.5)], "x")
-    assert {circle[lo[0]], circle[hi[0]]} == {circle[-1], circle[0]} and t[0] == pytest.approx(0.5)
-    assert t[1] == pytest.approx(0.5)
+    half = np.radians(np.arange(-90, 91, 15))
+    assert covers_circle(circle) and not covers_circle(half)
+    # a smooth periodic excitation-like function of heading, sampled every 15 deg: the periodic
+    # spline gives it back between the samples, across the wrap at +-180 deg too, to 5e-4
+    # (cubic: error ~ h^4 f / 384 with h = 0.26 rad, f <= 16 for the 2nd harmonic)
+    def f(b):
+        return np.exp(2j * b) + 0.3 * np.cos(b) + 0.1j * np.sin(3 * b)
+    d = np.radians([172.5, -172.5, 7.0, -97.5, 180.0])
+    M = heading_matrix(circle, d, "circle.nc")
+    assert M @ f(circle) == pytest.approx(f(d), abs=5e-4)
+    assert M.sum(axis=1) == pytest.approx(1.0, abs=1e-12)      # constants are kept
+    # over a sector the not-a-knot spline is exact for a cubic in heading
+    d = np.radians([-89.0, -3.0, 44.0, 89.9])
+    assert heading_matrix(half, d, "half.nc") @ (half ** 3 - half) == pytest.approx(
+        d ** 3 - d, abs=1e-12)
     with pytest.raises(HydroError, match="outside"):
-        heading_weights(np.radians(np.arange(-90, 91, 15)), [math.radians(100.0)], "half.nc")
+        heading_matrix(half, [math.radians(100.0)], "half.nc")
 
 
 def test_headings_for_spread():

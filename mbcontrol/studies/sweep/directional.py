@@ -7,9 +7,9 @@ realisations is the spreading-weighted integral over directions of the per-direc
 spectra (components in different directions have independent phases, so their powers add):
 P = sum_i sum_k W_ik 1/2 c a_i^2 |V(omega_i, theta_k)|^2, with W_ik the share of
 D(theta | omega_i) in direction theta_k's bin. The response V is linear in the excitation,
-which is linear in direction between two of the hydro data's headings (hydro.headings), so V
-is computed at the data's headings only and interpolated the same way: exact, not a further
-approximation. Powers in W, angles in rad.
+which is interpolated between the hydro data's headings by fixed weights (hydro.headings:
+heading_matrix), so V is computed at the data's headings only and interpolated the same way:
+exact, not a further approximation. Powers in W, angles in rad.
 """
 from __future__ import annotations
 
@@ -47,7 +47,7 @@ def spread_power(plant, wave, velocities, damping) -> float:
     PTO) in the spread sea `wave` (a realisation's frequencies and amplitudes, its settings'
     spreading): velocities(direction) gives (n_omega, n_pto) velocities per unit amplitude
     for one direction (rad) per frequency."""
-    from ...hydro.headings import heading_weights
+    from ...hydro.headings import heading_matrix
     from ...waves.spreading import from_settings
     spreading = from_settings(wave.settings)
     omega = np.asarray(wave.omega, float)
@@ -56,14 +56,13 @@ def spread_power(plant, wave, velocities, damping) -> float:
     theta = spreading.mean - spreading.sector + (np.arange(n) + 0.5) * 2 * spreading.sector / n
     W = spreading.bin_weights(theta, omega, omega_p)                  # (n_omega, n)
     headings = plant.hydro.data["wave_direction"].values
-    lo, hi, t = heading_weights(headings, theta, plant.hydro.source)
-    at = {}
-    for j in np.union1d(lo, hi):                                       # the data's headings
-        at[int(j)] = velocities(np.full(omega.size, float(headings[j])))
+    M = heading_matrix(headings, theta, plant.hydro.source)             # (n, n_headings)
+    used = np.flatnonzero(np.any(M != 0, axis=0))
+    at = np.stack([velocities(np.full(omega.size, float(headings[j]))) for j in used])
     a2 = np.asarray(wave.amplitude, float) ** 2
     c = np.asarray(damping, float)
     total = 0.0
     for k in range(n):
-        V = (1 - t[k]) * at[int(lo[k])] + t[k] * at[int(hi[k])]        # (n_omega, n_pto)
+        V = np.einsum("h,hip->ip", M[k, used], at)                     # (n_omega, n_pto)
         total += float(np.sum(W[:, k, None] * 0.5 * c[None, :] * a2[:, None] * np.abs(V) ** 2))
     return total
