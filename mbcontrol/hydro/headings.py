@@ -45,6 +45,36 @@ def headings_for_spread(mean: float, spread: float, step: float = STEP,
     return mean + np.linspace(-half, half, n + 1)
 
 
+def axisymmetric_headings(data, source: str, step: float = STEP):
+    """`data` with its one heading's excitation given at every `step` (rad) round the circle:
+    for bodies of revolution about the n-frame z axis moving in heave only, the heave
+    excitation does not depend on the direction the waves travel (a rotation about z maps
+    the bodies and the heave force onto themselves). HydroError naming `source` when a DOF is
+    not heave or a body's CoG or centre of buoyancy lies off the z axis (1 mm); data with
+    several headings are returned as they are."""
+    if data.sizes.get("wave_direction", 1) > 1:
+        return data
+    dofs = [str(d) for d in data["influenced_dof"].values]
+    other = [d for d in dofs if not d.endswith("__Heave")]
+    if other:
+        raise HydroError(f"{source}: axisymmetric data serve every direction in heave only; "
+                         f"the data also hold {other}")
+    for name in ("cog", "center_of_buoyancy"):
+        if name in data:
+            xy = np.asarray(data[name].transpose("body", "xyz").values, float)[:, :2]
+            if np.any(np.abs(xy) > 1e-3):
+                raise HydroError(f"{source}: axisymmetric data need every body on the z axis; "
+                                 f"{name} (x, y) = {np.round(xy, 4).tolist()} m")
+    n = math.ceil(2 * math.pi / step)
+    headings = -math.pi + 2 * math.pi * np.arange(n) / n
+    out = data.reindex(wave_direction=headings, method="nearest", tolerance=2 * math.pi)
+    out["wave_direction"].attrs = dict(data["wave_direction"].attrs)
+    out.attrs["axisymmetric"] = (f"heading {float(data['wave_direction'].values[0]):.4g} rad "
+                                 f"given every {math.degrees(step):.4g} deg (bodies of "
+                                 f"revolution in heave)")
+    return out
+
+
 def covers_circle(headings) -> bool:
     """True when headings (rad) cover the whole circle: three or more, and the gap across
     the wrap no wider than the widest gap between neighbours (interpolation wraps there)."""

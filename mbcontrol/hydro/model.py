@@ -27,7 +27,7 @@ from . import array_fit, array_passivity, fit_error, passive_order, passivity, r
 from ._io import read_netcdf
 from .bem import compute
 from .geometry import BemBody
-from .headings import excitation_over_headings, heading_matrix, headings_line
+from .headings import axisymmetric_headings, excitation_over_headings, heading_matrix, headings_line
 from .isolated import compute_isolated
 from .neighbours import compute_within
 from .radiation import RadiationModel, fit_radiation
@@ -202,6 +202,8 @@ def load_hydro_data(scene: Scene, dofs) -> tuple[str, xr.Dataset]:
     else:
         source, data = _run_bem(scene, dofs)
     _check_dofs(data, dofs, source)
+    if scene.hydro.axisymmetric:           # one heading serves all (module headings)
+        data = axisymmetric_headings(data, f"{scene.path}: [hydro] axisymmetric: {source}")
     return source, data
 
 

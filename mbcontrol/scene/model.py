@@ -243,6 +243,8 @@ class HydroSettings:
     interaction: bool = True                   # False: each body solved alone (hydro.isolated)
     interaction_radius: float = math.inf       # m: couple bodies only within it (hydro.neighbours)
     hydrostatics: str = "linear"               # "linear" | "large_angle" (box, cylinder, sphere)
+    axisymmetric: bool = False                 # bodies of revolution on the z axis, in heave:
+                                               # one heading's excitation serves every direction
 
 
 @dataclass(frozen=True)

@@ -186,6 +186,8 @@ MEANING = {
     ("hydro", "fit_omega_max"): "highest frequency the radiation fit sees",
     ("hydro", "response_band"): "[low, high]: where the fit is judged per frequency",
     ("hydro", "hydrostatics"): "`large_angle`: buoyancy of the immersed primitive at its pose",
+    ("hydro", "axisymmetric"): "true: bodies of revolution on the z axis in heave; the data's "
+                               "one heading serves every wave direction",
     ("hydro.omega", "min"): "first frequency",
     ("hydro.omega", "max"): "last frequency",
     ("hydro.omega", "n"): "number of frequencies",

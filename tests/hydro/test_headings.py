@@ -84,3 +84,20 @@ def test_headings_for_spread():
     # a coarse step is refined to stay within it
     assert np.max(np.diff(headings_for_spread(0.2, math.radians(10.0), math.radians(7.0)))) \
         <= math.radians(7.0) + 1e-12
+
+
+def test_axisymmetric_data_serve_every_direction_in_heave_only(array4):
+    from mbcontrol.hydro.headings import axisymmetric_headings
+    from mbcontrol.plant import build_plant
+    rm3 = build_plant("rm3")             # [hydro] axisymmetric = true: float and plate in heave
+    hydro = rm3.hydro
+    assert hydro.data.sizes["wave_direction"] == 24
+    w = hydro.omega[[5, 40, 90]]
+    one = hydro.excitation_at(w, 0.0)                          # the WAMIT file's own heading
+    # a spline through equal values is that value (its cardinal functions sum to one): 1e-13
+    assert hydro.excitation_at(w, np.radians([-170.0, 33.0, 97.5])) == pytest.approx(one,
+                                                                                      rel=1e-13)
+    # four floats off the z axis, in heave: refused, naming the data
+    single = array4.data.isel(wave_direction=[0])
+    with pytest.raises(HydroError, match="array4.*z axis"):
+        axisymmetric_headings(single, array4.source)

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from mbcontrol import waves
-from mbcontrol.hydro import BemBody, compute, read_netcdf, write_netcdf_atomic
+from mbcontrol.hydro import BemBody, compute
 from mbcontrol.plant import build_plant
 from mbcontrol.scene import load_scene
 from mbcontrol.sim import light
@@ -32,17 +32,17 @@ def test_bem_heave_excitation_of_a_body_of_revolution_ignores_the_heading():
 
 @pytest.fixture(scope="module")
 def sphere_all_headings(tmp_path_factory):
-    """The catalogue sphere with its heading-0 WAMIT data given at every 15 deg (a body of
-    revolution at the origin: the test above), the radiation data byte for byte its own (so
-    its shipped radiation fit serves)."""
+    """The catalogue sphere declared `[hydro] axisymmetric = true`: its heading-0 WAMIT data
+    serve every direction (a body of revolution at the origin: the test above), the radiation
+    data its own (so its shipped radiation fit serves)."""
     folder = tmp_path_factory.mktemp("sphere")
-    ds = read_netcdf(MODELS / "sphere_hydro.nc")
-    write_netcdf_atomic(ds.reindex(wave_direction=HEADINGS, method="nearest"),
-                        folder / "sphere_hydro.nc")
-    text = (MODELS / "sphere.toml").read_text().splitlines()
-    text = [line for line in text if not line.startswith(("source", "source_bodies"))]
-    (folder / "sphere.toml").write_text("\n".join(text) + "\n")
-    return build_plant(load_scene(folder / "sphere.toml"))
+    text = (MODELS / "sphere.toml").read_text()
+    text = text.replace('file = "sphere_hydro.nc"',
+                        f'file = "{MODELS / "sphere_hydro.nc"}"\naxisymmetric = true')
+    (folder / "sphere.toml").write_text(text)
+    plant = build_plant(load_scene(folder / "sphere.toml"))
+    assert np.allclose(plant.hydro.data["wave_direction"].values, HEADINGS)
+    return plant
 
 
 def test_spread_sea_gives_a_heaving_sphere_the_same_power(sphere_all_headings):
