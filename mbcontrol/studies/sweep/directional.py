@@ -18,15 +18,14 @@ import math
 import numpy as np
 
 QUADRATURE_STEP = math.radians(1.0)  # rad: direction bins of the expected power
-SECTOR_SIGMAS = 3.0                  # directions kept within mean +- 3 sigma unless the data
-                                     # cover the circle (hydro.headings.SECTOR_SIGMAS)
 
 
 def spread_sector(headings, spread: float) -> float:
     """Half-width (rad) of the directions a sea of spread sigma (rad) keeps about its mean:
     the whole circle (pi) where the hydro data's headings (rad) cover it, else 3 sigma (at
     most pi); the share of D cut off is recorded in the wave's settings."""
-    from ...hydro.headings import covers_circle
+    from ...hydro import covers_circle
+    from ...hydro.headings import SECTOR_SIGMAS
     if covers_circle(headings):
         return math.pi
     return min(math.pi, SECTOR_SIGMAS * spread)
@@ -47,7 +46,7 @@ def spread_power(plant, wave, velocities, damping) -> float:
     PTO) in the spread sea `wave` (a realisation's frequencies and amplitudes, its settings'
     spreading): velocities(direction) gives (n_omega, n_pto) velocities per unit amplitude
     for one direction (rad) per frequency."""
-    from ...hydro.headings import heading_matrix
+    from ...hydro import heading_matrix
     from ...waves.spreading import from_settings
     spreading = from_settings(wave.settings)
     omega = np.asarray(wave.omega, float)
