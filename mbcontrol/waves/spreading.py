@@ -84,11 +84,13 @@ class Spreading:
     def _cdf(self, s):
         """(x, F): relative directions over the sector and the (unnormalised over the sector)
         CDF of D per s, exact at the points: the share of cos^(2s)(u/2) within |u| <= |x| is
-        I(sin^2(x/2); 1/2, s + 1/2) (the regularised incomplete beta function; t = sin^2)."""
+        I(sin^2(x/2); 1/2, s + 1/2) (the regularised incomplete beta function; t = sin^2).
+        Computed once per distinct s (cos-2s: one)."""
         x = np.linspace(-self.sector, self.sector, GRID)
-        F = 0.5 + 0.5 * np.sign(x)[None, :] * betainc(0.5, s[:, None] + 0.5,
+        distinct, back = np.unique(s, return_inverse=True)
+        F = 0.5 + 0.5 * np.sign(x)[None, :] * betainc(0.5, distinct[:, None] + 0.5,
                                                       np.sin(x / 2)[None, :] ** 2)
-        return x, F - F[:, :1]
+        return x, (F - F[:, :1])[back.reshape(-1)]
 
     def outside(self, omega=None, omega_p: float | None = None) -> np.ndarray:
         """Share of D beyond the sector at each omega (0 for the whole circle)."""

@@ -91,17 +91,16 @@ def expected_power(plant, wave, gains, *, params=None, statespace: bool = False)
     from ...analysis.power_statistics import law_params, law_responses
     a2 = np.asarray(wave.amplitude, float) ** 2
     if wave.directional and "spreading" in wave.settings:   # a spread sea: over directions
+        from ...analysis import excitation_transfer
         from .directional import spread_power
         outputs = [f"{name}__velocity" for name in gains]
-        sys = None if not statespace else linearize(
-            plant, params=law_params(plant, gains, params), outputs=outputs)
+        values = law_params(plant, gains, params)
+        sys = linearize(plant, params=values, outputs=outputs) if statespace else None
+        G = excitation_transfer(plant, wave.omega, params=values, outputs=outputs, sys=sys)
 
-        def velocities(direction):
-            if sys is not None:
-                return statespace_response(sys, plant, wave.omega, direction=direction,
-                                           outputs=outputs)
-            r = law_responses(plant, wave.omega, gains, direction=direction, params=params)
-            return np.stack([r[name][0] for name in gains], axis=1)
+        def velocities(direction):          # linear in the excitation: one G for all
+            F = np.conj(plant.hydro.excitation_at(wave.omega, direction))
+            return np.einsum("ioh,ih->io", G, F)
         return spread_power(plant, wave, velocities, [c for c, _ in gains.values()])
     if not statespace:
         responses = law_responses(plant, wave.omega, gains, direction=wave.direction,
