@@ -61,7 +61,8 @@ class Wave:
                                                        * np.exp(1j * self.direction)))))
 
     def describe(self) -> dict:
-        return {"type": self.kind, **self.settings, "direction_rad": self.mean_direction,
+        direction = self.mean_direction if self.directional else self.direction   # as given
+        return {"type": self.kind, **self.settings, "direction_rad": direction,
                 "ramp_s": self.ramp_time, "n_components": int(self.omega.size)}
 
 
