@@ -223,6 +223,6 @@ def default_bounds(plant, wave, name: str, params) -> tuple[float, float]:
     from mbcontrol.analysis import pto_thevenin
     k = int(np.argmax(wave.amplitude))
     scale = float(np.abs(pto_thevenin(plant, wave.omega[k:k + 1], pto=name,
-                                      direction=wave.direction, params=params,
+                                      direction=wave.mean_direction, params=params,
                                       check_passive=False).impedance[0]))
     return 1e-3 * scale, 1e3 * scale

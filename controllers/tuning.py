@@ -174,7 +174,9 @@ def _loop_distance(plant, name: str, params, wave, n: int = 300):
     omega = plant.hydro.omega
     grid = np.union1d(np.geomspace(float(omega[0]), float(omega[-1]), n),
                       np.asarray(wave.omega, float))
-    Z, _ = intrinsic_impedance(plant, grid, pto=name, params=params, direction=wave.direction)
+    # Z_i does not depend on the direction: the mean one serves a spread sea's grid too
+    Z, _ = intrinsic_impedance(plant, grid, pto=name, params=params,
+                               direction=wave.mean_direction)
     # Re(i omega Z_i) = K - omega^2 m at low frequency: K from the two lowest frequencies
     r0, r1 = (float((1j * w * z).real) for w, z in zip(grid[:2], Z[:2]))
     K = (r0 * grid[1] ** 2 - r1 * grid[0] ** 2) / (grid[1] ** 2 - grid[0] ** 2)

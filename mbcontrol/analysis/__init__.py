@@ -8,8 +8,8 @@ passes), `summary` (a run's metrics, verdict and provenance: the simulate --json
 `metrics` (power, PAPR, peaks, limit violations), `reduce` (balanced truncation).
 """
 from .bounds import complex_conjugate_bound, pseudo_spectral_bound, pto_thevenin
-from .frequency import (frequency_domain_response, mechanical_matrices, regular_wave_amplitudes,
-                        statespace_response)
+from .frequency import (excitation_transfer, frequency_domain_response, mechanical_matrices,
+                        regular_wave_amplitudes, statespace_response)
 from .linearize import linearize
 from .metrics import electrical_power, pto_metrics
 from .ports import multiport_bound
@@ -17,7 +17,7 @@ from .reduce import balanced_truncation
 from .summary import summary
 from .validity import assess, simulate_checked
 
-__all__ = ["linearize", "frequency_domain_response", "statespace_response",
+__all__ = ["linearize", "frequency_domain_response", "statespace_response", "excitation_transfer",
            "regular_wave_amplitudes", "mechanical_matrices", "complex_conjugate_bound",
            "pseudo_spectral_bound", "pto_thevenin", "pto_metrics", "electrical_power", "summary",
            "balanced_truncation", "multiport_bound", "assess", "simulate_checked"]

@@ -216,8 +216,8 @@ class PseudoSpectralProblem:
             k = np.union1d(k, np.arange(max(lowest, 1),
                                         math.floor(omega_max * T / (2 * np.pi) * (1 + 1e-9)) + 1))
         self.omega = 2 * np.pi * k / T
-        th = cc.thevenin if k.size == k_wave.size else pto_thevenin(plant, self.omega, pto,
-                                                                    wave.direction, params)
+        th = cc.thevenin if k.size == k_wave.size else pto_thevenin(
+            plant, self.omega, pto, wave.mean_direction, params)  # its excitation: cc's below
         E = np.zeros(k.size, complex)
         E[np.searchsorted(k, k_wave)] = cc.thevenin.excitation * _wave_phasors(wave)
         Z = th.impedance

@@ -139,7 +139,7 @@ def envelope_response(plant, wave, pto: str, params=None) -> EnvelopeResponse:
     for j, item in enumerate(items):
         if item.relative:            # up = -heave (z down), minus the surface there
             x, y = item.point
-            surface = np.exp(1j * k * (x * math.cos(wave.direction) + y * math.sin(wave.direction)))
+            surface = np.exp(1j * k * (x * np.cos(wave.direction) + y * np.sin(wave.direction)))
             G[:, j], H[:, j] = -G[:, j], -H[:, j] - surface
     return EnvelopeResponse(items, G, H, amplitude, omega.size == 1)
 

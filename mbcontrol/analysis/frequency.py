@@ -19,14 +19,14 @@ def frequency_domain_response(plant, omega, *, direction: float = 0.0, params=No
     """Complex response per unit wave amplitude (n_omega, n_outputs), exp(+i omega t).
 
     Straight from the BEM data (no radiation fit): A(omega), B(omega) and the excitation are
-    interpolated linearly on the BEM grid. outputs: names (default all plant outputs).
+    interpolated linearly on the BEM grid. direction (rad): one, or one per omega (a spread
+    sea's components; `HydroModel.excitation_at`). outputs: names (default all plant outputs).
     """
     omega = np.atleast_1d(np.asarray(omega, float))
     mech = mechanical_matrices(plant, params)
     hyd = plant.hydro
     A_w, B_w = hyd.frequency_domain_matrices(omega)
-    from ..waves import interpolate_complex
-    F = np.conj(interpolate_complex(hyd.omega, hyd.excitation_coefficients(direction), omega))
+    F = np.conj(hyd.excitation_at(omega, direction))
     P = mech.P_hydro
     idx = [plant.outputs.index(o) for o in (outputs or plant.outputs)]
     out = np.empty((omega.size, len(idx)), dtype=complex)
@@ -39,15 +39,40 @@ def frequency_domain_response(plant, omega, *, direction: float = 0.0, params=No
     return out
 
 
+def excitation_transfer(plant, omega, *, params=None, outputs=None, sys=None) -> np.ndarray:
+    """(n_omega, n_outputs, n_hydro_dof): the outputs' response to a unit excitation force on
+    each hydro DOF (exp(+i omega t)); times conj(F) (`HydroModel.excitation_at`) it is
+    `frequency_domain_response` (BEM data straight) or, given the linearised `sys`,
+    `statespace_response`. For many wave directions at once: one solve per frequency."""
+    omega = np.atleast_1d(np.asarray(omega, float))
+    if sys is not None:
+        w_idx = [sys.input_labels.index(f"w__{d}") for d in plant.hydro.dofs]
+        y_idx = [sys.output_labels.index(o) for o in (outputs or sys.output_labels)]
+        A, B, C, D = (np.asarray(M) for M in (sys.A, sys.B, sys.C, sys.D))
+        eye = np.eye(A.shape[0])
+        return np.stack([C[y_idx] @ np.linalg.solve(1j * w * eye - A, B[:, w_idx])
+                         + D[np.ix_(y_idx, w_idx)] for w in omega])
+    mech = mechanical_matrices(plant, params)
+    A_w, B_w = plant.hydro.frequency_domain_matrices(omega)
+    P = mech.P_hydro
+    idx = [plant.outputs.index(o) for o in (outputs or plant.outputs)]
+    out = []
+    for i, w in enumerate(omega):
+        Z = (-w**2 * (mech.mass + P @ A_w[i] @ P.T) + 1j * w * (mech.damping + P @ B_w[i] @ P.T)
+             + mech.stiffness)
+        X = np.linalg.solve(Z, P)
+        out.append((mech.output_q @ X + mech.output_s @ (1j * w * X))[idx])
+    return np.stack(out)
+
+
 def statespace_response(sys, plant, omega, *, direction: float = 0.0, outputs=None):
     """Response per unit wave amplitude of a linearised model (n_omega, n_outputs).
 
     Drives the w inputs of `sys` with the conjugated BEM excitation (exp(+i omega t)).
     """
-    from ..waves import interpolate_complex
     omega = np.atleast_1d(np.asarray(omega, float))
     hyd = plant.hydro
-    F = np.conj(interpolate_complex(hyd.omega, hyd.excitation_coefficients(direction), omega))
+    F = np.conj(hyd.excitation_at(omega, direction))
     w_idx = [sys.input_labels.index(f"w__{d}") for d in hyd.dofs]
     names = outputs or sys.output_labels
     y_idx = [sys.output_labels.index(o) for o in names]

@@ -36,7 +36,6 @@ def output_responses(plant, omega, ptos, outputs, direction: float = 0.0, params
     (n_omega, n_out) per unit wave amplitude with the PTOs free (exp(-i omega t), straight
     from the BEM data), so that with PTO forces F the outputs are G F + H A. params:
     overrides as `linear_params`; the PTOs named in `ptos` are freed."""
-    from ..waves import interpolate_complex
     from .frequency import mechanical_matrices
     from .linearize import jacobians
 
@@ -60,7 +59,7 @@ def output_responses(plant, omega, ptos, outputs, direction: float = 0.0, params
     c_q, c_s = mech.output_q[i_y], mech.output_s[i_y]
     hyd, P = plant.hydro, mech.P_hydro
     A_w, B_w = hyd.frequency_domain_matrices(omega)
-    F_exc = interpolate_complex(hyd.omega, hyd.excitation_coefficients(direction), omega)
+    F_exc = hyd.excitation_at(omega, direction)
     n = len(ptos)
     G = np.empty((omega.size, len(i_y), n), complex)
     H = np.empty((omega.size, len(i_y)), complex)

@@ -68,7 +68,8 @@ def power_bound(plant, wave, params, window=None) -> dict:
     and frequency grid (seeds of one sea share it)."""
     from .ports import multiport_bound, port_responses, window_mean_power
     p = np.asarray(params, float)
-    key = (id(plant), p.tobytes(), float(wave.direction), np.asarray(wave.omega).tobytes())
+    key = (id(plant), p.tobytes(), np.asarray(wave.direction, float).tobytes(),
+           np.asarray(wave.omega).tobytes())
     if key not in _RESPONSES:
         if len(_RESPONSES) > 256:
             _RESPONSES.clear()
@@ -210,7 +211,7 @@ def wave_at(plant, wave, x: float, y: float):
     omega = np.atleast_1d(np.asarray(wave.omega, float))
     k = omega ** 2 / water.g if not math.isfinite(water.depth) else np.array(
         [wavenumber(float(w), water.depth, water.g) for w in omega])
-    shift = k * (x * math.cos(wave.direction) + y * math.sin(wave.direction))
+    shift = k * (x * np.cos(wave.direction) + y * np.sin(wave.direction))
     return dataclasses.replace(wave, phase=np.asarray(wave.phase) - shift)
 
 

@@ -20,6 +20,15 @@ labelled result (xarray). --vary NAME=v1,v2 adds a dimension: NAME is a scene pa
 a plant parameter, a setting of the controller, or `direction` (wave headings in degrees, among
 the hydro data's).
 
+Short-crested seas: a --seas file's columns `direction` (degrees, NED: where the waves travel
+to, +x towards +y) and `spread` (degrees, the directional spread sigma, the circular standard
+deviation), per sea, or --spread DEG for every sea (it overrides the file's), with the
+spreading function --spreading cos2s (default; one s = 2 / sigma^2 - 1) or mitsuyasu (Goda's
+s_max (f / fp)^5 below the peak, ^-2.5 above; sigma at the peak). Each component travels in
+its own direction, drawn stratified from the spreading function; the hydro data need headings
+around the mean (mbcontrol.hydro.headings_for_spread: mean +- 3 sigma on 15 deg steps, or the
+whole circle, which then keeps the whole spreading function).
+
 A farm: --isolated NAME=VALUE (scene parameters that make one device out of the farm's scene,
 e.g. n=1 for array_grid) also runs the lone device over the same cases and reports the q-factor
 per sea, q = farm power / (devices x power of one device alone), and the same ratio of the annual
@@ -44,7 +53,9 @@ hi] (Student's t over the valid seeds) with "power_std_W", "power_min_W", "power
 passive, reactive; nothing varied) per sea "spectral_cv" (one record's mean power: its
 standard deviation over records / mean, from the frequency-domain solution), "bandwidth_hz"
 (B_s of the power density), "effective_samples" (valid seeds / cv^2) and
-"spectral_stderr_W", and for a weighted list "annual_energy_ci95_MWh" [lo, hi] and
+"spectral_stderr_W" and "expected_power_W" (linear theory's, for a spread sea the
+spreading-weighted sum over directions), per sea "direction_deg", "spread_deg" and
+"spreading" when given, and for a weighted list "annual_energy_ci95_MWh" [lo, hi] and
 "annual_energy_budget": {"components": [{"component" (statistical, model, radiation_fit,
 parameters, resource), "type" (A or B), "over_seas" (quadrature, linear, one term),
 "std_MWh" (null when absent), "dof", "source", "absent" (why not, or null),
@@ -97,6 +108,7 @@ Examples:
       --design --json
   mbcontrol sweep sphere --hs 1 2 3 --tp 8 10 --controller passive --set damping=4e5 \
       --seeds 4 --amplitudes random --json
+  mbcontrol sweep oswec --seas ../shared/data/sites/pacwave_cluster_32.csv --spread 30 --json
   mbcontrol sweep array_grid --scene-param n=3 --scene-param scale=25 --isolated n=1 \
       --seas ../shared/data/sites/pacwave_cluster_32.csv --vary direction=0,45
 """
@@ -130,6 +142,11 @@ def add_parser(sub) -> None:
     p.add_argument("--robust", action="store_true",
                    help="with --design: a reactive law within the robustness floors (gain "
                         "margin 2, phase margin 30 deg at the least)")
+    p.add_argument("--spread", type=float, metavar="DEG",
+                   help="short-crested seas: every sea's directional spread sigma, degrees\n"
+                        "(0 long-crested, below 81; overrides a --seas file's spread column)")
+    p.add_argument("--spreading", choices=("cos2s", "mitsuyasu"), default=None,
+                   help="the spreading function (cos2s: one s; mitsuyasu: s peaks at Tp)")
     p.add_argument("--seeds", type=int, default=1, help="wave realisations per sea (1)")
     p.add_argument("--amplitudes", choices=("deterministic", "random"), default="deterministic",
                    help="deterministic: a = sqrt(2 S dw), the expected power (default); random: "
@@ -168,6 +185,22 @@ def _design_line(row: dict) -> str:
     return f"designed: {settings}; {share}{outside}{fragile}"
 
 
+def spread_seas(seas, spread_deg: float | None, kind: str | None):
+    """The seas with --spread (degrees, sigma; for every sea) and --spreading applied."""
+    import dataclasses
+    import math
+
+    from ..waves.sites import SPREAD_MAX_DEG
+    if spread_deg is not None:
+        if not 0 <= spread_deg < SPREAD_MAX_DEG:
+            raise ValueError(f"--spread {spread_deg:g}: expected a directional spread sigma from "
+                             f"0 (long-crested) to below {SPREAD_MAX_DEG:.2f} degrees")
+        seas = [dataclasses.replace(s, spread=math.radians(spread_deg)) for s in seas]
+    if kind is not None:
+        seas = [dataclasses.replace(s, spreading=kind) for s in seas]
+    return seas
+
+
 def _workers(given: int | None) -> int | None:
     """--workers (else the \"sweep.workers\" default) as sweep() takes it: -1 -> None (one per
     core), 0 serial, N."""
@@ -192,6 +225,7 @@ def run_sweep(args) -> int:
         if args.tp:
             raise ValueError("--tp goes with --hs; a --seas file gives its own periods")
         seas = read_seas(args.seas, args.gamma)
+    seas = spread_seas(seas, args.spread, args.spreading)
     if args.set and not args.controller:
         raise ValueError("--set needs --controller")
     cls = REGISTRY.get(args.controller) if args.controller else None

@@ -15,6 +15,9 @@ time convention e^{-iωt}, excitation per unit wave amplitude at the n-frame ori
 - ``excitation_force`` = ``froude_krylov_force`` + ``diffraction_force`` (wave_direction, omega, influenced_dof)
 - ``displaced_volume``, ``waterplane_area``, ``mass`` (body); ``center_of_buoyancy``, ``cog`` (body, xyz)
 
+Wave directions: the excitation between the data's headings, the headings a spread sea needs and
+axisymmetric data (module data.headings; `HydroModel.excitation_at`).
+
 Arrays: a mirror-symmetric layout is solved on its planes (module bem.array_bem); many bodies' radiation
 is fitted column by column (module fit.array_fit, :func:`fit_radiation_columns`).
 """
@@ -23,6 +26,8 @@ from .fit.baseline import fit_radiation_hankel
 from .bem.solve import cache_key, compute
 from .data.dataset import matrix
 from .data.frames import dof_map, shift_matrix, skew, to_body_frames, zup_to_ned
+from .data.headings import (axisymmetric_headings, covering_headings, covers_circle, heading_matrix,
+                            headings_for_spread, headings_line)
 from .mesh.geometry import RIGID_DOFS, BemBody, hull_mesh, lid_mesh, validate_body
 from .model import HydroModel, fit_hydro_model, fit_method, geometry_dict, load_hydro_data, load_hydro_model
 from .fit.passivity import PassivityReport, absorbed_energy, enforce_passivity, passivity_test
@@ -36,5 +41,7 @@ __all__ = [
     "to_body_frames", "dof_map", "shift_matrix", "skew", "zup_to_ned",
     "RadiationModel", "fit_radiation", "fit_radiation_columns", "impulse_response", "convolution_force", "kernel_data",
     "PassivityReport", "passivity_test", "enforce_passivity", "absorbed_energy", "fit_radiation_hankel",
+    "headings_for_spread", "headings_line", "covering_headings", "covers_circle",
+    "heading_matrix", "axisymmetric_headings",
     "HydroModel", "load_hydro_model", "load_hydro_data", "fit_hydro_model", "fit_method", "geometry_dict",
 ]

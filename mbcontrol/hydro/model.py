@@ -22,12 +22,13 @@ from ..atomic import atomic_path
 from ..cache import cache_dir, status
 from ..errors import HydroError
 from ..scene import DOF_NAMES, Scene
-from ..waves import Wave, excitation_series, interpolate_complex
+from ..waves import Wave, coefficient_series, excitation_series, interpolate_complex
 from .fit import (array_fit, array_passivity, fit_error, passive_order, passivity, radiation, response_error, sdp,
                   vector_fit)
 from .data.netcdf import read_netcdf
 from .bem.solve import compute
 from .mesh.geometry import BemBody
+from .data.headings import axisymmetric_headings, excitation_over_headings, heading_matrix, headings_line
 from .bem.isolated import compute_isolated
 from .bem.neighbours import compute_within
 from .fit.radiation import RadiationModel, fit_radiation
@@ -75,14 +76,42 @@ class HydroModel:
         i = int(np.argmin(np.abs(directions - direction)))
         if abs(directions[i] - direction) > 1e-6:
             raise HydroError(f"{self.source}: no excitation data for wave direction "
-                             f"{direction:.4g} rad; the data has {np.round(directions, 4)}")
+                             f"{direction:.4g} rad; the data has {np.round(directions, 4)} "
+                             f"(to compute it, the scene's [hydro] table: "
+                             f"{headings_line([direction])})")
         da = self.data["excitation_force"].isel(wave_direction=i)
         return da.sel(influenced_dof=list(self.dofs)).transpose("omega", "influenced_dof").values
 
+    def excitation_at(self, omega, direction=0.0) -> np.ndarray:
+        """Complex excitation per unit amplitude (n, n_dof), exp(-i omega t), at frequencies
+        omega (rad/s, n) travelling in `direction` (rad, NED): one float (the data's heading,
+        matched exactly, as `excitation_coefficients`) or one direction per frequency (a spread
+        sea's components), interpolated between the data's headings (module headings).
+        Frequencies are interpolated linearly, never extrapolated (ValueError outside the
+        band); a direction outside the data's headings raises HydroError."""
+        omega = np.asarray(omega, float)
+        if np.ndim(direction) == 0:
+            return interpolate_complex(self.omega, self.excitation_coefficients(direction), omega)
+        direction = np.asarray(direction, float)
+        if direction.shape != omega.shape:
+            raise ValueError(f"{self.source}: one wave direction per frequency expected, got "
+                             f"{direction.size} directions for {omega.size} frequencies")
+        weights = heading_matrix(self.data["wave_direction"].values, direction, self.source)
+        data = self.data["excitation_force"].sel(influenced_dof=list(self.dofs)).transpose(
+            "wave_direction", "omega", "influenced_dof").values
+        per_heading = np.zeros((data.shape[0], omega.size, data.shape[2]), complex)
+        for j in np.flatnonzero(np.any(weights != 0, axis=0)):
+            per_heading[j] = interpolate_complex(self.omega, data[j], omega)
+        return excitation_over_headings(per_heading, weights)
+
     def excitation(self, wave: Wave, t) -> np.ndarray:
         try:
+            if wave.directional:
+                return coefficient_series(wave, self.excitation_at(wave.omega, wave.direction), t)
             return excitation_series(wave, self.omega, self.excitation_coefficients(
                 wave.direction), t)
+        except HydroError:
+            raise
         except ValueError as exc:
             raise HydroError(f"{self.source}: {exc}") from None
 
@@ -179,6 +208,8 @@ def load_hydro_data(scene: Scene, dofs) -> tuple[str, xr.Dataset]:
     else:
         source, data = _run_bem(scene, dofs)
     _check_dofs(data, dofs, source)
+    if scene.hydro.axisymmetric:           # one heading serves all (module headings)
+        data = axisymmetric_headings(data, f"{scene.path}: [hydro] axisymmetric: {source}")
     return source, data
 
 

@@ -8,7 +8,7 @@ import numpy as np
 
 from ..errors import FidelityError
 from ..scene import DOF_NAMES, Scene
-from ..waves import Wave, interpolate_complex
+from ..waves import Wave
 from .jacobians import jacobians
 from .process import ProcessPlant
 
@@ -111,8 +111,7 @@ def _linear_rms(plant, wave, outputs):
     if n_w == 0:
         return np.zeros(0), np.zeros(len(outputs))
     hydro = plant.hydro
-    F = interpolate_complex(hydro.omega, hydro.excitation_coefficients(wave.direction),
-                            wave.omega) * wave.amplitude[:, None]           # (m, n_w)
+    F = hydro.excitation_at(wave.omega, wave.direction) * wave.amplitude[:, None]           # (m, n_w)
     rms_w = np.sqrt(0.5 * np.sum(np.abs(F) ** 2, axis=0))
     A, _, Bw, C, _, Dw = (np.asarray(M) for M in jacobians(plant)(
         plant.x0(), np.zeros(len(plant.inputs)), np.zeros(n_w), plant.p0))

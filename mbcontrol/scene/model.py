@@ -245,6 +245,8 @@ class HydroSettings:
     interaction: bool = True                   # False: each body solved alone (hydro.bem.isolated)
     interaction_radius: float = math.inf       # m: couple bodies only within it (hydro.bem.neighbours)
     hydrostatics: str = "linear"               # "linear" | "large_angle" (box, cylinder, sphere)
+    axisymmetric: bool = False                 # bodies of revolution on the z axis, in heave:
+                                               # one heading's excitation serves every direction
 
 
 @dataclass(frozen=True)

@@ -267,7 +267,7 @@ def _hydro(r: Reader, path: Path) -> HydroSettings:
         return HydroSettings()
     r.allow("file", "panel_size", "omega", "headings", "lid", "radiation_tol", "dofs",
             "source", "source_bodies", "source_options", "fit_omega_max", "response_band", "interaction",
-            "interaction_radius", "hydrostatics", "radiation_fit", "fit_judged_by")
+            "interaction_radius", "hydrostatics", "radiation_fit", "fit_judged_by", "axisymmetric")
     band = r.finite_list("response_band", "frequency", default=()) or None
     if band is not None and not (len(band) == 2 and 0 <= band[0] < band[1]):
         r.fail("response_band", f"expected [low, high] in rad/s with 0 <= low < high, got {band}")
@@ -296,7 +296,8 @@ def _hydro(r: Reader, path: Path) -> HydroSettings:
         source_bodies=tuple(r.string_list("source_bodies", default=())),
         source_options=_source_options(r.table("source_options", required=False)),
         interaction=interaction, interaction_radius=radius,
-        hydrostatics=r.choice("hydrostatics", ("linear", "large_angle"), default="linear"))
+        hydrostatics=r.choice("hydrostatics", ("linear", "large_angle"), default="linear"),
+        axisymmetric=r.boolean("axisymmetric", default=False))
 
 
 def _source_options(r: Reader) -> dict:

@@ -188,6 +188,8 @@ MEANING = {
                                 "the device's response; \"kernel\": by K(jω)'s own error",
     ("hydro", "response_band"): "[low, high]: limits where the fit's response error is judged",
     ("hydro", "hydrostatics"): "`large_angle`: buoyancy of the immersed primitive at its pose",
+    ("hydro", "axisymmetric"): "true: bodies of revolution on the z axis in heave; the data's "
+                               "one heading serves every wave direction",
     ("hydro.omega", "min"): "first frequency",
     ("hydro.omega", "max"): "last frequency",
     ("hydro.omega", "n"): "number of frequencies",

@@ -202,18 +202,23 @@ _COEFFICIENTS: dict = {}
 
 def excitation_at_nodes(plant, wave, n: int, dt: float, nodes) -> np.ndarray:
     """Excitation (n, len(nodes), n_w) at t_i + c dt for every step i and node c."""
-    from ..waves import excitation_at_offsets
+    from ..errors import HydroError
+    from ..waves import coefficient_offsets, excitation_at_offsets
     nw = len(plant.disturbances)
     if wave is None or nw == 0:
         return np.zeros((n, len(nodes), nw))
-    key = (id(plant), wave.direction)
-    if key not in _COEFFICIENTS:         # the data's coefficients: selected once per plant
-        _COEFFICIENTS[key] = (plant.hydro.excitation_coefficients(wave.direction), plant)
     try:
+        if wave.directional:            # a spread sea: each component's own direction
+            coeffs = plant.hydro.excitation_at(wave.omega, wave.direction)
+            return coefficient_offsets(wave, coeffs, n, dt, nodes)
+        key = (id(plant), wave.direction)
+        if key not in _COEFFICIENTS:     # the data's coefficients: selected once per plant
+            _COEFFICIENTS[key] = (plant.hydro.excitation_coefficients(wave.direction), plant)
         return excitation_at_offsets(wave, plant.hydro.omega, _COEFFICIENTS[key][0], n, dt,
                                      nodes)
+    except HydroError:
+        raise
     except ValueError as exc:
-        from ..errors import HydroError
         raise HydroError(f"{plant.hydro.source}: {exc}") from None
 
 
@@ -333,8 +338,6 @@ def cvodes_integrator(plant, wave_terms, t_grid, rtol=1e-8, atol=1e-10,
 
 def wave_terms(plant, wave):
     """(omega, Fc, Fs, ramp) of the excitation: Re(a F e^{-i(wt+phi)}) = Fc cos wt + Fs sin wt."""
-    from ..waves import interpolate_complex
-    coeffs = interpolate_complex(plant.hydro.omega, plant.hydro.excitation_coefficients(
-        wave.direction), wave.omega)                                      # (m, nw)
+    coeffs = plant.hydro.excitation_at(wave.omega, wave.direction)       # (m, nw)
     c = (wave.amplitude * np.exp(-1j * wave.phase))[:, None] * coeffs
     return wave.omega, c.real.T, c.imag.T, wave.ramp_time

@@ -163,15 +163,16 @@ def excitation_at_nodes(plant, wave, n: int, dt: float, nodes) -> np.ndarray:
 
 def _coefficients(plant, wave) -> np.ndarray:
     from ..errors import HydroError
-    from ..waves import interpolate_complex
-    key = (id(plant), wave.direction, wave.omega.size, float(wave.omega[0]),
+    direction = wave.direction if not wave.directional else np.asarray(wave.direction).tobytes()
+    key = (id(plant), direction, wave.omega.size, float(wave.omega[0]),
            float(wave.d_omega))
     if key not in _COEFFICIENTS:
         if len(_COEFFICIENTS) > 256:
             _COEFFICIENTS.clear()
         try:
-            coeffs = interpolate_complex(plant.hydro.omega, plant.hydro.excitation_coefficients(
-                wave.direction), wave.omega)
+            coeffs = plant.hydro.excitation_at(wave.omega, wave.direction)
+        except HydroError:
+            raise
         except ValueError as exc:
             raise HydroError(f"{plant.hydro.source}: {exc}") from None
         _COEFFICIENTS[key] = (coeffs, plant)          # the plant kept alive: its id stays unique

@@ -1,21 +1,22 @@
 """The sea, in one place: spectra and their moments, dispersion, realisations (regular,
-irregular, measured records) and the one band-clipping rule, excitation synthesis, energy flux
+irregular, measured records) and the one band-clipping rule, excitation synthesis, directional spreading, energy flux
 in finite depth, site files (weighted sea lists, NDBC buoy spectra, occurrence tables) and
 annual energy.
 
 Modules, one concept each: `spectra`, `dispersion`, `synthesis`, `realisation`, `excitation`,
-`flux`, `sites`, `annual`. Everything public is re-exported here
+`spreading`, `flux`, `sites`, `annual`. Everything public is re-exported here
 (`from mbcontrol.waves import irregular`). The package imports no stage of the flow.
 """
 from .annual import HOURS_PER_YEAR, annual_energy_MWh, bin_seas
 from .dispersion import group_velocities, group_velocity, wavenumber
-from .excitation import (excitation_at_offsets, excitation_impulse_response,
+from .excitation import (coefficient_offsets, coefficient_series, excitation_at_offsets, excitation_impulse_response,
                          excitation_series, interpolate_complex)
 from .flux import deep_water_flux, energy_flux, spectrum_energy_flux
 from .realisation import (DEFAULT_BAND, Wave, band_limits, from_args, from_elevation,
                           irregular, regular, variance_outside)
 from .sites import (SeaState, grid, occurrence, read_ndbc_spectra, read_seas,
                     read_year_weights, site_energy_flux)
+from .spreading import Spreading, component_directions, spread_from_s
 from .spectra import gamma_for_te_over_tp, jonswap_spectrum, moment, spectral_hm0_te, te_over_tp
 from .synthesis import ramp
 
@@ -25,9 +26,10 @@ __all__ = [
     "jonswap_spectrum", "moment", "spectral_hm0_te", "te_over_tp", "gamma_for_te_over_tp",
     "wavenumber", "group_velocity", "group_velocities",
     "excitation_series", "excitation_at_offsets", "excitation_impulse_response",
-    "interpolate_complex",
+    "interpolate_complex", "coefficient_series", "coefficient_offsets",
     "energy_flux", "spectrum_energy_flux", "deep_water_flux",
     "SeaState", "grid", "read_seas", "read_year_weights", "site_energy_flux",
     "read_ndbc_spectra", "occurrence",
+    "Spreading", "component_directions", "spread_from_s",
     "HOURS_PER_YEAR", "annual_energy_MWh", "bin_seas",
 ]

@@ -32,6 +32,12 @@ def excitation_series(wave: Wave, omega_data, force_data, t) -> np.ndarray:
     """
     omega_data = np.asarray(omega_data, dtype=float)
     coeffs = interpolate_complex(omega_data, np.asarray(force_data), wave.omega)
+    return coefficient_series(wave, coeffs, t)
+
+
+def coefficient_series(wave: Wave, coeffs, t) -> np.ndarray:
+    """Excitation time series (len(t), n_dof) from each component's own coefficients
+    (n_components, n_dof), complex per unit amplitude (a spread sea's, one direction each)."""
     weights = (wave.amplitude * np.exp(-1j * wave.phase))[:, None] * coeffs   # (n_comp, n_dof)
     t = np.asarray(t, dtype=float)
     series = _synthesise(wave, weights, t)
@@ -47,6 +53,11 @@ def excitation_at_offsets(wave: Wave, omega_data, force_data, n: int, dt: float,
     """
     coeffs = interpolate_complex(np.asarray(omega_data, float), np.asarray(force_data),
                                  wave.omega)
+    return coefficient_offsets(wave, coeffs, n, dt, offsets)
+
+
+def coefficient_offsets(wave: Wave, coeffs, n: int, dt: float, offsets) -> np.ndarray:
+    """`excitation_at_offsets` from each component's own coefficients (n_components, n_dof)."""
     weights = (wave.amplitude * np.exp(-1j * wave.phase))[:, None] * coeffs
     out = np.empty((n, len(offsets), weights.shape[1]))
     for j, c in enumerate(offsets):

@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .spectra import jonswap_spectrum
+from .spreading import Spreading, component_directions
 from .synthesis import _synthesise, ramp
 
 DEFAULT_BAND = (0.3, 4.0)       # an irregular sea's components: 0.3 to 4 times the peak frequency
@@ -28,7 +29,8 @@ class Wave:
     omega: np.ndarray
     amplitude: np.ndarray
     phase: np.ndarray
-    direction: float = 0.0                       # rad, NED: travelling towards +x, +y starboard
+    direction: float | np.ndarray = 0.0          # rad, NED: travelling towards +x, +y starboard;
+                                                 # per component (array) in a spread sea
     ramp_time: float = 0.0                       # s, half-cosine ramp from zero
     settings: dict = field(default_factory=dict)  # what made it (for provenance), incl. seed
     d_omega: float | None = None                 # uniform grid spacing, when on one
@@ -44,8 +46,23 @@ class Wave:
         """Regular wave period, or the peak period of a spectrum (s)."""
         return self.settings.get("period") or self.settings.get("tp")
 
+    @property
+    def directional(self) -> bool:
+        """True when each component has its own direction (a short-crested sea)."""
+        return np.ndim(self.direction) > 0
+
+    @property
+    def mean_direction(self) -> float:
+        """The sea's direction (rad): the float one, or its spreading's mean direction."""
+        if not self.directional:
+            return float(self.direction)
+        return float(self.settings.get("mean_direction_rad",
+                                       np.angle(np.sum(self.amplitude ** 2
+                                                       * np.exp(1j * self.direction)))))
+
     def describe(self) -> dict:
-        return {"type": self.kind, **self.settings, "direction_rad": self.direction,
+        direction = self.mean_direction if self.directional else self.direction   # as given
+        return {"type": self.kind, **self.settings, "direction_rad": direction,
                 "ramp_s": self.ramp_time, "n_components": int(self.omega.size)}
 
 
@@ -92,7 +109,7 @@ def irregular(hs: float, tp: float, *, gamma: float = 3.3, seed: int = 0,
               duration: float = 600.0, band: tuple[float, float] = DEFAULT_BAND,
               direction: float = 0.0, ramp_time: float | None = None,
               kind: str = "jonswap", data_band=None,
-              amplitudes: str = "deterministic") -> Wave:
+              amplitudes: str = "deterministic", spreading: Spreading | None = None) -> Wave:
     """An irregular sea with random phases (seeded) on a uniform grid covering `duration`.
 
     Components span band[0]..band[1] times the peak frequency, cut to data_band (rad/s, the
@@ -104,6 +121,12 @@ def irregular(hs: float, tp: float, *, gamma: float = 3.3, seed: int = 0,
     after the phases from the same seed (the phases are those of the deterministic sea), no
     rescaling, so each record's Hs and power scatter as a measured record's do (Tucker,
     Challenor & Carter 1984); settings["amplitudes"] says so. Ramp: 2 Tp by default.
+
+    spreading (`waves.Spreading`): a short-crested sea, each component travelling in its own
+    direction (`spreading.component_directions`, from the same seed, its own stream: phases and
+    amplitudes are those of the long-crested sea) around spreading.mean, which replaces
+    `direction`; settings record the spreading (`Spreading.describe`) and, with a sector
+    narrower than the circle, "spreading_outside" (the largest share of D cut off).
     """
     if hs <= 0 or tp <= 0 or gamma < 1:
         raise ValueError(f"{kind}: expected hs > 0, tp > 0, gamma >= 1; got {hs}, {tp}, {gamma}")
@@ -131,6 +154,11 @@ def irregular(hs: float, tp: float, *, gamma: float = 3.3, seed: int = 0,
         settings["amplitudes"] = "random"
     if data_band is not None:
         settings["spectrum_outside_data"] = variance_outside(hs, tp, gamma_used, band, kept)
+    if spreading is not None:
+        direction = component_directions(spreading, omega, wp, seed)
+        settings.update(spreading.describe())
+        if spreading.sector < math.pi:
+            settings["spreading_outside"] = float(np.max(spreading.outside(omega, wp)))
     return Wave(kind, omega, amplitude, phase, direction, ramp_time, settings, d_omega)
 
 

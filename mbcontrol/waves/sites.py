@@ -31,13 +31,24 @@ WEIGHT_SUM_TOLERANCE = 0.02        # a weighted list's weights must sum to 1 wit
 class SeaState:
     """A JONSWAP sea: significant height hs (m), peak period tp (s), peak enhancement gamma,
     and its weight (share of the year; NaN on a grid that carries no occurrence); te (s) and
-    j (W/m) are the energy period and energy flux the source gave (NaN when it gave none)."""
+    j (W/m) are the energy period and energy flux the source gave (NaN when it gave none);
+    direction (rad, NED: where the waves travel to) and spread (rad, the circular standard
+    deviation of a `spreading` function, "cos2s" or "mitsuyasu"; waves.Spreading): NaN when not
+    given (the data's heading; long-crested), spread 0 long-crested."""
     hs: float
     tp: float
     gamma: float = 3.3
     weight: float = math.nan
     te: float = math.nan                 # energy period (s), when the source gave it
     j: float = math.nan                  # energy flux (W/m), when the source gave it
+    direction: float = math.nan          # rad, NED mean direction, when given
+    spread: float = math.nan             # rad, directional spread sigma, when given
+    spreading: str = "cos2s"             # the spreading function's kind (waves.Spreading)
+
+    @property
+    def spread_given(self) -> bool:
+        """True for a short-crested sea (a spread sigma > 0)."""
+        return math.isfinite(self.spread) and self.spread > 0
 
 
 def grid(hs, tp, gamma: float = 3.3) -> list[SeaState]:
@@ -65,8 +76,10 @@ def site_energy_flux(sea: SeaState, depth: float = math.inf, rho: float = RHO,
 
 def read_seas(path, gamma: float = 3.3) -> list[SeaState]:
     """Sea states from a CSV with columns Hm0 and Tp and/or Te (only Te: Tp = Te / (Te/Tp of
-    the JONSWAP spectrum of this gamma)), optional weights (summing to 1) and J (W/m, the
-    site's energy flux). Errors name the file, row and column."""
+    the JONSWAP spectrum of this gamma)), optional weights (summing to 1), J (W/m, the
+    site's energy flux), direction (degrees, NED: where the waves travel to, +x towards +y)
+    and spread (degrees, the directional spread sigma, 0 to 81: `waves.Spreading`; 0 is
+    long-crested), kept in radians. Errors name the file, row and column."""
     path = Path(path)
     try:
         with path.open(newline="") as fh:
@@ -85,9 +98,9 @@ def read_seas(path, gamma: float = 3.3) -> list[SeaState]:
     seas = []
     for i, row in enumerate(rows, start=2):              # row 1 is the header
         values = {}
-        for name in ("Hm0", period, "weights", "Te", "J"):
+        for name in ("Hm0", period, "weights", "Te", "J") + DIRECTIONAL:
             text = (row.get(name) or "").strip()
-            if name in ("weights", "Te", "J") and not text:
+            if name in ("weights", "Te", "J") and not text or name not in columns:
                 continue
             try:
                 values[name] = float(text)
@@ -101,9 +114,12 @@ def read_seas(path, gamma: float = 3.3) -> list[SeaState]:
         if values.get("weights", 0.0) < 0:
             raise ValueError(f"{path}: row {i}, column weights: expected >= 0, got "
                              f"{values['weights']:g}")
+        _check_directional(path, i, values)
         tp = values[period] if period == "Tp" else values[period] / ratio
         seas.append(SeaState(values["Hm0"], tp, gamma, values.get("weights", math.nan),
-                             values.get("Te", math.nan), values.get("J", math.nan)))
+                             values.get("Te", math.nan), values.get("J", math.nan),
+                             math.radians(values.get("direction", math.nan)),
+                             math.radians(values.get("spread", math.nan))))
     weights = [s.weight for s in seas]
     if "weights" in columns:
         if any(math.isnan(w) for w in weights):
@@ -118,6 +134,22 @@ def read_seas(path, gamma: float = 3.3) -> list[SeaState]:
                           UserWarning, stacklevel=2)
             seas = [dataclasses.replace(s, weight=s.weight / total) for s in seas]
     return seas
+
+
+DIRECTIONAL = ("direction", "spread")     # optional seas-file columns, degrees
+SPREAD_MAX_DEG = math.degrees(math.sqrt(2.0))   # 81.03 deg: s = 0, the uniform distribution
+
+
+def _check_directional(path, row: int, values: dict) -> None:
+    """A seas file's direction (finite degrees) and spread (0 <= sigma < 81.03 degrees)."""
+    if "direction" in values and not math.isfinite(values["direction"]):
+        raise ValueError(f"{path}: row {row}, column direction: expected a finite angle "
+                         f"(degrees, NED: where the waves travel to), got {values['direction']:g}")
+    spread = values.get("spread", 0.0)
+    if not 0 <= spread < SPREAD_MAX_DEG:
+        raise ValueError(f"{path}: row {row}, column spread: expected a directional spread "
+                         f"sigma from 0 (long-crested) to below {SPREAD_MAX_DEG:.2f} degrees "
+                         f"(cos-2s, s > 0), got {spread:g}")
 
 
 def read_year_weights(path) -> dict[str, np.ndarray]:

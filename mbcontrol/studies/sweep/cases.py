@@ -55,6 +55,12 @@ class Case:
                 record.pop(flag)
         if record["amplitudes"] == "deterministic":
             record.pop("amplitudes")
+        sea = record["sea"]             # a long-crested sea keeps the key it had before
+        for name in ("direction", "spread"):
+            if sea[name] != sea[name]:   # NaN: not given
+                sea.pop(name)
+        if "spread" not in sea or sea["spread"] == 0:
+            sea.pop("spreading")
         text = json.dumps(record, sort_keys=True, default=float)
         return hashlib.sha256(text.encode()).hexdigest()[:20]
 

@@ -93,15 +93,21 @@ def run_case(case) -> dict:
 def sea_wave(plant, sea, duration: float, *, seed: int = 0, direction: float | None = None,
              amplitudes: str = "deterministic"):
     """The wave a case of `sea` runs in: JONSWAP cut to the hydro data's band, seeded; its
-    heading the data's one heading, or `direction` (rad), or 0."""
+    direction `direction` (rad, --vary direction), else the sea's own (a seas file's
+    column), else the data's one heading, or 0. A sea with a spread is short-crested: its
+    spreading about that direction (`directional.sea_spreading`), one direction per
+    component."""
     from ... import waves
+    from .directional import sea_spreading
     headings = plant.hydro.data["wave_direction"].values
     omega = plant.hydro.omega
+    if direction is None and math.isfinite(sea.direction):
+        direction = sea.direction
     if direction is None:
         direction = float(headings[0]) if len(headings) == 1 else 0.0
     return waves.irregular(sea.hs, sea.tp, gamma=sea.gamma, seed=seed, duration=duration,
                            data_band=(float(omega[0]), float(omega[-1])), direction=direction,
-                           amplitudes=amplitudes)
+                           amplitudes=amplitudes, spreading=sea_spreading(plant, sea, direction))
 
 
 def failed_record(case, exc: BaseException, start: float) -> dict:

@@ -61,7 +61,9 @@ def spectral_row(plant, wave, rms, gains, duration: float, amplitudes: str, n_va
                  mean_power: float | None) -> dict:
     """A sea's spectral entries (wave, rms: `sea_components`): "spectral_cv" (one record's),
     "effective_samples" (over its valid seeds: n / cv^2), "spectral_stderr_W" (cv x the
-    mean power / sqrt(n)), "bandwidth_hz" (Bendat & Piersol's B_s of the power density)."""
+    mean power / sqrt(n)), "bandwidth_hz" (Bendat & Piersol's B_s of the power density),
+    "expected_power_W" (linear theory's expected power: for a spread sea weighted over
+    directions, `expected_power`)."""
     from ...analysis.power_statistics import record_power_statistics
     amplitude = rms if amplitudes == "random" else wave.amplitude
     stats = record_power_statistics(plant, wave.omega, amplitude, gains,
@@ -70,18 +72,36 @@ def spectral_row(plant, wave, rms, gains, duration: float, amplitudes: str, n_va
     n = max(n_valid, 1)
     base = mean_power if isinstance(mean_power, float) and math.isfinite(mean_power) \
         else stats["mean_power_W"]
+    expected = stats["mean_power_W"]
+    if wave.directional and "spreading" in wave.settings:
+        import dataclasses
+        expected = expected_power(plant, dataclasses.replace(wave, amplitude=amplitude), gains)
     return {"spectral_cv": stats["cv"], "effective_samples": n * stats["effective_samples"],
             "spectral_stderr_W": stats["cv"] * base / math.sqrt(n),
-            "bandwidth_hz": stats["bandwidth_hz"]}
+            "bandwidth_hz": stats["bandwidth_hz"], "expected_power_W": float(expected)}
 
 
 def expected_power(plant, wave, gains, *, params=None, statespace: bool = False) -> float:
     """Linear theory's mean absorbed power (W) in `wave` over whole repeat periods, with the
     BEM data straight (statespace False) or with the radiation fit the plant steps
-    (`analysis.statespace_response` of the model linearised with the law in place)."""
+    (`analysis.statespace_response` of the model linearised with the law in place). A spread
+    sea's (settings with a spreading): the expected power, weighted over directions
+    (`directional.spread_power`), not its realisation's one direction per component."""
     from ...analysis import linearize, statespace_response
     from ...analysis.power_statistics import law_params, law_responses
     a2 = np.asarray(wave.amplitude, float) ** 2
+    if wave.directional and "spreading" in wave.settings:   # a spread sea: over directions
+        from ...analysis import excitation_transfer
+        from .directional import spread_power
+        outputs = [f"{name}__velocity" for name in gains]
+        values = law_params(plant, gains, params)
+        sys = linearize(plant, params=values, outputs=outputs) if statespace else None
+        G = excitation_transfer(plant, wave.omega, params=values, outputs=outputs, sys=sys)
+
+        def velocities(direction):          # linear in the excitation: one G for all
+            F = np.conj(plant.hydro.excitation_at(wave.omega, direction))
+            return np.einsum("ioh,ih->io", G, F)
+        return spread_power(plant, wave, velocities, [c for c, _ in gains.values()])
     if not statespace:
         responses = law_responses(plant, wave.omega, gains, direction=wave.direction,
                                   params=params)

@@ -166,6 +166,10 @@ def _summary(ds, seas, run, wall, n_cases) -> dict:
                "failed_cases": int(failed.isel(sea=k).sum())}
         if not math.isnan(s.te):
             row["te"] = s.te
+        if not math.isnan(s.direction):     # a seas file's or the CLI's direction and spread
+            row["direction_deg"] = math.degrees(s.direction)
+        if not math.isnan(s.spread):
+            row.update(spread_deg=math.degrees(s.spread), spreading=s.spreading)
         if ds.sizes["seed"] > 1 and np.ndim(p) == 0:
             row.update(seed_statistics(ds["mean_power_W"].isel(sea=k).values))
         if "bound_W" in ds:                 # --design: the sea's settings and its bound
