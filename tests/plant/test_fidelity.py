@@ -246,6 +246,8 @@ panel_size = 0.5                    # coarse: a few seconds of BEM, resolved to 
 omega = { min = 0.3, max = 4.0, n = 12 }
 headings = [0.0, "45 deg"]
 radiation_tol = 0.02
+fit_judged_by = "kernel"            # the frozen model's fit must be the full one's: judged by the
+                                    # response, it would depend on the DOFs left (0.29 % apart)
 [[body]]
 name = "box"
 mass = 12300.0                      # rho x 4 x 3 x 1 m^3: floats at half its height
