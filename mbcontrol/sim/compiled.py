@@ -16,7 +16,6 @@ instead of compiling it again.
 """
 from __future__ import annotations
 
-import contextlib
 import hashlib
 import os
 import shutil
@@ -29,7 +28,7 @@ from pathlib import Path
 import casadi as ca
 
 from ..atomic import write_text
-from ..cache import cache_dir, status
+from ..cache import cache_dir, exclusive, status
 
 # -O3 for this CPU, and reassociation so that the radiation model's dense products vectorise;
 # NaN and Inf keep their IEEE meaning (no -ffinite-math-only), so divergence is still caught.
@@ -131,30 +130,10 @@ def compile_function(fun: ca.Function, enabled: bool = True, optimise: bool = Tr
     library = folder / f"{fun.name()}_{key.hexdigest()[:20]}.so"
     if library.exists() and _verified(library):
         return ca.external(fun.name(), str(library))
-    with _build_lock(library):
+    with exclusive(library):   # a second process needing this code waits and loads it
         if library.exists() and _verified(library):     # another process just built it
             return ca.external(fun.name(), str(library))
         return _build(fun, source, flags, cc, folder, library)
-
-
-@contextlib.contextmanager
-def _build_lock(library: Path):
-    """Held while `library` is built: a second process needing the same code (a test
-    worker, a sweep's Dask worker) waits for the first and loads its library instead of
-    compiling it again (two test workers compiling raft3's 275-state chunk at once each took
-    twice as long). An advisory lock (fcntl), released by the kernel if its holder dies; where
-    fcntl is missing, no lock: concurrent builds stay safe, only wasteful."""
-    try:
-        import fcntl
-    except ImportError:
-        yield
-        return
-    with open(library.with_suffix(".lock"), "a") as handle:
-        fcntl.flock(handle, fcntl.LOCK_EX)
-        try:
-            yield
-        finally:
-            fcntl.flock(handle, fcntl.LOCK_UN)
 
 
 def _build(fun, source, flags, cc, folder: Path, library: Path) -> ca.Function:
@@ -174,7 +153,11 @@ def _build(fun, source, flags, cc, folder: Path, library: Path) -> ca.Function:
             warnings.warn(f"C compilation failed ({result.stderr[:300]}); using "
                           f"interpreted CasADi code", RuntimeWarning, stacklevel=3)
             return fun
-        status(f"compiled {fun.name()} in {time.perf_counter() - started:.1f} s", __name__)
+        seconds = time.perf_counter() - started
+        status(f"compiled {fun.name()} in {seconds:.1f} s", __name__)
+        with open(folder / "builds.log", "a") as log:     # what the cache cost, one line a build
+            log.write(f"{time.strftime('%Y-%m-%dT%H:%M:%S')}\t{fun.name()}\t"
+                      f"{len(source) // 1000} kB\t{seconds:.2f} s\t{flags[0]}\n")
         # the record first, then the library: a library is never there without its record
         write_text(library.with_suffix(".sha256"), _digest(built) + "\n")
         os.replace(built, library)        # atomic: readers never see half a library

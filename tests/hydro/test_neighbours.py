@@ -64,9 +64,11 @@ def test_neighbours_only_couple_and_the_error_shrinks_with_the_radius():
     assert near.attrs["distinct_clusters"] == 3          # two ends, and one interior shape for three
     B = near["radiation_damping"].sel(omega=5.0).values
     assert B[0, 1] != 0 and B[0, 2] == 0 and np.allclose(B, B.T)
-    cuts = {r: compute_within(bodies, radius=r, **KW) for r in (0.5, 1.0, 2.0, 3.0)}
+    # (a cluster is solved per distinct relative layout: at 2 m, five of three to five floats,
+    # 12 s; at 3 m another 14 s, so the test stops at 2 m)
+    cuts = {r: near if r == 1.0 else compute_within(bodies, radius=r, **KW) for r in (0.5, 1.0, 2.0)}
     errors = [cut_error(full, cut)["kernel"] for cut in cuts.values()]
-    assert errors[0] > errors[1] > errors[2] > errors[3] > 0, errors
+    assert errors[0] > errors[1] > errors[2] > 0, errors
     # radiated waves reach far: B_1j of the full solve does not fall off with distance here (kd
     # = 10 at 4 m), so even nearest neighbours leave a large error (the README's table)
     assert errors[1] > 0.1

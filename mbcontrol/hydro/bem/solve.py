@@ -23,7 +23,7 @@ import xarray as xr
 
 from mbcontrol.errors import HydroError
 
-from ...cache import progress_bar
+from ...cache import exclusive, progress_bar
 from ..data import netcdf
 from ..data.dataset import BODY_FRAME_UNITS
 from ..data.frames import to_body_frames
@@ -270,14 +270,24 @@ def compute(bodies: list[BemBody], *, rho: float, g: float, depth: float, omegas
     omegas, headings = _check_inputs(bodies, rho, g, depth, omegas, headings)
     rho, g, depth = float(rho), float(g), float(depth)
     key = cache_key(bodies, rho=rho, g=g, depth=depth, omegas=omegas, headings=headings, lid=lid)
-    path = Path(cache_dir) / f"bem_{key[:16]}.nc" if cache_dir is not None else None
-    if path is not None and path.exists():
-        ds = netcdf.read_netcdf(path, required=REQUIRED_VARS)
-        if ds.attrs.get("cache_key") != key:
-            raise HydroError(f"{path}: cache_key attribute {ds.attrs.get('cache_key')!r} does not match the "
-                             f"inputs ({key}); expected the dataset of these inputs — delete the file")
+    if cache_dir is None:
+        return _solve_bem(bodies, rho, g, depth, omegas, headings, lid, progress, n_jobs, key)
+    path = Path(cache_dir) / f"bem_{key[:16]}.nc"
+    with exclusive(path):       # a second process asking for the same solve waits and loads it
+        if path.exists():
+            ds = netcdf.read_netcdf(path, required=REQUIRED_VARS)
+            if ds.attrs.get("cache_key") != key:
+                raise HydroError(f"{path}: cache_key attribute {ds.attrs.get('cache_key')!r} does "
+                                 f"not match the inputs ({key}); expected the dataset of these "
+                                 f"inputs — delete the file")
+            return ds
+        ds = _solve_bem(bodies, rho, g, depth, omegas, headings, lid, progress, n_jobs, key)
+        netcdf.write_netcdf_atomic(ds, path)
         return ds
 
+
+def _solve_bem(bodies, rho, g, depth, omegas, headings, lid, progress, n_jobs, key) -> xr.Dataset:
+    """compute's BEM solve itself (no cache), its dataset tagged with the inputs' `key`."""
     import capytaine as cpt
 
     fbs, hydro, use_sym, removed = _capytaine_bodies(bodies, lid, depth)
@@ -343,7 +353,5 @@ def compute(bodies: list[BemBody], *, rho: float, g: float, depth: float, omegas
         "cache_key": key, "solve_seconds": seconds,
         "created": datetime.datetime.now().isoformat(timespec="seconds"),
     })
-    if path is not None:
-        netcdf.write_netcdf_atomic(ds, path)
     return ds
 
