@@ -23,6 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.linalg import cho_factor, cho_solve
+from scipy.linalg.blas import dsyrk
 
 
 @dataclass(frozen=True)
@@ -67,21 +68,35 @@ def fourier_gram(k, beta, n_t: int):
     return gram
 
 
+# The DFT's round-off is of the order of its largest weight: rows within DFT_RANGE of the least
+# weight go through it (every row in the first iterations), heavier ones through the product.
+DFT_RANGE = 1e6
+
+
+def _weighted_gram(C, w):
+    """C' diag(w) C, upper triangle only (what cho_factor(lower=False) reads): one BLAS syrk,
+    half the flops of the plain product."""
+    A = np.sqrt(w)[:, None] * C
+    return dsyrk(1.0, A.T, trans=0, lower=0)        # A.T is Fortran-ordered: no copy
+
+
 def _normal_factor(h, C, w, gram):
     """Cholesky factor of diag(h) + C' diag(w) C. Near the optimum w spans ~20 decades (active
     rows huge, the rest tiny); a DFT of w spreads the round-off of the huge ones over every
-    entry, so those rows go through the dense product (few) and the DFT takes the rest."""
-    big = w > 1e-6 * np.max(w)
+    entry, so those rows (above DFT_RANGE times the least, and above 1e-6 of the largest) go
+    through the dense product (few) and the DFT takes the rest."""
+    big = w > max(1e-6 * np.max(w), DFT_RANGE * np.min(w))
     if gram is None or big.mean() > 0.5:
-        K = C.T @ (w[:, None] * C)
+        K = _weighted_gram(C, w)
     else:
-        Cb = C[big]
-        K = Cb.T @ (w[big, None] * Cb) + gram(np.where(big, 0.0, w))
+        K = gram(np.where(big, 0.0, w))
+        if big.any():
+            K += _weighted_gram(C[big], w[big])     # its upper triangle: all cho_factor reads
     K[np.diag_indices(h.size)] += h
     try:
         return cho_factor(K, lower=False)
     except np.linalg.LinAlgError:   # the DFT's round-off after all: the dense product
-        K = C.T @ (w[:, None] * C)
+        K = _weighted_gram(C, w)
         K[np.diag_indices(h.size)] += h
     # on dense grids (oversample 16, a 300 s sea) many rows are near-active and K loses
     # definiteness to round-off: a ridge of 1e-14.. of its diagonal makes the step inexact
