@@ -26,15 +26,18 @@ from .compiled import compile_function
 from .methods import METHODS, method, radiation_exponential, radiation_split
 
 CHUNK = 512         # steps per compiled call: long enough that Python overhead vanishes
-# Above this many states (a farm: the radiation model's states dominate) a step calls the plant's
-# f as one function (MX) instead of inlining its expression at every stage (SX), so the generated
-# C holds f once, not four times; and the output map, evaluated once per sample, is compiled
-# unoptimised (sim.compiled.PLAIN_FLAGS). Measured on array_grid's 16 floats (776 states): step
-# compile 286 s -> 7 s, output map 12 s -> 0.8 s; a 60 s run's steps 0.08 s (-O0 steps: 1.2 s).
-# raft3 (275 states): first use 53 s -> 12 s, a 300 s run (dt 0.01) 1.44 s -> 1.74 s once
-# compiled, the same end state to 1e-12. Smaller plants keep the inlined form (same results to
-# round-off), where the compile is short and the inlined step the faster.
-CALL_F_STATES = 200
+# Above CALL_F_STATES a step calls the plant's f as one function (MX) instead of inlining its
+# expression at every stage (SX), so the generated C holds f once, not four times. Measured on
+# this machine (first use with the compile; a 300 s regular-wave run at dt 0.01 s once compiled):
+# array4 (80 states) 6.2 s -> 1.2 s, run 0.34 s -> 0.37 s; flap_pair (92) 3.8 s -> 1.5 s, run
+# 0.50 s -> 0.29 s; array_grid's 16 floats (776) compile 286 s -> 7 s. Below it the inlined step
+# is the faster (hinged_barge, 49: run 0.19 s against 0.23 s) and its compile short. Same end
+# states to round-off.
+CALL_F_STATES = 64
+# Above this many states (a farm: the radiation model's constants dominate) the output map,
+# evaluated once per sample, is compiled unoptimised (sim.compiled.PLAIN_FLAGS): array_grid's
+# output map 12 s -> 0.8 s.
+PLAIN_OUTPUTS_STATES = 200
 
 
 # --- one step -------------------------------------------------------------------------------
@@ -291,7 +294,7 @@ def outputs(plant, X, U, W, p, compiled=True) -> np.ndarray:
         w, p_sym = ca.MX.sym("w", len(plant.disturbances), length), ca.MX.sym("p", len(plant.p0))
         y = plant.h.map(length)(x, u, w, ca.repmat(p_sym, 1, length))
         fun = ca.Function("outputs_chunk", [x, u, w, p_sym], [y])
-        _OUTPUT_MAPS[key] = (compile_function(fun, enabled=compiled, optimise=plant.nx <= CALL_F_STATES),
+        _OUTPUT_MAPS[key] = (compile_function(fun, enabled=compiled, optimise=plant.nx <= PLAIN_OUTPUTS_STATES),
                              plant)
     fun = _OUTPUT_MAPS[key][0]
     Y = np.empty((n, len(plant.outputs)))
