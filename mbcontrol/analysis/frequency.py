@@ -27,16 +27,28 @@ def frequency_domain_response(plant, omega, *, direction: float = 0.0, params=No
     hyd = plant.hydro
     A_w, B_w = hyd.frequency_domain_matrices(omega)
     F = np.conj(hyd.excitation_at(omega, direction))
-    P = mech.P_hydro
     idx = [plant.outputs.index(o) for o in (outputs or plant.outputs)]
-    out = np.empty((omega.size, len(idx)), dtype=complex)
-    for i, w in enumerate(omega):
-        Z = (-w**2 * (mech.mass + P @ A_w[i] @ P.T) + 1j * w * (mech.damping + P @ B_w[i] @ P.T)
-             + mech.stiffness)
-        X = np.linalg.solve(Z, P @ F[i])
-        y = mech.output_q @ X + mech.output_s @ (1j * w * X)
-        out[i] = y[idx]
-    return out
+    rhs = (F @ mech.P_hydro.T)[..., None]
+    X = np.concatenate([np.linalg.solve(_impedance(mech, omega[k], A_w[k], B_w[k]), rhs[k])
+                        for k in frequency_chunks(omega.size, mech.mass.shape[0])])[..., 0]
+    return _outputs(mech, omega, X, idx)
+
+
+def _impedance(mech, omega, A_w, B_w) -> np.ndarray:
+    """Z(omega) = -omega^2 (M + P A P^T) + i omega (B_mech + P B P^T) + K, (n_omega, n, n),
+    to be solved as a stack (a Python loop of small solves cost a sweep's uncertainty budget
+    8 s over 92 seas)."""
+    P = mech.P_hydro
+    w = omega[:, None, None]
+    return (-w**2 * (mech.mass + P @ A_w @ P.T) + 1j * w * (mech.damping + P @ B_w @ P.T)
+            + mech.stiffness)
+
+
+def _outputs(mech, omega, X, idx) -> np.ndarray:
+    """The outputs `idx` of the joint responses X (n_omega, n_q[, k]) at each omega."""
+    iw = 1j * omega.reshape((-1,) + (1,) * (X.ndim - 1))
+    return (np.einsum("oq,wq...->wo...", mech.output_q, X)
+            + np.einsum("oq,wq...->wo...", mech.output_s, iw * X))[:, idx]
 
 
 def excitation_transfer(plant, omega, *, params=None, outputs=None, sys=None) -> np.ndarray:
@@ -54,15 +66,10 @@ def excitation_transfer(plant, omega, *, params=None, outputs=None, sys=None) ->
                          + D[np.ix_(y_idx, w_idx)] for w in omega])
     mech = mechanical_matrices(plant, params)
     A_w, B_w = plant.hydro.frequency_domain_matrices(omega)
-    P = mech.P_hydro
     idx = [plant.outputs.index(o) for o in (outputs or plant.outputs)]
-    out = []
-    for i, w in enumerate(omega):
-        Z = (-w**2 * (mech.mass + P @ A_w[i] @ P.T) + 1j * w * (mech.damping + P @ B_w[i] @ P.T)
-             + mech.stiffness)
-        X = np.linalg.solve(Z, P)
-        out.append((mech.output_q @ X + mech.output_s @ (1j * w * X))[idx])
-    return np.stack(out)
+    X = np.concatenate([np.linalg.solve(_impedance(mech, omega[k], A_w[k], B_w[k]), mech.P_hydro)
+                        for k in frequency_chunks(omega.size, mech.mass.shape[0])])
+    return _outputs(mech, omega, X, idx)
 
 
 def statespace_response(sys, plant, omega, *, direction: float = 0.0, outputs=None):
@@ -79,10 +86,20 @@ def statespace_response(sys, plant, omega, *, direction: float = 0.0, outputs=No
     A, B, C, D = (np.asarray(M) for M in (sys.A, sys.B, sys.C, sys.D))
     eye = np.eye(A.shape[0])
     out = np.empty((omega.size, len(y_idx)), dtype=complex)
-    for i, w in enumerate(omega):
-        G = C[y_idx] @ np.linalg.solve(1j * w * eye - A, B[:, w_idx]) + D[np.ix_(y_idx, w_idx)]
-        out[i] = G @ F[i]
+    # G(i w) in stacked solves of a few MB each: a Python loop of rm3's 40 x 40 solves cost a
+    # sweep's uncertainty budget 5 s over 92 seas; one stack of raft3's 275 x 275 is 240 MB
+    for k in frequency_chunks(omega.size, A.shape[0]):
+        X = np.linalg.solve(1j * omega[k, None, None] * eye - A, B[:, w_idx])
+        G = C[y_idx] @ X + D[np.ix_(y_idx, w_idx)]
+        out[k] = (G @ F[k, :, None])[..., 0]
     return out
+
+
+def frequency_chunks(n_omega: int, n: int, budget: int = 1 << 19):
+    """Slices of the frequencies whose n x n complex matrices fill about 8 MB: a stacked
+    solve per slice, rather than a Python loop of small solves or one huge stack."""
+    step = max(1, budget // (n * n))
+    return [slice(k, k + step) for k in range(0, max(n_omega, 1), step)]   # one if empty
 
 
 def steady_amplitude(ds, name: str, period: float, n_periods: int = 10) -> float:

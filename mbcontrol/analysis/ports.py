@@ -36,7 +36,7 @@ def output_responses(plant, omega, ptos, outputs, direction: float = 0.0, params
     (n_omega, n_out) per unit wave amplitude with the PTOs free (exp(-i omega t), straight
     from the BEM data), so that with PTO forces F the outputs are G F + H A. params:
     overrides as `linear_params`; the PTOs named in `ptos` are freed."""
-    from .frequency import mechanical_matrices
+    from .frequency import frequency_chunks, mechanical_matrices
     from .linearize import jacobians
 
     if plant.hydro is None:
@@ -61,15 +61,16 @@ def output_responses(plant, omega, ptos, outputs, direction: float = 0.0, params
     A_w, B_w = hyd.frequency_domain_matrices(omega)
     F_exc = hyd.excitation_at(omega, direction)
     n = len(ptos)
-    G = np.empty((omega.size, len(i_y), n), complex)
-    H = np.empty((omega.size, len(i_y)), complex)
-    for k, w in enumerate(omega):
+    Y = np.empty((omega.size, len(i_y), n + 1), complex)
+    rhs = np.concatenate([np.broadcast_to(b, (omega.size,) + b.shape),
+                          (F_exc @ P.T)[..., None]], axis=2)
+    for k in frequency_chunks(omega.size, mech.mass.shape[0]):   # stacked solves
+        w = omega[k, None, None]
         Z = (-w**2 * (mech.mass + P @ A_w[k] @ P.T) - 1j * w * (mech.damping + P @ B_w[k] @ P.T)
              + mech.stiffness)
-        X = np.linalg.solve(Z, np.column_stack([b, P @ F_exc[k]]))
-        Y = c_q @ X + c_s @ (-1j * w * X)        # the outputs' phasors
-        G[k], H[k] = Y[:, :n], Y[:, n]
-    return G, H
+        X = np.linalg.solve(Z, rhs[k])
+        Y[k] = c_q @ X + c_s @ (-1j * w * X)    # the outputs' phasors
+    return Y[..., :n], Y[..., n]
 
 
 @dataclass(frozen=True)

@@ -48,14 +48,28 @@ def te_over_tp(gamma: float = 3.3) -> float:
     period), by quadrature on a fine geometric grid (0.2 to 50 times the peak frequency; the
     omega^-5 tail beyond holds < 1e-7 of m_-1). gamma = 1 (Pierson-Moskowitz): 0.8572;
     gamma = 3.3: 0.9033."""
-    w = np.geomspace(0.2, 50.0, 40001)           # in units of the peak frequency (Tp = 2 pi)
-    s = jonswap_spectrum(w, 1.0, 2 * math.pi, gamma)
+    w, pm, r = _te_grid()
+    s = (1 - 0.287 * np.log(gamma)) * pm * gamma ** r   # jonswap_spectrum's, term for term
     return float(np.trapezoid(s / w, w) / np.trapezoid(s, w))
 
 
+@lru_cache(maxsize=1)
+def _te_grid():
+    """te_over_tp's grid (in units of the peak frequency, Tp = 2 pi), its Pierson-Moskowitz
+    density and peak-shape exponent: what does not depend on gamma, computed once (the
+    root search of gamma_for_te_over_tp calls te_over_tp a dozen times per sea)."""
+    w = np.geomspace(0.2, 50.0, 40001)
+    pm = jonswap_spectrum(w, 1.0, 2 * math.pi, 1.0)     # gamma 1: the PM density alone
+    wp = 2 * np.pi / (2 * math.pi)
+    sigma = np.where(w <= wp, 0.07, 0.09)
+    return w, pm, np.exp(-0.5 * ((w - wp) / (sigma * wp)) ** 2)
+
+
+@lru_cache(maxsize=1024)
 def gamma_for_te_over_tp(ratio: float) -> float:
     """The JONSWAP gamma (1..20) whose Te / Tp equals ratio (e.g. a site file's own Te / Tp);
-    ValueError when no gamma in that range has it."""
+    ValueError when no gamma in that range has it. Cached: a sweep asks once per sea, and
+    again for the same seas in the next sweep."""
     from scipy.optimize import brentq
     lo, hi = te_over_tp(1.0), te_over_tp(20.0)
     if not lo - 1e-6 <= ratio <= hi:
