@@ -42,13 +42,13 @@ def pytest_runtest_makereport(item, call):
 # reads.) Files start longest first (these, measured on a cold cache on a 2-core machine; the
 # order only balances the workers, it changes no result), the rest in collection order.
 LONGEST_FIRST = (
-    "tests/test_notebooks.py", "tests/controllers/test_joint.py", "tests/test_cli.py",
-    "tests/controllers/test_electrical.py", "tests/controllers/test_wecccomp.py",
-    "tests/controllers/test_reactive_latching.py", "tests/test_readme.py",
-    "tests/export/test_export.py", "tests/hydro/test_bem.py", "tests/hydro/test_neighbours.py",
-    "tests/cli/test_identify.py", "tests/studies/identify/test_flume_data.py",
-    "tests/controllers/test_nmpc.py", "tests/controllers/test_latching_logic.py",
-    "tests/hydro/test_radiation.py", "tests/studies/identify/test_identify.py",
+    "tests/test_notebooks.py", "tests/test_readme.py", "tests/studies/sweep/test_sweep.py",
+    "tests/test_cli.py", "tests/controllers/test_nmpc.py", "tests/controllers/test_joint.py",
+    "tests/studies/identify/test_identify.py", "tests/controllers/test_electrical.py",
+    "tests/studies/identify/test_flume_data.py", "tests/hydro/test_bem.py",
+    "tests/controllers/test_wecccomp.py", "tests/hydro/test_fit_where_it_matters.py",
+    "tests/export/test_export.py", "tests/hydro/test_fixed_bodies.py",
+    "tests/cli/test_identify.py", "tests/hydro/test_radiation.py",
 )
 
 
