@@ -19,13 +19,19 @@ def jonswap_spectrum(omega, hs: float, tp: float, gamma: float = 3.3) -> np.ndar
     gamma = 1 gives Pierson-Moskowitz. sigma = 0.07 below the peak, 0.09 above.
     """
     omega = np.asarray(omega, dtype=float)
-    wp = 2 * np.pi / tp
+    pm, r = _pm_and_peak_shape(omega, hs, 2 * np.pi / tp)
+    with np.errstate(over="ignore", invalid="ignore"):
+        density = (1 - 0.287 * np.log(gamma)) * pm * gamma ** r
+    return np.where(omega > 0, np.nan_to_num(density), 0.0)
+
+
+def _pm_and_peak_shape(omega, hs: float, wp: float):
+    """(Pierson-Moskowitz density, r): JONSWAP is (1 - 0.287 ln gamma) PM gamma^r, with
+    sigma = 0.07 below the peak frequency wp (rad/s), 0.09 above."""
     with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
         pm = 5 / 16 * hs**2 * wp**4 * omega**-5.0 * np.exp(-1.25 * (wp / omega) ** 4)
         sigma = np.where(omega <= wp, 0.07, 0.09)
-        peak = gamma ** np.exp(-0.5 * ((omega - wp) / (sigma * wp)) ** 2)
-    density = (1 - 0.287 * np.log(gamma)) * pm * peak
-    return np.where(omega > 0, np.nan_to_num(density), 0.0)
+        return pm, np.exp(-0.5 * ((omega - wp) / (sigma * wp)) ** 2)
 
 
 def moment(x, S, n: int, axis: int = -1) -> np.ndarray:
@@ -49,7 +55,7 @@ def te_over_tp(gamma: float = 3.3) -> float:
     omega^-5 tail beyond holds < 1e-7 of m_-1). gamma = 1 (Pierson-Moskowitz): 0.8572;
     gamma = 3.3: 0.9033."""
     w, pm, r = _te_grid()
-    s = (1 - 0.287 * np.log(gamma)) * pm * gamma ** r   # jonswap_spectrum's, term for term
+    s = (1 - 0.287 * np.log(gamma)) * pm * gamma ** r   # jonswap_spectrum's density
     return float(np.trapezoid(s / w, w) / np.trapezoid(s, w))
 
 
@@ -59,10 +65,7 @@ def _te_grid():
     density and peak-shape exponent: what does not depend on gamma, computed once (the
     root search of gamma_for_te_over_tp calls te_over_tp a dozen times per sea)."""
     w = np.geomspace(0.2, 50.0, 40001)
-    pm = jonswap_spectrum(w, 1.0, 2 * math.pi, 1.0)     # gamma 1: the PM density alone
-    wp = 2 * np.pi / (2 * math.pi)
-    sigma = np.where(w <= wp, 0.07, 0.09)
-    return w, pm, np.exp(-0.5 * ((w - wp) / (sigma * wp)) ** 2)
+    return (w, *_pm_and_peak_shape(w, 1.0, 2 * np.pi / (2 * math.pi)))
 
 
 @lru_cache(maxsize=1024)
