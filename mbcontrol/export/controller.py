@@ -48,7 +48,7 @@ def export_controller(controller, plant, out_dir, *, model: str | None = None,
         compile_library(fmu_sources, binaries / f"{ident}.so", ("-fvisibility=hidden",))
         period = getattr(controller, "period", None)
         (fmu_root / "modelDescription.xml").write_text(
-            controller_description(spec, ident, step or period or 0.01))
+            controller_description(spec, ident, step or period or 0.01, period))
         fmu = out_dir / f"{ident}.fmu"
         zip_fmu(fmu_root, fmu)
         if c_final.exists():
@@ -59,7 +59,9 @@ def export_controller(controller, plant, out_dir, *, model: str | None = None,
     return ExportedController(ident, c_final, c_final / f"lib{ident}.so", fmu, spec)
 
 
-def controller_description(spec: ControllerSpec, ident: str, step: float) -> str:
+def controller_description(spec: ControllerSpec, ident: str, step: float, period: float | None = None) -> str:
+    """The FMU's model description. A controller with a sample `period` (s) states it as the
+    constant `sample_period` and in the text; `step` is the DefaultExperiment's stepSize."""
     variables, vr = [], 0
     for name in spec.inputs:
         variables.append(variable(name, vr, "input", "continuous",
@@ -74,8 +76,18 @@ def controller_description(spec: ControllerSpec, ident: str, step: float) -> str
         variables.append(variable(p.name, vr, "parameter", "fixed",
                                   f"{p.description} ({p.unit})", start=p.value))
         vr += 1
+    if period:
+        variables.append(variable("sample_period", vr, "local", "constant",
+                                  "the controller's sample period, s: it samples at start + k "
+                                  "sample_period (at the first communication point at or after "
+                                  "each) and holds its command in between", start=period))
     outputs = list(range(first_output, first_output + len(spec.outputs)))
+    timing = (f"It samples every {period!r} s on the grid start + k {period!r} s, at the first "
+              f"communication point at or after each sample time, and holds the command in "
+              f"between. Use a communication step that divides {period!r} s: any other samples "
+              f"up to one step late, which a model-based controller does not expect." if period else
+              "It runs at every communication point.")
     text = (f"mbcontrol {spec.name} controller: reads {', '.join(spec.inputs)}; writes the PTO "
             f"force command(s). Set the inputs, then read the outputs, at each communication "
-            f"point.")
+            f"point. {timing}")
     return model_description(ident, guid(spec, ident), text, variables, outputs, step)

@@ -4,8 +4,10 @@ Inside: the CasADi-generated RK4 step and output map of the process plant (`sim.
 own step, so an FMU run and `simulate(..., method="rk4")` take the same steps), and the wave's
 excitation generated from its components at the RK nodes. The PTO forces are inputs (the
 controller owns them: the scene's linear PTO law is zeroed, as `simulate` does with a
-controller); every plant output is an output. Parameters: `dt`, the internal step (s), and
-`wave_scale` (0: still water)."""
+controller); every plant output is an output. Parameters: `dt`, the largest internal step (s),
+and `wave_scale` (0: still water). Any communication step h is taken in ceil(h / dt) equal RK4
+steps (FMI 2.0 masters choose their own steps, and a last one is often shorter), so a run at a
+constant communication step h is `simulate(..., method="rk4", dt=h / ceil(h / dt))`."""
 from __future__ import annotations
 
 import shutil
@@ -109,7 +111,8 @@ def _description(plant, ident, guid_text, dt, wave) -> str:
                                   initial="calculated"))
         vr += 1
     variables.append(variable("dt", vr, "parameter", "fixed",
-                              "internal RK4 step, s (the communication step: a multiple)",
+                              "largest internal RK4 step, s: a communication step h is "
+                              "taken in ceil(h / dt) equal steps",
                               start=dt))
     variables.append(variable("wave_scale", vr + 1, "parameter", "fixed",
                               "multiplies the wave's excitation (0: still water)", start=1.0))

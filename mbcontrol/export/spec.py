@@ -47,12 +47,13 @@ def controller_spec(controller, plant) -> ControllerSpec:
     """The spec of `controller` after controller.reset(plant) (called here)."""
     controller.reset(plant)
     name = controller.name
-    if name in ("passive", "reactive"):
-        return _law_spec(controller, plant)
-    if name in ("latching", "declutching"):
-        return _switching_spec(controller, plant)
-    if name == "mpc":
-        return _mpc_spec(controller, plant)
+    build = {"passive": _law_spec, "reactive": _law_spec, "latching": _switching_spec,
+             "declutching": _switching_spec, "mpc": _mpc_spec}.get(name)
+    if build is not None:
+        spec = build(controller, plant)
+        # s; the FMU samples on this grid (0: at every communication point)
+        spec.defines["MBC_SAMPLE_PERIOD"] = repr(float(getattr(controller, "period", None) or 0.0))
+        return spec
     raise ValueError(f"export: controller {name!r} cannot be exported; exportable: passive, "
                      f"reactive, latching, declutching, mpc (NMPC's solver, IPOPT, generates "
                      f"no C)")
@@ -203,7 +204,7 @@ def _mpc_spec(c, plant) -> ControllerSpec:
     }
     context = "\n    ".join([
         f"double params[{len(params)}];",
-        f"double s[{kal.Phi.shape[0]}], u_prev[{nu}], last_t, warm_up_end;",
+        f"double s[{kal.Phi.shape[0]}], u_prev[{nu}], first_t, next_t, warm_up_end;",
         "int has_last, warm_done, has_plan, has_coef, last_form;",
         f"double hist[{window_max * max(nd, 1)}];",
         "int hist_len, hist_start, since_fit, min_samples, window;",

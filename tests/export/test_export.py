@@ -190,3 +190,50 @@ def test_an_fmus_sources_rebuild_it(sphere, plant_fmus, tmp_path):
         lib = ctypes.CDLL(str(folder / "rebuilt.so"))
         for name in ("fmi2Instantiate", "fmi2DoStep", "fmi2GetReal", "fmi2SetReal"):
             assert hasattr(lib, name), (fmu.name, name)
+
+
+def test_plant_fmu_takes_any_communication_step(sphere, plant_fmus):
+    """FMI masters choose their own steps (issue 38): fmpy's simulate_fmu at its defaults with
+    a stop time that is no multiple of dt, and at a step dt does not divide. A step h runs as
+    ceil(h / dt) equal RK4 steps: against simulate's RK4 at h / ceil(h / dt), round-off apart."""
+    fmu = str(plant_fmus[id(SEA)])
+    result = fmpy.simulate_fmu(fmu, stop_time=30.013)            # a last step of 13 ms
+    assert result["time"][-1] == pytest.approx(30.013, abs=1e-12)
+    ds = simulate(sphere, SEA, duration=30.0, dt=DT, method="rk4",
+                  params={"pto__damping": 0.0, "pto__stiffness": 0.0})
+    ref = ds["pto__position"].values
+    got = np.interp(ds["time"].values, result["time"], result["pto__position"])
+    assert np.max(np.abs(got - ref)) <= 1e-9 * np.max(np.abs(ref))
+    h = 0.07                                                    # two steps of 35 ms
+    result = fmpy.simulate_fmu(fmu, stop_time=10.0, output_interval=h, output=["pto__position"])
+    ds = simulate(sphere, SEA, duration=142 * h, dt=h / 2, method="rk4",
+                  params={"pto__damping": 0.0, "pto__stiffness": 0.0})
+    ref = ds["pto__position"].values[::2]
+    assert np.max(np.abs(result["pto__position"][:ref.size] - ref)) <= 1e-9 * np.max(np.abs(ref))
+    assert result["time"][-1] == pytest.approx(10.0, abs=1e-12)
+
+
+def test_controller_fmu_keeps_its_sample_grid_under_any_step(sphere, plant_fmus, tmp_path):
+    """The MPC (period 0.2 s): its model description states the period. Driven by fmpy's
+    FMU2Slave master at 40 ms (not its period), it is the Python MPC at dt 40 ms (the export's
+    bar, 1e-6 of the peak force). At 30 ms, which does not divide the period, it samples at
+    the first communication point at or after each k 0.2 s and holds in between: every
+    command change lies less than one step after its grid time."""
+    from mbcontrol.export.cosim import closed_loop
+    settings, wave = SETTINGS["mpc"]
+    controller = make("mpc", **settings)
+    exported = export_controller(controller, sphere, tmp_path)
+    md = fmpy.read_model_description(str(exported.fmu))
+    period = {v.name: v for v in md.modelVariables}["sample_period"]
+    assert period.variability == "constant" and float(period.start) == 0.2
+    assert float(md.defaultExperiment.stepSize) == 0.2
+    duration = 60.0
+    run = closed_loop(plant_fmus[id(wave)], exported.fmu, duration=duration, step=0.04)
+    python = simulate(sphere, wave, duration=duration - 0.04, dt=0.04, method="rk4", controller=controller)
+    assert force_error(python["u__pto"].values, run["u"][:, 0]) <= 1e-6
+    h = 0.03
+    run = closed_loop(plant_fmus[id(wave)], exported.fmu, duration=duration, step=h)
+    t, u = run["time"][:-1], run["u"][:, 0]
+    changes = t[1:][np.diff(u) != 0]
+    late = changes - np.floor(changes / 0.2 + 1e-9) * 0.2        # after its grid time, s
+    assert changes.size > 0.8 * duration / 0.2 and np.all(late < h + 1e-9)

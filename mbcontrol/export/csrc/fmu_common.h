@@ -66,6 +66,12 @@ static void mbc_log(const fmi2CallbackFunctions *f, fmi2String name, fmi2String 
     if (f && f->logger) f->logger(f->componentEnvironment, name, fmi2Error, "logError", "%s", message);
 }
 
+/* A warning: the step goes on. */
+static void mbc_warn(const fmi2CallbackFunctions *f, fmi2String name, fmi2String message)
+{
+    if (f && f->logger) f->logger(f->componentEnvironment, name, fmi2Warning, "logWarning", "%s", message);
+}
+
 /* The common part of fmi2Instantiate: this FMU's GUID and co-simulation, or NULL (logged);
  * else a zeroed instance of `size` bytes from the environment's allocator. */
 static void *mbc_instantiate(fmi2String name, fmi2Type type, fmi2String guid,

@@ -2,8 +2,11 @@
  * mbcontrol's process plant (plant_casadi.c), the wave's excitation generated inside from its
  * components, w(t) = ramp(t) sum_j (Fc_j cos w_j t + Fs_j sin w_j t), as `simulate` does.
  * Value references: the PTO forces (inputs) 0..NU-1, the plant's outputs next, then the
- * parameter `dt` (the internal step, s; the communication step must be a multiple of it)
- * and `wave_scale` (multiplies the excitation: 0 for still water). Sizes: plant_config.h. */
+ * parameter `dt` (the largest internal step, s) and `wave_scale` (multiplies the excitation:
+ * 0 for still water). Sizes: plant_config.h.
+ * Any communication step h is taken in n = ceil(h / dt) equal RK4 steps of h / n <= dt, the
+ * PTO forces held: a master's step that dt divides runs at dt exactly, any other step (a last
+ * partial one, a variable-step master) at the nearest smaller step, never coarser than dt. */
 #include <math.h>
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
@@ -134,21 +137,24 @@ MBC_API fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], s
 MBC_API fmi2Status fmi2DoStep(fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolean no_prior)
 {
     Instance *s = (Instance *)c;
-    long k, n = lround(h / s->dt);
-    double W[3 * (PLANT_NW > 0 ? PLANT_NW : 1)], x_next[PLANT_NX], u_applied[PLANT_NU];
+    long k, n;
+    double step, W[3 * (PLANT_NW > 0 ? PLANT_NW : 1)], x_next[PLANT_NX], u_applied[PLANT_NU];
     const double *arg[PLANT_SZ_ARG];
     double *res[PLANT_SZ_RES];
     (void)no_prior;
-    if (n < 1 || fabs(n * s->dt - h) > 1e-9 * h) {
-        mbc_log(s->functions, s->name, "the communication step is not a multiple of dt");
+    if (!(h > 0) || !isfinite(h)) {
+        mbc_log(s->functions, s->name, "the communication step must be a finite number > 0 s");
         return fmi2Error;
     }
+    n = (long)ceil(h / s->dt * (1 - 1e-12));   /* a step dt divides (to round-off) stays whole */
+    if (n < 1) n = 1;
+    step = h / n;
     for (k = 0; k < n; ++k) {
-        double tk = t + k * s->dt;
+        double tk = t + k * step;
         excitation(s, tk, W);
-        excitation(s, tk + 0.5 * s->dt, W + PLANT_NW);
-        excitation(s, tk + s->dt, W + 2 * PLANT_NW);
-        arg[0] = s->x; arg[1] = s->u; arg[2] = W; arg[3] = PLANT_P; arg[4] = &s->dt;
+        excitation(s, tk + 0.5 * step, W + PLANT_NW);
+        excitation(s, tk + step, W + 2 * PLANT_NW);
+        arg[0] = s->x; arg[1] = s->u; arg[2] = W; arg[3] = PLANT_P; arg[4] = &step;
         res[0] = x_next; res[1] = u_applied;
         if (plant_step(arg, res, s->iw, s->w, 0)) return fmi2Error;
         memcpy(s->x, x_next, sizeof(x_next));

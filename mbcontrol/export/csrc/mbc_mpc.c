@@ -280,7 +280,7 @@ void MBC_FN(reset)(MBC_CTX *ctx)
     ctx->has_last = ctx->warm_done = ctx->has_plan = ctx->has_coef = 0;
     ctx->hist_len = ctx->hist_start = ctx->since_fit = 0;
     ctx->last_form = 0;
-    ctx->last_t = ctx->warm_up_end = 0.0;
+    ctx->first_t = ctx->next_t = ctx->warm_up_end = 0.0;
     ctx->solves = ctx->failures = ctx->soft_solves = ctx->ar_fits = ctx->ar_unstable_fits = 0;
 }
 
@@ -298,12 +298,16 @@ int MBC_FN(step)(MBC_CTX *ctx, const double *measurements, double t, double *for
     double ym[MBC_NY], pred[MBC_NK], innov[MBC_NY], d[MBC_ND > 0 ? MBC_ND : 1], u[MBC_NU];
     const double *c_warm = ctx->params;
     int i, k;
-    if (ctx->has_last && t < ctx->last_t + MBC_DT * (1 - 1e-6)) {   /* within a period: hold */
+    /* samples on the grid first_t + k MBC_DT: each at the first call at or after its time, the
+     * command held in between; a caller that steps off the grid (an FMU master's step that
+     * does not divide the period) shifts a sample by less than its step, never the grid */
+    if (ctx->has_last && t < ctx->next_t - MBC_DT * 1e-6) {
         memcpy(force, ctx->u_prev, sizeof(u));
         return 0;
     }
+    if (!ctx->has_last) ctx->first_t = t;
     ctx->has_last = 1;
-    ctx->last_t = t;
+    ctx->next_t = ctx->first_t + (floor((t - ctx->first_t) / MBC_DT + 1e-6) + 1) * MBC_DT;
     /* Kalman: predict with the command held over the last period, correct */
     for (i = 0; i < MBC_NY; ++i) ym[i] = measurements[MBC_KALMAN_INDEX[i]] - MBC_Y_REST[i];
     matvec(MBC_PHI, MBC_NK, MBC_NK, ctx->s, pred, 0);
