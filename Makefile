@@ -48,6 +48,7 @@ docs: $(VENV)/.installed-docs
 bench: $(VENV)/.installed-test
 	$(PY) benchmarks/run.py --out $(OUT)/bench
 	$(PY) benchmarks/speed.py --out $(OUT)/bench/speed
+	$(PY) benchmarks/stepping.py
 	$(PY) -m mbcontrol.cli bench rm3 --wave jonswap --hs 2.5 --tp 8 --stability \
 	    --out $(OUT)/bench/work_precision_rm3
 	$(PY) benchmarks/batch.py

@@ -65,6 +65,7 @@ TABLES = {
 }
 MODEL_TABLES = {"mbcontrol (method, dt, radiation tol)": ("measured", "benchmarks/speed.py"),
                 "C step median / p99 / max (us)": ("measured", "benchmarks/export_step.py"),
+                "components x nodes": ("measured", "benchmarks/stepping.py"),
                 "what it is": ("reference", "the catalogue (tests/test_catalogue.py builds each)")}
 
 

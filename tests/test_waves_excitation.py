@@ -29,8 +29,8 @@ def test_excitation_fft_path_equals_direct_sum(monkeypatch):
     omega_data, table = coefficient_table(w.d_omega, k[0], k[-1])
     t = np.arange(6000) * 0.1                 # 0.1 s divides the 600 s period: FFT-able
     calls = []
-    fft = np.fft.fft
-    monkeypatch.setattr(np.fft, "fft", lambda *a, **kw: calls.append(1) or fft(*a, **kw))
+    irfft = np.fft.irfft
+    monkeypatch.setattr(np.fft, "irfft", lambda *a, **kw: calls.append(1) or irfft(*a, **kw))
     got = excitation_series(w, omega_data, table, t)
     assert calls, "the uniform-grid FFT path was not taken"
     coeffs = np.stack([(1 + 0.5j) * w.omega**2, (0.3 - 2j) * w.omega], axis=1)
@@ -42,6 +42,30 @@ def test_excitation_fft_path_equals_direct_sum(monkeypatch):
     for j in range(2):
         scale = np.abs(expected[:, j]).max()
         np.testing.assert_allclose(got[:, j], expected[:, j], rtol=0, atol=1e-10 * scale)
+
+
+def test_excitation_at_the_integrators_nodes_equals_direct_sum(monkeypatch):
+    """RK4's nodes t_i, t_i + dt/2, t_i + dt over a record longer than the wave's repeat
+    period (so it wraps): one inverse FFT per fractional offset (node 1 is node 0 a sample
+    on), against the direct sum within 1e-9 of the largest value (issue 38)."""
+    from mbcontrol.waves import excitation_at_offsets
+    w = irregular(HS, TP, duration=200.0, seed=5)          # repeat period 200 s
+    k = np.rint(w.omega / w.d_omega).astype(int)
+    omega_data, table = coefficient_table(w.d_omega, k[0], k[-1])
+    coeffs = np.stack([(1 + 0.5j) * w.omega**2, (0.3 - 2j) * w.omega], axis=1)
+    calls = []
+    irfft = np.fft.irfft
+    monkeypatch.setattr(np.fft, "irfft", lambda *a, **kw: calls.append(1) or irfft(*a, **kw))
+    n, dt = 5000, 0.05                                       # 250 s: past one period
+    got = excitation_at_offsets(w, omega_data, table, n, dt, [0.0, 0.5, 1.0])
+    assert len(calls) == 2, "one inverse FFT per fractional offset"
+    for j, c in enumerate((0.0, 0.5, 1.0)):
+        t = (np.arange(n) + c) * dt
+        expected = half_cosine(t, w.ramp_time)[:, None] * direct_sum(
+            w.omega, w.amplitude, w.phase, coeffs, t)
+        for d in range(2):
+            np.testing.assert_allclose(got[:, j, d], expected[:, d], rtol=0,
+                                       atol=1e-9 * np.abs(expected[:, d]).max())
 
 
 def test_excitation_direct_path_equals_direct_sum():

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from .realisation import Wave
-from .synthesis import _synthesise, _synthesise_uniform, ramp
+from .synthesis import _synthesise, _synthesise_uniform, ramp, repeat_period
 
 
 def excitation_impulse_response(omega_data, force_data, t) -> np.ndarray:
@@ -57,13 +57,27 @@ def excitation_at_offsets(wave: Wave, omega_data, force_data, n: int, dt: float,
 
 
 def coefficient_offsets(wave: Wave, coeffs, n: int, dt: float, offsets) -> np.ndarray:
-    """`excitation_at_offsets` from each component's own coefficients (n_components, n_dof)."""
+    """`excitation_at_offsets` from each component's own coefficients (n_components, n_dof).
+
+    On the wave's repeat period (dt divides it) one inverse FFT per distinct fractional offset:
+    RK4's nodes 0, 1/2, 1 take two, node 1 being node 0 one sample on."""
     weights = (wave.amplitude * np.exp(-1j * wave.phase))[:, None] * coeffs
     out = np.empty((n, len(offsets), weights.shape[1]))
+    periods = {}
     for j, c in enumerate(offsets):
+        whole = int(np.floor(c))
+        frac = float(c) - whole
+        if wave.omega.size > 16 and frac not in periods:
+            shifted = weights * np.exp(-1j * wave.omega * frac * dt)[:, None] if frac else weights
+            periods[frac] = repeat_period(wave, shifted, dt)
+        if periods.get(frac) is not None:
+            period = periods[frac]
+            out[:, j] = period[(np.arange(n) + whole) % period.shape[0]]
+        else:
+            out[:, j] = _synthesise_uniform(wave, weights, n, dt, c * dt)
         t = (np.arange(n) + c) * dt
-        series = _synthesise_uniform(wave, weights, n, dt, c * dt)
-        out[:, j] = ramp(t, wave.ramp_time)[:, None] * series
+        rising = t < wave.ramp_time
+        out[rising, j] *= ramp(t[rising], wave.ramp_time)[:, None]
     return out
 
 

@@ -11,10 +11,12 @@ import numpy as np
 def ramp(t, ramp_time: float) -> np.ndarray:
     """Half-cosine ramp 0 -> 1 over ramp_time seconds (1 everywhere if ramp_time == 0)."""
     t = np.asarray(t, dtype=float)
+    out = np.ones_like(t)
     if ramp_time <= 0:
-        return np.ones_like(t)
-    x = np.clip(t / ramp_time, 0.0, 1.0)
-    return 0.5 * (1.0 - np.cos(np.pi * x))
+        return out
+    rising = t < ramp_time                  # 1 exactly after it (cos pi = -1): no cosines there
+    out[rising] = 0.5 * (1.0 - np.cos(np.pi * np.clip(t[rising] / ramp_time, 0.0, None)))
+    return out
 
 
 def _synthesise(wave, weights, t) -> np.ndarray:
@@ -33,17 +35,29 @@ def _synthesise_uniform(wave, weights, n: int, step: float, t0: float = 0.0):
         return _synthesise_direct(wave.omega, weights, t0 + np.arange(n) * step)
     if t0 != 0.0:            # shift the phases to the grid's first time
         weights = weights * np.exp(-1j * wave.omega * t0)[:, None]
-    n_fft = int(round(2 * np.pi / (wave.d_omega * step))) if wave.d_omega else 0
-    k = np.rint(wave.omega / wave.d_omega).astype(int) if wave.d_omega else None
-    if (n_fft < 2 or abs(n_fft * wave.d_omega * step - 2 * np.pi) > 1e-9
-            or k.max() >= n_fft // 2):
+    period = repeat_period(wave, weights, step)
+    if period is None:
         return _synthesise_blocks(wave.omega, weights, n, step)
-    spectrum = np.zeros((n_fft, weights.shape[1]), dtype=complex)
-    spectrum[k] = weights
-    # numpy's fft sums x_k exp(-2 pi i k n / N) = exp(-i omega_k t_n): our convention
-    period = np.fft.fft(spectrum, axis=0).real
     # the sum is exactly periodic in n_fft samples: longer records wrap around
-    return period[np.arange(n) % n_fft]
+    return period[np.arange(n) % period.shape[0]]
+
+
+def repeat_period(wave, weights, step: float):
+    """Re sum_i weights_i exp(-i omega_i k step) for k < N, one repeat period 2 pi / d_omega
+    of N samples, by one real inverse FFT; None when the step does not divide the period (or
+    the components reach its Nyquist frequency). Exact: every omega_i is a whole multiple
+    k_i d_omega, so the sum is sum_i Re conj(w_i) exp(+2 pi i k_i n / N), what irfft computes
+    from the half spectrum X_k = N conj(w_k) / 2 (tests: against the direct sum)."""
+    if not wave.d_omega or wave.omega.size == 0:
+        return None
+    n_fft = int(round(2 * np.pi / (wave.d_omega * step)))
+    k = np.rint(wave.omega / wave.d_omega).astype(int)
+    if n_fft < 2 or abs(n_fft * wave.d_omega * step - 2 * np.pi) > 1e-9 or k.max() >= n_fft // 2 \
+            or k.min() < 1:
+        return None
+    half = np.zeros((n_fft // 2 + 1, weights.shape[1]), dtype=complex)
+    np.add.at(half, k, np.conj(weights) * (0.5 * n_fft))
+    return np.fft.irfft(half, n=n_fft, axis=0)
 
 
 def _synthesise_blocks(omega, weights, n: int, step: float, block: int = 512) -> np.ndarray:
