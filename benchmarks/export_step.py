@@ -26,8 +26,11 @@ sys.path.insert(0, str(ROOT))
 
 CASES = [("sphere", "passive", "sea"), ("sphere", "reactive", "sea"),
          ("sphere", "latching", "swell"), ("sphere", "declutching", "swell"),
-         ("sphere", "mpc", "sea"), ("wavestar", "mpc", "sea")]
+         ("sphere", "mpc", "sea"), ("sphere", "mpc", "binding"), ("wavestar", "mpc", "sea")]
 SEAS = {"sphere": (2.0, 9.0), "wavestar": (0.1, 2.0)}    # Hs m, Tp s (Wavestar: tank scale)
+# where the MPC works hardest: `mbcontrol export sphere --controller mpc --wave regular
+# --height 2.5 --period 9.6664` (issue 38): force, stroke and slew limits all bind
+BINDING = (2.5, 9.6664)                                # H m, T s
 
 
 def run_case(model, name, kind, steps, python_steps, folder):
@@ -42,25 +45,27 @@ def run_case(model, name, kind, steps, python_steps, folder):
     from mbcontrol.sim import simulate
     from mbcontrol.waves import irregular, regular
     plant = build_plant(load_scene(model))
-    hs, tp = SEAS[model]
-    parameters, _, _, extra = tune(plant, regular(hs, tp) if kind == "swell" else
+    hs, tp = BINDING if kind == "binding" else SEAS[model]
+    regular_wave = kind in ("swell", "binding")
+    parameters, _, _, extra = tune(plant, regular(hs, tp) if regular_wave else
                                    irregular(hs, tp, seed=0, duration=600.0), name,
                                    plant.scene.ptos[0], True, None, [])
-    controller = make(name, **parameters, **extra)
+    # the C engine does not hold the MPC's envelope: exported without it, as `mbcontrol export`
+    controller = make(name, **parameters, **extra, **({"envelope": False} if name == "mpc" else {}))
     period = getattr(controller, "period", None)
     dt = tp / 200 if period is None else period / max(1, round(period / (tp / 200)))
     duration = steps * (period or dt)
-    wave = regular(hs, tp) if kind == "swell" else irregular(hs, tp, seed=0, duration=duration)
-    exported = export_controller(controller, plant, folder / f"{model}_{name}")
+    wave = regular(hs, tp) if regular_wave else irregular(hs, tp, seed=0, duration=duration)
+    exported = export_controller(controller, plant, folder / f"{model}_{name}_{kind}")
     c = CController.from_export(exported, period=period)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         record = simulate(plant, wave, duration=duration, dt=dt, controller=c, audit=False)
     timing = step_timing(controller, exported, record, plant, python_steps=python_steps)
     # the check: 200 s of the sea (20 periods of the swell), Python against C and the FMUs
-    check_s = 20 * tp if kind == "swell" else 200.0
-    check_wave = wave if kind == "swell" else irregular(hs, tp, seed=1, duration=check_s)
-    plant_fmu = export_plant(plant, check_wave, folder / f"{model}_{name}", dt=dt)
+    check_s = 20 * tp if regular_wave else 200.0
+    check_wave = wave if regular_wave else irregular(hs, tp, seed=1, duration=check_s)
+    plant_fmu = export_plant(plant, check_wave, folder / f"{model}_{name}_{kind}", dt=dt)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         check = closed_loop_check(plant, check_wave, controller, exported, duration=check_s,
@@ -69,7 +74,8 @@ def run_case(model, name, kind, steps, python_steps, folder):
             "c_us": timing["c"],
             "python_us": timing["python"], "speed_up_median": timing["speed_up_median"],
             **footprint(exported), "dt_s": dt, "period_s": period,
-            "kalman_states": int(exported.spec.defines.get("MBC_NK", 0))}
+            "kalman_states": int(exported.spec.defines.get("MBC_NK", 0)),
+            "qp_max_iter": int(exported.spec.defines.get("MBC_QP_MAX_ITER", 0))}
 
 
 def main() -> None:
@@ -78,12 +84,16 @@ def main() -> None:
     parser.add_argument("--out", default="out/bench/export")
     parser.add_argument("--steps", type=int, default=100_000)
     parser.add_argument("--python-steps", type=int, default=10_000)
+    parser.add_argument("--case", action="append", metavar="MODEL:CONTROLLER:WAVE",
+                        help="only these cases, e.g. sphere:mpc:binding (repeatable)")
     args = parser.parse_args()
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
         for model, name, kind in CASES:
+            if args.case and f"{model}:{name}:{kind}" not in args.case:
+                continue
             row = run_case(model, name, kind, args.steps, args.python_steps, Path(tmp))
             rows.append(row)
             print(f"{model} {name}: C median {row['c_us']['median']:.3g} us", flush=True)
@@ -93,7 +103,8 @@ def main() -> None:
     print("|---|---|---|---|---|---|---|")
     for r in rows:
         c = r["c_us"]
-        print(f"| {r['model']} | {r['controller']} | {c['median']:.3g} / {c['p99']:.3g} / "
+        print(f"| {r['model']} | {r['controller']}{' (H 2.5 m regular)' if r['wave'] == 'binding' else ''} | "
+              f"{c['median']:.3g} / {c['p99']:.3g} / "
               f"{c['max']:.3g} | {r['python_us']['median']:.3g} | {r['speed_up_median']:.0f}x "
               f"| {r['context_bytes']:,} | {r['library_bytes'] / 1e3:.0f} |")
     print("\n| model, controller | C vs Python: force, mean power | FMUs in fmpy vs Python: "

@@ -15,6 +15,10 @@ from dataclasses import dataclass, field
 import casadi as ca
 import numpy as np
 
+# The exported QP's iteration cap per variable: the bound on a step's time. Past it the step
+# takes the previous plan's next move (within the force and rate limits; mbc_mpc.c).
+QP_MAX_ITER_PER_VARIABLE = 3      # the sphere's 40-variable QPs in H 2.5 m waves took at most 62
+
 
 @dataclass
 class Parameter:
@@ -201,6 +205,7 @@ def _mpc_spec(c, plant) -> ControllerSpec:
         "MBC_DT": repr(c.dt_s), "MBC_FS": repr(qp.Fs), "MBC_LS": repr(qp.Ls),
         "MBC_HAS_STROKE": str(int(qp.has_stroke)), "MBC_HAS_RATE": str(int(qp.has_rate)),
         "MBC_NFORMS": str(len(forms)),
+        "MBC_QP_ITER_PER_VARIABLE": str(QP_MAX_ITER_PER_VARIABLE),
     }
     context = "\n    ".join([
         f"double params[{len(params)}];",

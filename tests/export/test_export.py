@@ -237,3 +237,32 @@ def test_controller_fmu_keeps_its_sample_grid_under_any_step(sphere, plant_fmus,
     changes = t[1:][np.diff(u) != 0]
     late = changes - np.floor(changes / 0.2 + 1e-9) * 0.2        # after its grid time, s
     assert changes.size > 0.8 * duration / 0.2 and np.all(late < h + 1e-9)
+
+
+def test_mpc_past_its_iteration_cap_falls_back_within_its_limits(sphere, tmp_path):
+    """The exported QP stops at MBC_QP_ITER_PER_VARIABLE Goldfarb-Idnani iterations per
+    variable (the bound on a step's time; 3 as exported). Rebuilt with 0.05 per variable (two
+    iterations for the 40 variables of the hard form), most solves stop early:
+    each such step takes the previous plan's next move, and the command still keeps the force
+    limit and the slew limit (rate_max x period) at every sample."""
+    settings, wave = SETTINGS["mpc-model-forecast"]
+    controller = make("mpc", **settings)
+    exported = export_controller(controller, sphere, tmp_path)
+    import shutil
+    capped = shutil.copytree(exported.c_folder, tmp_path / "capped")   # its own library path
+    header = capped / "mbc_controller.h"
+    text = header.read_text()
+    assert "#define MBC_QP_ITER_PER_VARIABLE 3" in text
+    header.write_text(text.replace("#define MBC_QP_ITER_PER_VARIABLE 3",
+                                   "#define MBC_QP_ITER_PER_VARIABLE 0.05"))
+    subprocess.run(["make", "-s", "-C", str(capped), "clean", f"lib{exported.ident}.so"],
+                   check=True, capture_output=True)
+    runs = {}
+    for name, library in (("full", exported.library), ("capped", capped / exported.library.name)):
+        c = CController(library, exported.ident, exported.spec.inputs, 1, period=0.2)
+        runs[name] = simulate(sphere, wave, duration=120.0, dt=DT, method="rk4", controller=c)
+    u = runs["capped"]["u__pto"].values[::4]                  # one per controller sample
+    force_max = controller.limits["force"][0]
+    assert np.max(np.abs(u)) <= force_max * (1 + 1e-12)
+    assert np.max(np.abs(np.diff(u))) <= settings["rate_max"] * 0.2 * (1 + 1e-9)
+    assert force_error(runs["full"]["u__pto"].values, runs["capped"]["u__pto"].values) > 1e-3

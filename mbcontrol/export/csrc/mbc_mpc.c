@@ -266,6 +266,7 @@ int MBC_FN(init)(MBC_CTX *ctx, const double *params)
         qp->Jt0 = ctx->J0[f];
         qp->work = ctx->qp_work;
         qp->iwork = ctx->qp_iwork;
+        qp->max_iter = MBC_QP_ITER_PER_VARIABLE * qp->n;   /* the bound on a solve's time */
         if (mbc_qp_setup(qp) != MBC_QP_SOLVED) return -3;
     }
     MBC_FN(reset)(ctx);
@@ -297,7 +298,7 @@ int MBC_FN(step)(MBC_CTX *ctx, const double *measurements, double t, double *for
 {
     double ym[MBC_NY], pred[MBC_NK], innov[MBC_NY], d[MBC_ND > 0 ? MBC_ND : 1], u[MBC_NU];
     const double *c_warm = ctx->params;
-    int i, k;
+    int i, k, failed;
     /* samples on the grid first_t + k MBC_DT: each at the first call at or after its time, the
      * command held in between; a caller that steps off the grid (an FMU master's step that
      * does not divide the period) shifts a sample by less than its step, never the grid */
@@ -342,8 +343,9 @@ int MBC_FN(step)(MBC_CTX *ctx, const double *measurements, double t, double *for
     matvec(MBC_QZ, NV, MBC_NZ, ctx->s, ctx->q, 0);
     matvec(MBC_QD, NV, MBC_N * MBC_ND, ctx->D, ctx->q, 1);
     ctx->solves += 1;
-    if (solve_qp(ctx) != 0) {               /* the previous plan's next move */
-        ctx->failures += 1;
+    failed = solve_qp(ctx) != 0;
+    if (failed) {                           /* infeasible, or past its iteration cap: the */
+        ctx->failures += 1;                 /* previous plan's next move */
         if (ctx->has_plan) {
             memmove(ctx->plan, ctx->plan + MBC_NU, sizeof(double) * (NV - MBC_NU));
         } else {
@@ -357,6 +359,12 @@ int MBC_FN(step)(MBC_CTX *ctx, const double *measurements, double t, double *for
         for (i = 0; i < MBC_NU; ++i)
             u[i] = share * u[i] - (1 - share) * c_warm[i] * measurements[MBC_VELOCITY_INDEX[i]];
     }
+    if (failed && MBC_HAS_RATE)             /* the fallback within the slew limit too */
+        for (i = 0; i < MBC_NU; ++i) {
+            double step = MBC_RATE[i] * MBC_FS;
+            if (u[i] > ctx->u_prev[i] + step) u[i] = ctx->u_prev[i] + step;
+            if (u[i] < ctx->u_prev[i] - step) u[i] = ctx->u_prev[i] - step;
+        }
     clip(u);
     memcpy(ctx->u_prev, u, sizeof(u));
     memcpy(force, u, sizeof(u));

@@ -120,7 +120,7 @@ int mbc_qp_solve(mbc_qp *qp, const double *g, const double *lbx, const double *u
     memset(x, 0, sizeof(double) * n);
     for (j = 0; j < n; ++j)
         for (k = 0; k < n; ++k) x[k] -= Jt[j * n + k] * d[j];
-    max_iter = 10 * (n + nc);
+    max_iter = qp->max_iter > 0 ? qp->max_iter : 10 * (n + nc);
     for (iter = 0; iter < max_iter; ++iter) {
         int p = -1;
         double worst = -TOL, up = 0.0;

@@ -26,12 +26,14 @@ typedef struct {
     double *work;         /* MBC_QP_WORK(n, m) */
     int *iwork;           /* MBC_QP_IWORK(n, m) */
     int iterations;       /* of the last solve */
+    int max_iter;         /* iterations at most (0: 10 (n + 2n + 2m)): a solve's time bound */
 } mbc_qp;
 
 /* Factor H once (after the fields above are set): MBC_QP_SOLVED or MBC_QP_NOT_PD. */
 int mbc_qp_setup(mbc_qp *qp);
 
-/* Solve for x (n): MBC_QP_SOLVED, MBC_QP_INFEASIBLE or MBC_QP_MAX_ITER. */
+/* Solve for x (n): MBC_QP_SOLVED, MBC_QP_INFEASIBLE or MBC_QP_MAX_ITER (x then not the
+ * optimum: the caller falls back). */
 int mbc_qp_solve(mbc_qp *qp, const double *g, const double *lbx, const double *ubx,
                  const double *lba, const double *uba, double *x);
 
