@@ -156,7 +156,8 @@ def record_power_statistics(plant, omega, amplitude, gains: dict, window: tuple[
     responses = law_responses(plant, omega, gains, direction=direction, params=params)
     # straight from the quadrants: Q (2n x 2n, 72 MB for an hour's 1,500 components) is
     # never assembled
-    mean, std = _quadrant_statistics(*_quadrants(omega, responses, gains, window), amplitude)[amplitudes]
+    quadrants = _quadrants(omega, responses, gains, window)
+    mean, std = _quadrant_statistics(*quadrants, amplitude)[amplitudes]
     # the power density per component (W) for Bendat & Piersol's statistical bandwidth
     a2 = np.asarray(amplitude, float) ** 2
     p = sum(0.5 * c * a2 * np.abs(V) ** 2 for (c, _), (V, _X) in

@@ -59,7 +59,8 @@ def export_controller(controller, plant, out_dir, *, model: str | None = None,
     return ExportedController(ident, c_final, c_final / f"lib{ident}.so", fmu, spec)
 
 
-def controller_description(spec: ControllerSpec, ident: str, step: float, period: float | None = None) -> str:
+def controller_description(spec: ControllerSpec, ident: str, step: float,
+                           period: float | None = None) -> str:
     """The FMU's model description. A controller with a sample `period` (s) states it as the
     constant `sample_period` and in the text; `step` is the DefaultExperiment's stepSize."""
     variables, vr = [], 0

@@ -8,7 +8,7 @@
  * communication point at or after each sample time, and holds its command in between
  * (zero-order hold), whatever the master's step. A step that divides T samples exactly on
  * the grid; any other samples up to one step late and is logged once: the MPC's model assumes
- * its own period, and on the sphere a 13-30 ms lag made it saturate (README, Export). A law
+ * its own period, and on the sphere 30-70 ms steps made it saturate (README, Export). A law
  * without a period runs at every communication point. */
 #include <math.h>
 #include <stdlib.h>
