@@ -18,12 +18,15 @@ decay rate (1/s).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
-import control
 import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
 from mbcontrol.sim import sampled as zoh_loop
+
+if TYPE_CHECKING:       # python-control costs 2.5 s to import: only where it is used
+    import control
 
 # a loop gain this small relative to the loop's peak is a zero of L, not a crossing of the
 # negative real axis (velocity feedback has L(0) = 0, which round-off puts at -1e-16)
@@ -128,6 +131,7 @@ def discrete_loop(plant, gains: dict, period: float, pto: str, *, params=None):
     control.StateSpace with dt = period) with the other PTOs' loops closed in discrete time,
     Phi_o = Phi - Gamma_o G_o C_o. Negative feedback: u_p = -G_p y_p closes 1 + L(z) = 0.
     G_p = [stiffness, damping]; gains as sampled_closed_loop."""
+    import control
     gains = _complete(plant, gains)
     names = list(gains)
     sys = joint_plant(plant, params=params)

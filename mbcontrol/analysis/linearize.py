@@ -7,11 +7,15 @@ coulomb / velocity_scale; pass params={"<friction>__coulomb": 0} to leave it out
 """
 from __future__ import annotations
 
-import control
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from ..errors import LinearizationError
 from ..plant.jacobians import jacobians
+
+if TYPE_CHECKING:       # python-control costs 2.5 s to import: only where it is used
+    import control
 
 
 def linearize(plant, *, x0=None, u0=None, w0=None, params=None, inputs=None, outputs=None,
@@ -22,6 +26,7 @@ def linearize(plant, *, x0=None, u0=None, w0=None, params=None, inputs=None, out
     overrides or a full vector. Raises LinearizationError when the point is not an equilibrium
     or a name is unknown.
     """
+    import control
     x0 = plant.x0() if x0 is None else np.asarray(x0, float)
     u0 = np.zeros(len(plant.inputs)) if u0 is None else np.asarray(u0, float)
     w0 = np.zeros(len(plant.disturbances)) if w0 is None else np.asarray(w0, float)

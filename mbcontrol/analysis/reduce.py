@@ -8,10 +8,13 @@ twice the sum of the discarded ones (Glover's bound), which the tests check.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
-import control
 import numpy as np
 from scipy import linalg
+
+if TYPE_CHECKING:       # python-control costs 2.5 s to import: only where it is used
+    import control
 
 
 @dataclass
@@ -30,6 +33,7 @@ def balanced_truncation(sys: control.StateSpace, order: int) -> Reduction:
     Keeps input, output names and the feedthrough D. Raises ValueError for an unstable model
     (no finite gramians) or an order outside 1..n.
     """
+    import control
     A, B, C, D = (np.asarray(M, float) for M in (sys.A, sys.B, sys.C, sys.D))
     n = A.shape[0]
     if not 1 <= order <= n:
