@@ -9,15 +9,13 @@ needs: the wave elevation, the states and inputs as variables, provenance, the m
 report. Measured on rm3 (one hour at dt 0.05 s, 72,000 RK4 steps, one core): 33-35 ms a run
 against 62 ms for `simulate`, of which 21 ms is the stepping either way.
 
-The excitation at the steps' nodes comes from one real inverse FFT on the grid of half (or
-whole) steps when the wave is on a uniform frequency grid and the method's nodes fall on it
-(RK4, RK3, exp-RK4): 3 ms against 10 ms for an FFT per node; equal to rounding (1e-15 of the
-largest force). Other waves and methods use `integrators.excitation_at_nodes`.
+The excitation at the steps' nodes is `waves.coefficient_offsets` (one real inverse FFT on the
+grid of half or whole steps, as `simulate` uses), with the interpolated coefficients cached
+here across the seeds of a sea.
 """
 from __future__ import annotations
 
 import json
-import math
 import time
 
 import numpy as np
@@ -121,44 +119,14 @@ _COEFFICIENTS: dict = {}
 
 
 def excitation_at_nodes(plant, wave, n: int, dt: float, nodes) -> np.ndarray:
-    """Excitation (n, len(nodes), n_w) at t_i + c dt, as `integrators.excitation_at_nodes`.
-
-    For a wave on a uniform grid (irregular seas) whose repeat period is a whole number of
-    sub-steps dt / s (s = 1 or 2, whichever puts every node on the grid): one real inverse FFT
-    of length repeat / (dt / s) gives the sum at every sub-step, and each node is a strided
-    slice of it. Coefficients interpolated to the wave's frequencies are kept per plant,
-    direction and frequency grid (every seed of a sea shares them).
-    """
-    sub = next((s for s in (1, 2) if all(abs(c * s - round(c * s)) < 1e-12 for c in nodes)),
-               None)
-    nw = len(plant.disturbances)
-    if wave is None or nw == 0 or sub is None or not wave.d_omega or wave.omega.size <= 16:
+    """Excitation (n, len(nodes), n_w) at t_i + c dt, as `integrators.excitation_at_nodes`
+    (`waves.coefficient_offsets`: one inverse FFT over the repeat period for all nodes), with
+    the coefficients interpolated to the wave's frequencies kept per plant, direction and
+    frequency grid (every seed of a sea shares them)."""
+    from ..waves import coefficient_offsets
+    if wave is None or not plant.disturbances or not wave.d_omega or wave.omega.size <= 16:
         return integrators.excitation_at_nodes(plant, wave, n, dt, nodes)
-    step = dt / sub
-    n_fft = int(round(2 * math.pi / (wave.d_omega * step)))
-    k = np.rint(wave.omega / wave.d_omega).astype(int)
-    if (abs(n_fft * wave.d_omega * step - 2 * math.pi) > 1e-9 or k.min() < 1
-            or k.max() >= n_fft / 2):
-        return integrators.excitation_at_nodes(plant, wave, n, dt, nodes)
-    weights = (wave.amplitude * np.exp(-1j * wave.phase))[:, None] * _coefficients(plant, wave)
-    spectrum = np.zeros((n_fft // 2 + 1, nw), dtype=complex)
-    spectrum[k] = np.conj(weights)
-    # irfft: x_j = (2 / N) Re sum_k X_k exp(+2 pi i k j / N) for 0 < k < N / 2; with
-    # X_k = conj(w_k) that is (2 / N) Re sum_k w_k exp(-i omega_k t_j): our convention
-    series = np.fft.irfft(spectrum, n=n_fft, axis=0) * (n_fft / 2)
-    out = np.empty((n, len(nodes), nw))
-    for j, c in enumerate(nodes):
-        first = int(round(c * sub))
-        if first + (n - 1) * sub < n_fft:
-            out[:, j] = series[first:first + (n - 1) * sub + 1:sub]
-        else:                      # the sum is periodic in n_fft sub-steps: wrap around
-            out[:, j] = series[(first + sub * np.arange(n)) % n_fft]
-        if wave.ramp_time > 0:     # the ramp is exactly 1 after ramp_time: scale only before
-            t = (np.arange(n) + c) * dt
-            m = int(np.searchsorted(t, wave.ramp_time))
-            out[:m, j] *= (0.5 * (1.0 - np.cos(np.pi * np.clip(t[:m] / wave.ramp_time,
-                                                                0.0, 1.0))))[:, None]
-    return out
+    return coefficient_offsets(wave, _coefficients(plant, wave), n, dt, nodes)
 
 
 def _coefficients(plant, wave) -> np.ndarray:

@@ -59,20 +59,20 @@ def excitation_at_offsets(wave: Wave, omega_data, force_data, n: int, dt: float,
 def coefficient_offsets(wave: Wave, coeffs, n: int, dt: float, offsets) -> np.ndarray:
     """`excitation_at_offsets` from each component's own coefficients (n_components, n_dof).
 
-    On the wave's repeat period (dt divides it) one inverse FFT per distinct fractional offset:
-    RK4's nodes 0, 1/2, 1 take two, node 1 being node 0 one sample on."""
+    When every offset lies on the grid of sub-steps dt / s (s = 1 or 2: RK4's 0, 1/2, 1 take
+    s = 2) and the repeat period is a whole number of sub-steps: one real inverse FFT over the
+    period (`repeat_period`) gives the sum at every sub-step, and each offset is a strided
+    slice of it. Otherwise an FFT (or blocks of phasors) per offset. The ramp is applied only
+    where it rises (it is exactly 1 after ramp_time)."""
     weights = (wave.amplitude * np.exp(-1j * wave.phase))[:, None] * coeffs
     out = np.empty((n, len(offsets), weights.shape[1]))
-    periods = {}
+    sub = next((s for s in (1, 2) if all(abs(c * s - round(c * s)) < 1e-12 for c in offsets)),
+               None)
+    period = repeat_period(wave, weights, dt / sub) \
+        if sub is not None and wave.omega.size > 16 else None
     for j, c in enumerate(offsets):
-        whole = int(np.floor(c))
-        frac = float(c) - whole
-        if wave.omega.size > 16 and frac not in periods:
-            shifted = weights * np.exp(-1j * wave.omega * frac * dt)[:, None] if frac else weights
-            periods[frac] = repeat_period(wave, shifted, dt)
-        if periods.get(frac) is not None:
-            period = periods[frac]
-            out[:, j] = period[(np.arange(n) + whole) % period.shape[0]]
+        if period is not None:             # periodic in its length: longer records wrap
+            out[:, j] = period[(int(round(c * sub)) + sub * np.arange(n)) % period.shape[0]]
         else:
             out[:, j] = _synthesise_uniform(wave, weights, n, dt, c * dt)
         t = (np.arange(n) + c) * dt
