@@ -71,6 +71,7 @@ bench: $(VENV)/.installed-test
 	$(PY) benchmarks/wavebot_hull_fit.py --out $(OUT)/bench/wavebot_hull
 	$(PY) benchmarks/export_qp.py
 	$(PY) benchmarks/export_step.py --out $(OUT)/bench/export
+	$(PY) benchmarks/export_site.py
 
 clean:
 	rm -rf $(OUT) .pytest_cache
