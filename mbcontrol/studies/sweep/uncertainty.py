@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import json
 import math
-import os
 from pathlib import Path
 
 import numpy as np
@@ -79,24 +78,18 @@ def add_uncertainty(summary: dict, ds, seas, plant, *, controller, settings, par
     if ds["mean_power_W"].ndim != 2:           # other quantities varied: no single law per sea
         return
     laws, why_not, waves = [], None, []
-
-    def per_sea(k):                      # each sea's law, components and spectral entries
+    for k, sea in enumerate(seas):
         gains, why = sea_gains(ds, k, plant, controller, settings, params)
+        laws.append(gains)
+        why_not = why_not or why
         if gains is None:
-            return gains, why, None, {}
-        wave, rms = sea_components(plant, seas[k], duration)
+            waves.append(None)
+            continue
+        wave, rms = sea_components(plant, sea, duration)
+        waves.append(wave)
         n_valid = rows[k].get("valid_seeds", int(ds["valid"].isel(sea=k).sum()))
-        return gains, why, wave, spectral_row(plant, wave, rms, gains, duration, amplitudes,
-                                              n_valid, rows[k]["mean_power_W"])
-    # the seas on threads: their exact power forms are numpy's n^2 work on an hour's ~1,500
-    # components (the GIL released), 4.3 s serially for 16 rm3 seas; same numbers, same order
-    from concurrent.futures import ThreadPoolExecutor
-    with ThreadPoolExecutor(max_workers=max(1, min(len(seas), os.cpu_count() or 1))) as pool:
-        for k, (gains, why, wave, row) in enumerate(pool.map(per_sea, range(len(seas)))):
-            laws.append(gains)
-            why_not = why_not or why
-            waves.append(wave)
-            rows[k].update(row)
+        rows[k].update(spectral_row(plant, wave, rms, gains, duration, amplitudes, n_valid,
+                                    rows[k]["mean_power_W"]))
     if summary.get("annual_energy_MWh") is None:
         return
     weights = np.array([s.weight for s in seas])
