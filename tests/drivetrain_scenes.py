@@ -15,10 +15,14 @@ phases = 3
 """
 
 
-def catalogue_copy(folder: Path, model: str, suffix: str, appended: str) -> Path:
+def catalogue_copy(folder: Path, model: str, suffix: str, appended: str, *, kernel_judged: bool = False) -> Path:
     """`folder/<model>_<suffix>.toml`: the catalogue scene, its hydro file made absolute,
-    with `appended` added to its last table (its only PTO in the scenes used here)."""
+    with `appended` added to its last table (its only PTO in the scenes used here).
+    kernel_judged: its radiation fit judged by the kernel, so it does not depend on the device
+    (springs, drivetrains) and variants of one device share one fit."""
     text = (catalogue_dir() / f"{model}.toml").read_text()
+    if kernel_judged:
+        text = text.replace("[hydro]\n", '[hydro]\nfit_judged_by = "kernel"\n', 1)
     text = text.replace('file = "', f'file = "{catalogue_dir()}/')
     text = "\n".join(line for line in text.splitlines()
                      if not line.startswith(("source =", "source_bodies")))

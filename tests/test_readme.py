@@ -51,7 +51,7 @@ TABLES = {
     "drivetrain": ("measured", "benchmarks/wecopttool_tste.py"),
     "r2 \\ J (kg m², scale 1)": ("measured", "notebooks/codesign.ipynb"),
     "data": ("measured", "benchmarks/radiation_fit.py"),
-    "catalogue fit": ("measured", "--judged-by response"),
+    "catalogue fit": ("test", "tests/test_catalogue.py"),
     "method": ("reference", "the integration methods by name"),
     "scenario": ("measured", "--stability"),
     "model, sea, tol": ("measured", "fidelity_auto"),

@@ -40,17 +40,21 @@ def run_models(args) -> int:
 
 
 def run_hydro(args) -> int:
+    from ..plant import response_error_of
     plant = _plant(args, radiation_tol=args.tol)
     if plant.hydro is None:
         print(f"{plant.name}: no hydrodynamic bodies")
         return 0
     rad, rep = plant.hydro.radiation, plant.hydro.radiation.report
+    judged_by = "response" if rep.get("response_error") is not None else "kernel"
+    # a kernel-judged fit's response error too, so the two measures can be set side by side
+    response = rep.get("response_worst") if judged_by == "response" else response_error_of(plant)
     report = {"model": plant.name, "source": plant.hydro.source, "dofs": list(plant.hydro.dofs),
               "omega_rad_s": [float(plant.hydro.omega[0]), float(plant.hydro.omega[-1])],
               "n_omega": int(plant.hydro.omega.size), "radiation_states": int(rad.order),
-              "fit_error": float(rad.fit_error), **{k: rep.get(k) for k in (
-                  "tol", "tol_met", "response_band", "band_error", "worst", "rms_error", "response_error",
-                  "response_worst", "limited_by")},
+              "fit_error": float(rad.fit_error), "judged_by": judged_by, **{k: rep.get(k) for k in (
+                  "tol", "tol_met", "response_band", "band_error", "worst", "rms_error", "limited_by")},
+              "response_error": response["error"] if response else None, "response_worst": response,
               "max_pole_real_part": float(np.max(np.linalg.eigvals(rad.A).real)), "report": jsonable(rep)}
     if args.json:
         print(json.dumps(report, indent=2))
@@ -71,6 +75,9 @@ def run_hydro(args) -> int:
                 print(f"  the kernel's own error (not what judges the fit): {kernel}")
             else:
                 print(f"  fit error {rad.fit_error:.2%} (tol {rep['tol']:.2%}{'' if rep['tol_met'] else ', MISSED'}): {kernel}")
+                if response:
+                    print(f"  its response error (not what judges this fit): {response['error']:.2%} at "
+                          f"{response['omega']:.4g} rad/s, most the {response['what']}")
     return 0
 
 

@@ -23,8 +23,8 @@ from ..cache import cache_dir, status
 from ..errors import HydroError
 from ..scene import DOF_NAMES, Scene
 from ..waves import Wave, coefficient_series, excitation_series, interpolate_complex
-from .fit import (array_fit, array_passivity, fit_error, passive_order, passivity, radiation, response_error, sdp,
-                  vector_fit)
+from .fit import (array_fit, array_passivity, fit_error, kernel, passive_order, passivity, radiation, response_error,
+                  sdp, vector_fit)
 from .data.netcdf import read_netcdf
 from .bem.solve import compute
 from .mesh.geometry import BemBody
@@ -327,7 +327,7 @@ def _fit_cached(data: xr.Dataset, dofs, tol, source: str, omega_max: float = np.
     for var in ("added_mass", "radiation_damping", "added_mass_inf"):
         digest.update(np.ascontiguousarray(data[var].values).tobytes())
     # the fitting code is part of the key: a changed algorithm never serves an old fit
-    for module in (radiation, fit_error, vector_fit, passive_order, passivity, sdp, response_error):
+    for module in (radiation, kernel, fit_error, vector_fit, passive_order, passivity, sdp, response_error):
         digest.update(Path(module.__file__).read_bytes())
     band = fit_band_limit(data, omega_max)
     response_band = None if response_band is None else [float(x) for x in response_band]

@@ -14,10 +14,10 @@ from .catenary_line import CatenaryLine, catenary_line
 from .fidelity import Fidelity, FidelityError, plant_for
 from .jacobians import jacobians
 from .mechanical import MechanicalMatrices, dof_selector, linear_params, mechanical_matrices
-from .process import ProcessPlant, active_hydro_dofs, device_around
+from .process import ProcessPlant, active_hydro_dofs, device_around, response_error_of
 from .provenance import provenance
 
 __all__ = ["build_plant", "ProcessPlant", "active_hydro_dofs", "dof_selector", "jacobians",
            "Fidelity", "FidelityError", "plant_for", "CatenaryLine", "CatenarySolution",
            "catenary_line", "solve_catenary", "provenance", "MechanicalMatrices", "mechanical_matrices",
-           "device_around", "linear_params"]
+           "device_around", "linear_params", "response_error_of"]

@@ -359,3 +359,19 @@ def device_around(scene, source: str, data, dofs) -> Device:
     return Device(tuple(plant.topology.tree.coordinate_names), tuple(dofs), mech.mass + mech.added_mass_inf,
                   mech.damping, mech.stiffness, mech.P_hydro, excitation, data["omega"].values,
                   data["wave_direction"].values, scene.hydro.response_band)
+
+
+def response_error_of(plant) -> dict | None:
+    """The response error (module hydro.fit.response_error) of the plant's radiation fit, whatever
+    judged it: {"error", "omega", "weight", "what"} at the worst fitted frequency, on the data the
+    fit saw (its band, BEM reciprocity as it applied it), the device at rest with its PTOs free.
+    None for a plant without radiation states."""
+    from ..hydro.fit.kernel import kernel_data, reciprocal
+    hydro = plant.hydro
+    if hydro is None or hydro.radiation.order == 0:
+        return None
+    rad = hydro.radiation
+    dofs = list(rad.dofs)
+    w, K, _ = kernel_data(hydro.data, dofs, rad.report["omega_fit"][1])
+    device = device_around(plant.scene, hydro.source, hydro.data, dofs)
+    return device.at(w, reciprocal(K)[0]).worst(rad.frequency_response(w))

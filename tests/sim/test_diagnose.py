@@ -11,6 +11,8 @@ from mbcontrol.plant import build_plant
 from mbcontrol.sim import simulate
 from mbcontrol.sim.diagnose import closed_loop_poles, unstable
 
+from kernel_fits import judged_by_kernel   # tests/ is on sys.path (conftest.py)
+
 
 @pytest.fixture(scope="module")
 def rm3():
@@ -50,10 +52,10 @@ def test_closed_loop_poles_of_a_stable_damper_are_stable(rm3):
 
 
 def test_a_step_too_large_is_still_blamed_on_the_step():
-    """The sphere's fastest radiation pole (-16.7 1/s) makes RK4 unstable at dt = 0.2 s
-    (|lambda dt| > 2.78) under a stable damper: the linear check finds the loop stable and the
-    rerun at 0.1 s does not diverge, so the remedy stays a smaller dt."""
-    sphere = build_plant("sphere")
+    """The kernel-judged sphere fit's fastest radiation pole (-16.7 1/s) makes RK4 unstable at
+    dt = 0.2 s (|lambda dt| > 2.78) under a stable damper: the linear check finds the loop stable
+    and the rerun at 0.1 s does not diverge, so the remedy stays a smaller dt."""
+    sphere = build_plant(judged_by_kernel("sphere"))
     with pytest.raises(SimulationError, match="smaller dt") as info:
         simulate(sphere, waves.regular(1.0, 8.0), duration=60.0, dt=0.2,
                  controller=make("passive", damping=5e5))

@@ -6,11 +6,15 @@ from mbcontrol import waves
 from mbcontrol.cli import main
 from mbcontrol.studies import workprecision as wp
 
+from kernel_fits import judged_by_kernel   # tests/ is on sys.path (conftest.py)
+
 
 @pytest.fixture(scope="module")
 def chart():
+    """The sphere with its kernel-judged fit, whose pole at -16.7 rad/s makes RK4 fail above
+    0.169 s (tests/sim/test_stability.py): the chart must show where a method fails."""
     sea = waves.irregular(2.5, 9.67, seed=1, duration=80)
-    return wp.work_precision("sphere", sea, duration=80, methods=("rk4", "exp-rk4", "cvodes"),
+    return wp.work_precision(judged_by_kernel("sphere"), sea, duration=80, methods=("rk4", "exp-rk4", "cvodes"),
                              steps=[9.67 / 2**k for k in range(2, 7)], rtols=(1e-4, 1e-7),
                              radiation_tols=(0.2,), repeats=1)
 

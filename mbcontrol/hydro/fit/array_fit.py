@@ -36,7 +36,7 @@ from mbcontrol.errors import HydroError
 
 from .array_passivity import enforce_columns
 from .fit_error import _group_errors, _nerr
-from .kernel import _cos_transform, _with_tail, kernel_data
+from .kernel import RECIPROCITY, _cos_transform, _with_tail, kernel_data, reciprocal
 from .radiation import RadiationModel
 from .vector_fit import TAIL_POINTS, TAIL_WEIGHT, _basis, _relocate, _residues
 
@@ -92,8 +92,7 @@ def fit_radiation_columns(ds, dofs=None, *, tol: float = 0.02, omega_max=None, r
         raise HydroError(f"fit_radiation_columns: {w.size} frequencies below omega_max={omega_max}; "
                          "expected at least 4")
     n = len(dofs)
-    asym = np.linalg.norm(K - np.swapaxes(K, 1, 2)) / max(np.linalg.norm(K), 1e-300)
-    Ks = 0.5 * (K + np.swapaxes(K, 1, 2)) if asym < 1e-2 else K
+    Ks, asym = reciprocal(K)                 # BEM reciprocity, up to discretisation
     # BEM frequencies only: a far pair's K_ij turns its phase by k d (k = ω²/g), 2 rad between
     # samples at 12 rad/s and 4 m, so interpolates would be fitted as if they were data
     wf, Kf, weight, bem = w, Ks, np.ones(w.size), np.ones(w.size, bool)
@@ -219,7 +218,7 @@ def _report(model, fit, K, w, dofs, classes, fits, passivity, history, tol, err,
         "column_classes": len(fits), "class_of_column": [int(r) for r, _ in classes],
         "poles_per_column": {dofs[r]: int(f[1].shape[0]) for r, f in fits.items()},
         "rounds": history, "tol": float(tol), "tol_met": bool(err <= tol),
-        "dofs": list(dofs), "symmetrized": bool(asym < 1e-2), "asymmetry": float(asym),
+        "dofs": list(dofs), "symmetrized": bool(asym < RECIPROCITY), "asymmetry": float(asym),
         "omega_fit": [float(w.min()), float(w.max())], "n_omega": int(w.size),
         "slowest_decay": float(-np.max(ev.real)), "max_real_eig": float(np.max(ev.real)),
         "passivity": {"enforce": True, "enforced": passivity["corrections"] > 0, **passivity},

@@ -32,6 +32,16 @@ def kernel_data(ds, dofs=None, omega_max=None):
     return w[keep], K, dofs
 
 
+RECIPROCITY = 1e-2   # relative asymmetry of K below which it is BEM discretisation error
+
+
+def reciprocal(K) -> tuple[np.ndarray, float]:
+    """(K, asymmetry): K (nω, n, n) made symmetric, as BEM reciprocity has it, when its relative
+    asymmetry ‖K - Kᵀ‖ / ‖K‖ is below RECIPROCITY; otherwise K as it is (data that mean it)."""
+    asym = float(np.linalg.norm(K - np.swapaxes(K, 1, 2)) / max(np.linalg.norm(K), 1e-300))
+    return (0.5 * (K + np.swapaxes(K, 1, 2)) if asym < RECIPROCITY else K), asym
+
+
 def tail_exponent(w, B) -> float:
     """Decay exponent p of B(ω) ∝ ω^-p above the band, from the diagonal over the top 40 % of ω.
 

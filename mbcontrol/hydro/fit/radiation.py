@@ -23,12 +23,13 @@ whose transfer function is K(jω) = B(ω) + jω(A(ω) - A∞) (ERRATA §4 "Radia
 
 Error (decides the order; ``tol`` bounds it). With a ``device`` (every plant built from a scene
 passes one, :func:`mbcontrol.plant.device_around`) it is the error the fit causes in the device's
-own response, per BEM frequency: its admittance and its velocity per unit wave amplitude, each
-relative to the coordinate's peak, the device linear at rest with its joint stiffness and PTOs
-(module response_error); ``response_band`` then only limits where it is judged. A kernel error
-where the device does not move is then free (rm3's plate damping at 0.3 rad/s, 537 % off in K and
-nothing in the motion), and one at a lightly damped mode is not (the flap's hinge damping). The
-kernel's own errors are reported beside it. Without a device (a dataset fitted on its own):
+own response, per BEM frequency: the largest relative change of the device's velocity under any
+generalised force, ‖D Z'⁻¹ P δK Pᵀ D⁻¹‖ in the kinetic-energy norm, the device linear at rest with
+its joint stiffness and drivetrains and its PTOs free, weighted down where its wave motion is under
+a tenth of its peak (module response_error); ``response_band`` then only limits where it is
+judged. A kernel error where the device does not move is then free (rm3's plate damping at
+0.3 rad/s, 537 % off in K and nothing in the motion), and one at a lightly damped mode is not (the
+flap's hinge damping). The kernel's own errors are reported beside it. Without a device (a dataset fitted on its own):
 - in the response band (``response_band``), per decoupled group, in D K D (D = diag(1/√max_ω|K_ii|):
   each DOF's peak 1, so units drop out), at every BEM frequency ω and entry ij
       e_ij(ω) = max(|Re δK_ij| / R(ω), |Im δK_ij| / I(ω)),   R = max(max_kl |Re K_kl(ω)|, FLOOR),
@@ -56,7 +57,7 @@ import scipy.linalg as sla
 from mbcontrol.errors import HydroError
 
 from ..data.dataset import matrix
-from .kernel import _cos_transform, _with_tail, kernel_data
+from .kernel import RECIPROCITY, _cos_transform, _with_tail, kernel_data, reciprocal
 from .passivity import _response, passivity_test
 from .fit_error import FLOOR, _group_errors, _nerr, _worst, miss_message
 from .vector_fit import SLOW_POLE, _best_scaled_fit
@@ -65,9 +66,10 @@ ZERO_COUPLING = 1e-6  # |K_ij| <= this * sqrt(max|K_ii| max|K_jj|): treated as a
 DENSE_STEP = 0.02  # fit on a grid refined (by interpolation) to Δω <= 2 % of ω
 
 
-RESPONSE_DEFINITION = ("the worst over the BEM ω (in the response band) of the change the fit makes in the "
-                       "device's admittance |δY_ij| / sqrt(peak|Y_ii| peak|Y_jj|) and in its velocity per unit wave "
-                       "amplitude |δH_i| / peak|H_i|, the device linear at rest with its PTOs (module response_error)")
+RESPONSE_DEFINITION = ("the worst over the fit band's ω (in the response band) of the largest relative change the fit "
+                       "makes in the device's velocity under any generalised force, ||D Z'^-1 P dK P^T D^-1|| with "
+                       "D = diag(sqrt(M_ii)), the device linear at rest with its joint stiffness and drivetrains and "
+                       "its PTOs free, weighted by min(1, wave motion / (0.1 x its peak)) (module response_error)")
 
 
 class RadiationFitWarning(UserWarning):
@@ -185,8 +187,7 @@ def fit_radiation(ds, dofs=None, *, tol: float = 0.02, max_order: int = 30, omeg
     if w.size < 4:
         raise HydroError(f"fit_radiation: {w.size} frequencies below omega_max={omega_max}; expected at least 4")
     n = len(dofs)
-    asym = np.linalg.norm(K - np.swapaxes(K, 1, 2)) / max(np.linalg.norm(K), 1e-300)
-    Ks = 0.5 * (K + np.swapaxes(K, 1, 2)) if asym < 1e-2 else K  # BEM reciprocity, up to discretisation
+    Ks, asym = reciprocal(K)                 # BEM reciprocity, up to discretisation
     groups, link = _groups(Ks)
     # K(t=0+) = (2/π)∫B dω = C B, with B(0) = 0 and the power-law tail of impulse_response. Only
     # meaningful for a group whose B has decayed inside the band (Σ|B_ii| over its DOFs at ω_max
@@ -260,7 +261,7 @@ def fit_radiation(ds, dofs=None, *, tol: float = 0.02, max_order: int = 30, omeg
         "response_worst": gate_w.worst(fit) if device is not None else None,
         "slowest_decay": float(-np.max(ev.real)) if order else None, "decay_floor": SLOW_POLE * float(w.min()),
         "dofs": list(dofs), "entry_errors": entry.tolist(),
-        "groups": info, "symmetrized": bool(asym < 1e-2), "asymmetry": float(asym),
+        "groups": info, "symmetrized": bool(asym < RECIPROCITY), "asymmetry": float(asym),
         "tail_exponent": float(p_tail), "markov_imposed": [group_markov(g) is not None for g in groups],
         "omega_fit": [float(w.min()), float(w.max())], "n_omega": int(w.size), "tol": float(tol),
         "tol_met": bool(err <= tol),

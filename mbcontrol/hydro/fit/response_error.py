@@ -35,6 +35,7 @@ import numpy as np
 from ...waves import interpolate_complex
 
 SIGNIFICANT = 6        # digits of the device's matrices in a fit's cache key
+ROUND_OFF = 1e-9       # entries below this share of their array's largest are zeros in the key
 MOVES = 0.1            # full weight where the device's wave motion is at least this share of its peak
 LS_FLOOR = 0.02        # least-squares weight where the response is insensitive (of the largest):
                        # the fit stays sane there (impulse response, step sizes) without spending poles
@@ -61,9 +62,13 @@ class Device:
     band: tuple | None = None
 
     def key(self) -> list:
-        """What a fit judged by this device depends on, rounded for a cache key."""
+        """What a fit judged by this device depends on, rounded for a cache key: each array to
+        SIGNIFICANT digits, entries below ROUND_OFF of its largest as 0 (round-off, e.g. a
+        large-angle plant's stiffness at rest against a linear one's, must not make a new fit)."""
         def rounded(a):
-            return [float(f"{x:.{SIGNIFICANT}g}") for x in np.ravel(a)]
+            a = np.ravel(a)
+            floor = ROUND_OFF * np.max(np.abs(a), initial=0.0)
+            return [float(f"{x:.{SIGNIFICANT}g}") if abs(x) > floor else 0.0 for x in a]
         return [list(self.coordinates), list(self.dofs), rounded(self.mass), rounded(self.damping),
                 rounded(self.stiffness), rounded(self.P), rounded(np.abs(self.excitation)),
                 list(self.band) if self.band else None]
