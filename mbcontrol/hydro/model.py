@@ -8,31 +8,25 @@ temporary file and renamed.
 from __future__ import annotations
 
 import functools
-import hashlib
-import json
-import time
-import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import xarray as xr
 
-from ..atomic import atomic_path
-from ..cache import cache_dir, status
+from ..cache import cache_dir
 from ..errors import HydroError
 from ..scene import DOF_NAMES, Scene
 from ..waves import Wave, coefficient_series, excitation_series, interpolate_complex
-from .fit import (array_fit, array_passivity, fit_error, kernel, passive_order, passivity, radiation, response_error,
-                  sdp, vector_fit)
 from .data.netcdf import read_netcdf
 from .bem.solve import compute
 from .mesh.geometry import BemBody
 from .data.headings import axisymmetric_headings, excitation_over_headings, heading_matrix, headings_line
 from .bem.isolated import compute_isolated
 from .bem.neighbours import compute_within
-from .fit.radiation import RadiationModel, fit_radiation
+from .fit.radiation import RadiationModel
 from .fit.response_error import Device
+from .fit.store import FITS_SERVED, cached_fit, fit_band_limit, model_from_arrays, shipped_fits_dir  # noqa: F401 (the model's face)
 from .fit.ssforms import modal_form
 
 
@@ -162,7 +156,7 @@ class HydroModel:
         if missing:
             raise HydroError(f"{self.source}: the plant moves {missing} but the hydro model "
                              f"only has {list(self.dofs)}")
-        return HydroModel(dofs, self.data, _fit_cached(self.data, dofs, None, self.source,
+        return HydroModel(dofs, self.data, cached_fit(self.data, dofs, None, self.source,
                                                        self.fit_omega_max, self.response_band,
                                                        self.fit_method),
                           self.source, self.fit_omega_max, self.response_band, self.fit_method)
@@ -237,7 +231,7 @@ def fit_hydro_model(data: xr.Dataset, dofs, tol: float | None, source: str,
     bodies): the cache key is the data itself, so a changed dataset never serves an old fit.
     """
     _check_dofs(data, dofs, source)
-    fit = _fit_cached(data, tuple(dofs), tol, source, fit_omega_max, response_band, method, device)
+    fit = cached_fit(data, tuple(dofs), tol, source, fit_omega_max, response_band, method, device)
     return HydroModel(tuple(dofs), data, fit, source, fit_omega_max, response_band, method, device)
 
 
@@ -298,100 +292,3 @@ def _check_dofs(data: xr.Dataset, dofs, source: str) -> None:
     if missing:
         raise HydroError(f"{source}: the scene's joints move {missing}, but the hydro data "
                          f"has only {sorted(have)}")
-
-
-def fit_band_limit(data: xr.Dataset, scene_limit: float = np.inf) -> float | None:
-    """Highest frequency the radiation fit uses: the scene's fit_omega_max, and for our own
-    BEM runs no higher than where the mesh is still resolved.
-
-    Above `omega_max_mesh` (fewer than 8 panels per wavelength) panel-method damping loses
-    accuracy and even passivity; third-party files carry irregular-frequency spikes the scene
-    can exclude. Fitting either would spend states on numerical artefacts.
-    """
-    limit = min(float(data.attrs.get("omega_max_mesh", np.inf)), float(scene_limit))
-    return limit if np.isfinite(limit) else None
-
-
-FITS_SERVED: list = []      # the fit files asked for, in order (models/generate_hydro.py --ship-fits)
-
-
-def _fit_cached(data: xr.Dataset, dofs, tol, source: str, omega_max: float = np.inf, response_band=None,
-                method: str = "coupled", device: Device | None = None):
-    """fit_radiation (``method`` "coupled", judged by ``device``'s response when given) or
-    fit_radiation_columns ("columns": the kernel's own error) with an on-disk cache keyed by the
-    data, the DOFs, the tolerance, the bands, the method and the device."""
-    if method not in ("coupled", "columns"):
-        raise HydroError(f"radiation fit method {method!r}: expected 'coupled' or 'columns'")
-    tol = 0.01 if tol is None else tol
-    digest = hashlib.sha256()
-    for var in ("added_mass", "radiation_damping", "added_mass_inf"):
-        digest.update(np.ascontiguousarray(data[var].values).tobytes())
-    # the fitting code is part of the key: a changed algorithm never serves an old fit
-    for module in (radiation, kernel, fit_error, vector_fit, passive_order, passivity, sdp, response_error):
-        digest.update(Path(module.__file__).read_bytes())
-    band = fit_band_limit(data, omega_max)
-    response_band = None if response_band is None else [float(x) for x in response_band]
-    digest.update(json.dumps([list(dofs), tol, band] + ([response_band] if response_band else [])).encode())
-    device = device if method == "coupled" else None
-    if device is not None:
-        digest.update(json.dumps(device.key()).encode())
-    if method == "columns":    # (the coupled fit's keys stay as they were: shipped fits still found)
-        for module in (array_fit, array_passivity):
-            digest.update(b"columns" + Path(module.__file__).read_bytes())
-    name = f"radiation_{digest.hexdigest()[:20]}.npz"
-    FITS_SERVED.append(name)
-    shipped = shipped_fits_dir() / name
-    if shipped.exists():                       # the catalogue's, made by generate_hydro.py
-        with np.load(shipped, allow_pickle=False) as z:
-            return _model_from_arrays(z)
-    path = cache_dir() / name
-    if path.exists():
-        try:
-            with np.load(path, allow_pickle=False) as z:
-                return _model_from_arrays(z)
-        except (OSError, ValueError, KeyError):
-            path.unlink(missing_ok=True)       # a stale or foreign file: refit
-    started = time.perf_counter()
-    status(f"fitting the radiation model of {Path(source).name} ({len(dofs)} DOFs, tolerance "
-           f"{tol:g}, {method}): typically 5-90 s, once; cached afterwards", __name__)
-    judged = {"device": device} if device is not None else {}
-    fitter = fit_radiation if method == "coupled" else array_fit.fit_radiation_columns
-    model = fitter(data, dofs=list(dofs), tol=tol, omega_max=band, response_band=response_band, **judged)
-    status(f"radiation model fitted in {time.perf_counter() - started:.1f} s: "
-           f"{model.order} states, error {model.fit_error:.2%}", __name__)
-    with atomic_path(path) as tmp, open(tmp, "wb") as fh:
-        np.savez(fh, A=model.A, B=model.B, C=model.C, D=model.D, dofs=np.array(model.dofs),
-                 order=model.order, fit_error=model.fit_error, entry_errors=model.entry_errors,
-                 report=json.dumps(model.report, default=_jsonable))
-    return model
-
-
-def shipped_fits_dir() -> Path:
-    """The radiation fits shipped with the catalogue (models/radiation_fits), keyed as the
-    cache is: by the data, the DOFs, the tolerance, the band and the fitting code itself, so a
-    shipped fit serves exactly the fit it replaces and a stale one is never found."""
-    from importlib.resources import files
-    try:
-        return Path(str(files("mbcontrol.models"))) / "radiation_fits"
-    except ModuleNotFoundError:
-        return Path(__file__).resolve().parents[2] / "models" / "radiation_fits"
-
-
-def _model_from_arrays(z) -> RadiationModel:
-    model = RadiationModel(A=z["A"], B=z["B"], C=z["C"], D=z["D"],
-                           dofs=tuple(str(d) for d in z["dofs"]), order=int(z["order"]),
-                           fit_error=float(z["fit_error"]), entry_errors=z["entry_errors"],
-                           report=json.loads(str(z["report"])))
-    if model.report.get("tol_met") is False and "limited_by" in model.report:  # as loud as a fresh fit
-        warnings.warn(radiation.RadiationFitWarning(radiation.miss_message(model.report)), stacklevel=4)
-    return model
-
-
-def _jsonable(obj):
-    if isinstance(obj, np.ndarray):
-        return obj.tolist() if obj.dtype.kind != "c" else [obj.real.tolist(), obj.imag.tolist()]
-    if isinstance(obj, np.generic):
-        return obj.item()
-    if isinstance(obj, complex):
-        return [obj.real, obj.imag]
-    return str(obj)

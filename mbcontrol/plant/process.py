@@ -366,12 +366,10 @@ def response_error_of(plant) -> dict | None:
     judged it: {"error", "omega", "weight", "what"} at the worst fitted frequency, on the data the
     fit saw (its band, BEM reciprocity as it applied it), the device at rest with its PTOs free.
     None for a plant without radiation states."""
-    from ..hydro.fit.kernel import kernel_data, reciprocal
+    from ..hydro.fit.response_error import response_error_on
     hydro = plant.hydro
     if hydro is None or hydro.radiation.order == 0:
         return None
     rad = hydro.radiation
-    dofs = list(rad.dofs)
-    w, K, _ = kernel_data(hydro.data, dofs, rad.report["omega_fit"][1])
-    device = device_around(plant.scene, hydro.source, hydro.data, dofs)
-    return device.at(w, reciprocal(K)[0]).worst(rad.frequency_response(w))
+    device = device_around(plant.scene, hydro.source, hydro.data, list(rad.dofs))
+    return response_error_on(device, hydro.data, rad, rad.report["omega_fit"][1])

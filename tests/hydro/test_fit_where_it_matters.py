@@ -123,7 +123,7 @@ def test_missed_tolerance_warns_with_value_and_place(empty_cache):
     arrays = dict(A=m.A, B=m.B, C=m.C, D=m.D, dofs=np.array(m.dofs), order=m.order, fit_error=m.fit_error,
                   entry_errors=m.entry_errors, report=__import__("json").dumps(rep))
     with pytest.warns(RadiationFitWarning, match="misses its tolerance"):
-        hydro_model._model_from_arrays(arrays)
+        hydro_model.model_from_arrays(arrays)
 
 
 @pytest.mark.parametrize("name", list_models())

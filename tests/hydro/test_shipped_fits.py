@@ -4,7 +4,7 @@ run makes."""
 import numpy as np
 import pytest
 
-from mbcontrol.hydro import model as hydro_model
+from mbcontrol.hydro.fit import store as hydro_model   # where fits are found and made
 from mbcontrol.plant import build_plant
 from mbcontrol.scene import list_models, load_scene
 
@@ -46,3 +46,28 @@ def test_shipped_fit_equals_a_fresh_fit(empty_cache, monkeypatch):
     w = np.linspace(0.1, 3.0, 60)
     np.testing.assert_allclose(fresh.frequency_response(w), shipped.frequency_response(w),
                                rtol=1e-8, atol=1e-8 * np.abs(shipped.frequency_response(w)).max())
+
+
+def test_a_fit_made_for_another_device_serves_when_it_meets_the_tolerance(empty_cache, monkeypatch, tmp_path):
+    """The sphere with a drivetrain (its inertia changes the device, so the fit's name) is served
+    the catalogue sphere's shipped fit, without fitting: that fit's response error in the new
+    device, recomputed independently by plant.response_error_of, is within the tolerance and is
+    what its report now says. The same fit against a tolerance it misses is not reused."""
+    from drivetrain_scenes import with_drivetrain
+    from mbcontrol.plant import device_around, response_error_of
+
+    def no_fitting(*args, **kwargs):
+        raise AssertionError("fitted anew although a shipped fit meets the tolerance")
+    monkeypatch.setattr(hydro_model, "fit_radiation", no_fitting)
+    plant = build_plant(with_drivetrain(tmp_path, "sphere", gear=12.0, inertia=200.0))
+    rad = plant.hydro.radiation
+    assert rad.report["made_for_another_device"] in {p.name for p in hydro_model.shipped_fits_dir().iterdir()}
+    worst = response_error_of(plant)
+    assert rad.fit_error == rad.report["response_error"] == pytest.approx(worst["error"], rel=1e-9)
+    assert worst["error"] <= plant.scene.hydro.radiation_tol and rad.report["tol_met"]
+    assert hydro_model.FITS_SERVED[-1] in {p.name for p in empty_cache.glob("radiation_*.npz")}   # kept
+    # the gate itself: the same candidates against a tolerance the fit misses give nothing
+    base = rad.report["made_for_another_device"].split("_")[1]
+    device = device_around(plant.scene, plant.hydro.source, plant.hydro.data, list(rad.dofs))
+    assert hydro_model._reused_fit(base, plant.hydro.data, rad.report["omega_fit"][1], 1e-3 * worst["error"],
+                                   device) is None

@@ -33,6 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...waves import interpolate_complex
+from .kernel import kernel_data, reciprocal
 
 SIGNIFICANT = 6        # digits of the device's matrices in a fit's cache key
 ROUND_OFF = 1e-9       # entries below this share of their array's largest are zeros in the key
@@ -151,3 +152,12 @@ class GroupJudge:
 
     def sensitivity(self, scale=None) -> np.ndarray:
         return self.gate.sensitivity(self.group, scale)
+
+
+def response_error_on(device: Device, data, fit, omega_max=None) -> dict:
+    """The response error of ``fit`` (a RadiationModel of ``data``) in ``device``, as
+    fit_radiation judges it: on the data's frequencies up to omega_max (rad/s), K made reciprocal
+    as the fit had it (kernel.reciprocal); the ResponseGate.worst dict (its "error" is the max)."""
+    dofs = list(fit.dofs)
+    w, K, _ = kernel_data(data, dofs, omega_max)
+    return device.restricted(dofs).at(w, reciprocal(K)[0]).worst(fit.frequency_response(w))
