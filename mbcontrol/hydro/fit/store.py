@@ -57,7 +57,7 @@ def cached_fit(data: xr.Dataset, dofs, tol, source: str, omega_max: float = np.i
     response_band = None if response_band is None else [float(x) for x in response_band]
     digest.update(json.dumps([list(dofs), tol, band] + ([response_band] if response_band else [])).encode())
     device = device if method == "coupled" else None
-    if method == "columns":    # (the coupled fit's keys stay as they were: shipped fits still found)
+    if method == "columns":
         for module in (array_fit, array_passivity):
             digest.update(b"columns" + Path(module.__file__).read_bytes())
     base = digest.hexdigest()
@@ -136,7 +136,7 @@ def shipped_fits_dir() -> Path:
     try:
         return Path(str(files("mbcontrol.models"))) / "radiation_fits"
     except ModuleNotFoundError:
-        return Path(__file__).resolve().parents[2] / "models" / "radiation_fits"
+        return Path(__file__).resolve().parents[3] / "models" / "radiation_fits"   # the repository's
 
 
 def model_from_arrays(z, quiet: bool = False) -> RadiationModel:
