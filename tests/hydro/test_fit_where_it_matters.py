@@ -172,9 +172,10 @@ def test_response_error_of_a_plant_is_what_its_fit_reports(name):
     response-judged fit's own reported error: the same data, band and reciprocity (rm3's K is
     symmetrised, hinged_raft's is not: its asymmetry is over 1 %)."""
     from mbcontrol.plant import response_error_of
-    rad = _quiet_plant(name).hydro.radiation
+    plant = _quiet_plant(name)
+    rad = plant.hydro.radiation
     assert rad.report["symmetrized"] is (name == "rm3")
-    worst = response_error_of(_quiet_plant(name))
+    worst = response_error_of(plant)
     assert worst["error"] == pytest.approx(rad.report["response_error"], rel=1e-9)
     reported = rad.report["response_worst"]
     assert (worst["omega"], worst["what"]) == (reported["omega"], reported["what"])

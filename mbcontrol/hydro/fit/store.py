@@ -65,13 +65,12 @@ def cached_fit(data: xr.Dataset, dofs, tol, source: str, omega_max: float = np.i
     name = (f"radiation_{base[:20]}.npz" if device is None else
             f"radiation_{base[:16]}_{hashlib.sha256(json.dumps(device.key()).encode()).hexdigest()[:12]}.npz")
     path = cache_dir() / name
+    FITS_SERVED.append(name)
     model = _load_fit(name) or (_reused_fit(base[:16], data, band, tol, device) if device is not None else None)
     if model is not None:
         if not path.exists() and not (shipped_fits_dir() / name).exists():
             _save_fit(path, model)             # a reused fit, under this device's name from now on
-        FITS_SERVED.append(name)
         return model
-    FITS_SERVED.append(name)
     started = time.perf_counter()
     status(f"fitting the radiation model of {Path(source).name} ({len(dofs)} DOFs, tolerance "
            f"{tol:g}, {method}): typically 5-90 s, once; cached afterwards", __name__)
