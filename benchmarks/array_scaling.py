@@ -45,7 +45,7 @@ def measure(n_side: int, fit_tol: float) -> dict:
     t_bem = time.perf_counter() - t0
     t0 = time.perf_counter()
     hydro = fit_hydro_model(data, dofs, scene.hydro.radiation_tol, source, scene.hydro.fit_omega_max,
-                            scene.hydro.response_band, fit_method(scene.hydro.radiation_fit, dofs))
+                            scene.hydro.response_band, fit_method(scene.hydro.radiation_fit, dofs, data))
     t_fit = time.perf_counter() - t0
     rss_fit = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     t0 = time.perf_counter()

@@ -24,7 +24,7 @@ from .mesh.geometry import BemBody
 from .data.headings import axisymmetric_headings, excitation_over_headings, heading_matrix, headings_line
 from .bem.isolated import compute_isolated
 from .bem.neighbours import compute_within
-from .fit.radiation import RadiationModel
+from .fit.radiation import RadiationModel, coupled_groups
 from .fit.response_error import Device
 from .fit.store import FITS_SERVED, cached_fit, fit_band_limit, model_from_arrays, shipped_fits_dir  # noqa: F401 (the model's face)
 from .fit.ssforms import modal_form
@@ -175,19 +175,25 @@ def load_hydro_model(scene: Scene, dofs, tol: float | None = None, device=None) 
     tol = scene.hydro.radiation_tol if tol is None else tol
     source, data = load_hydro_data(scene, dofs)
     return fit_hydro_model(data, dofs, tol, source, scene.hydro.fit_omega_max, scene.hydro.response_band,
-                           fit_method(scene.hydro.radiation_fit, dofs),
+                           fit_method(scene.hydro.radiation_fit, dofs, data),
                            device(source, data) if device is not None else None)
 
 
 ARRAY_BODIES = 9   # "auto" fits column by column from this many bodies (module array_fit)
 
 
-def fit_method(setting: str, dofs) -> str:
+def fit_method(setting: str, dofs, data: xr.Dataset | None = None) -> str:
     """The radiation fit a scene's [hydro] radiation_fit asks for on ``dofs``: "coupled" or
-    "columns"; "auto" is "columns" when the DOFs belong to at least ARRAY_BODIES bodies."""
-    if setting != "auto":
-        return setting
-    return "columns" if len({str(d).split("__")[0] for d in dofs}) >= ARRAY_BODIES else "coupled"
+    "columns"; "auto" is "columns" when the DOFs belong to at least ARRAY_BODIES bodies that
+    radiation couples (with ``data``, the largest coupled group's bodies: bodies solved without
+    interaction are fitted group by group, and identical ones share a fit)."""
+    def bodies(group):
+        return len({str(d).split("__")[0] for d in group})
+    if setting != "auto" or bodies(dofs) < ARRAY_BODIES:
+        return "coupled" if setting == "auto" else setting
+    if data is not None and max(map(bodies, coupled_groups(data, list(dofs)))) < ARRAY_BODIES:
+        return "coupled"
+    return "columns"
 
 
 def load_hydro_data(scene: Scene, dofs) -> tuple[str, xr.Dataset]:

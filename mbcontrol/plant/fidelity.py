@@ -156,7 +156,7 @@ def _hydro_model(scene, frozen, fidelity, hydro, waves, notes) -> HydroModel | N
         data = drop_couplings(data)
         source = f"{source} (couplings between bodies dropped)"
     return fit_hydro_model(data, dofs, tol, source, limit, scene.hydro.response_band,
-                           fit_method(scene.hydro.radiation_fit, dofs),
+                           fit_method(scene.hydro.radiation_fit, dofs, data),
                            device_around(frozen, source, data, dofs) if scene.hydro.fit_judged_by == "response" else None)
 
 
@@ -287,5 +287,5 @@ def linearised_plant(plant: ProcessPlant) -> ProcessPlant:
         gradient = ca.Function("g", [p], [Jy[plant.outputs.index("energy"), :plant.nx]])
         notes["energy_gradient_at_rest"] = float(np.max(np.abs(np.asarray(gradient(plant.p0))),
                                                         initial=0.0))
-    return dataclasses.replace(plant, f=f_fun, h=h_fun, notes=notes)
+    return dataclasses.replace(plant, f=f_fun, h=h_fun, notes=notes, parts=None)
 

@@ -22,6 +22,7 @@ from ..multibody import Topology, build_topology
 from ..scene import DOF_NAMES, Scene, load_scene
 from . import checks, loads
 from .mechanical import dof_selector, linear_params, mechanical_matrices
+from .pieces import plant_parts
 
 
 @dataclass(frozen=True, eq=False)      # identity semantics: compiled code is cached per plant
@@ -39,6 +40,7 @@ class ProcessPlant:
     f: ca.Function = field(repr=False)
     h: ca.Function = field(repr=False)
     notes: dict = field(default_factory=dict)   # build-time findings (plant.checks.rest_checks)
+    parts: tuple | None = field(default=None, repr=False)   # f's pieces (module plant.pieces)
 
     @property
     def name(self) -> str:
@@ -174,7 +176,7 @@ def assemble_plant(scene: Scene | str, hydro: HydroModel | None = None, *,
     h = ca.Function("h", [x, u, w, p], [y], ["x", "u", "w", "p"], ["y"])
     return ProcessPlant(scene, topo, hydro, tuple(states), tuple(inputs), tuple(disturbances),
                         tuple(output_names), tuple(params.names), np.array(params.values),
-                        f, h, notes)
+                        f, h, notes, plant_parts([x, u, w, p], M, tau, x_dot[:tree.n_q], chi_dot))
 
 
 def _preloads(scene, topo, q, s, u, w, chi, tau, pto_signals, params):

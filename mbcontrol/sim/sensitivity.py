@@ -53,4 +53,5 @@ def sensitivity_plant(plant, names, outputs):
     states = plant.states + tuple(f"d_{s}__d_{n}" for n in names for s in plant.states)
     outs = plant.outputs + tuple(sensitivity_name(o, n) for n in names for o in outputs)
     notes = {**plant.notes, "sensitivities": {"parameters": list(names), "outputs": list(outputs)}}
-    return dataclasses.replace(plant, states=states, outputs=outs, f=f_aug, h=h_aug, notes=notes)
+    return dataclasses.replace(plant, states=states, outputs=outs, f=f_aug, h=h_aug, notes=notes,
+                               parts=None)

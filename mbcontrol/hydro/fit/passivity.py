@@ -220,6 +220,36 @@ def passivity_test(A, B, C, D=None, *, omega=None, n_grid: int = 2000, rtol: flo
                            time.perf_counter() - t0)
 
 
+def passivity_test_groups(parts) -> PassivityReport:
+    """:func:`passivity_test` of a block-diagonal model from its decoupled groups ``parts``
+    [(dof indices, A, B, C)], group by group: H(ω) is block-diagonal, so its eigenvalues are
+    the groups' together. Each group's violation threshold is its own (rtol × its largest
+    eigenvalue: no laxer than the whole's); a group equal to an earlier one is tested once.
+    The whole model's test costs O(states³) per frequency, a group's O(its states³): at 16
+    decoupled barges (676 states) 42 s against a fraction of a second."""
+    t0, reports, seen = time.perf_counter(), [], []
+    for _, a, b, c in parts:
+        same = next((r for (a2, b2, c2), r in seen if a2.shape == a.shape and b2.shape == b.shape
+                     and np.array_equal(a2, a) and np.array_equal(b2, b) and np.array_equal(c2, c)),
+                    None)
+        reports.append(same or passivity_test(a, b, c))
+        if same is None:
+            seen.append(((a, b, c), reports[-1]))
+    if len(reports) == 1:
+        return reports[0]
+    low = min(reports, key=lambda r: r.min_eig)
+    emax = max(r.max_eig for r in reports)
+    return PassivityReport(
+        all(r.passive for r in reports), sorted(band for r in reports for band in r.bands),
+        low.min_eig, low.omega_at_min, emax, low.min_eig / emax if emax > 0 else -np.inf,
+        sorted({c for r in reports for c in r.crossings}),
+        (min(r.grid[0] for r in reports), max(r.grid[1] for r in reports),
+         sum(r.grid[2] for r in reports)),
+        min(r.grid_min_eig for r in reports), sum(r.missed_crossings for r in reports),
+        f"{reports[0].method}; group by group ({len(seen)} distinct of {len(reports)})",
+        time.perf_counter() - t0)
+
+
 # ---------------------------------------------------------------------------- enforcement
 def _lyap_map(A, N, L, R):
     """Matrix T (p·q, r²) with vec_C(L P R) = T vec(Q̃), where AᵀP + PA = -N Q̃ Nᵀ.

@@ -58,9 +58,9 @@ from mbcontrol.errors import HydroError
 
 from ..data.dataset import matrix
 from .kernel import RECIPROCITY, _cos_transform, _with_tail, kernel_data, reciprocal
-from .passivity import _response, passivity_test
+from .passivity import _response, passivity_test_groups
 from .fit_error import FLOOR, _group_errors, _nerr, _worst, miss_message
-from .vector_fit import SLOW_POLE, _best_scaled_fit
+from .vector_fit import SLOW_POLE, _best_scaled_fit, group_error, same_group_fit
 
 ZERO_COUPLING = 1e-6  # |K_ij| <= this * sqrt(max|K_ii| max|K_jj|): treated as an exact zero
 DENSE_STEP = 0.02  # fit on a grid refined (by interpolation) to Δω <= 2 % of ω
@@ -154,6 +154,13 @@ def _groups(K):
     return [[int(i) for i in g] for g in groups], link
 
 
+def coupled_groups(ds, dofs) -> list[list[str]]:
+    """The DOF groups of ``dofs`` that radiation couples (connected through entries of K(jω)
+    above ZERO_COUPLING): each is fitted on its own."""
+    _, K, dofs = kernel_data(ds, dofs, None)
+    return [[dofs[i] for i in g] for g in _groups(reciprocal(K)[0])[0]]
+
+
 def fit_radiation(ds, dofs=None, *, tol: float = 0.02, max_order: int = 30, omega_max=None,
                   n_iter: int = 20, dc_zero: bool = True, refit: bool = True,
                   markov: bool = True, passive: bool = True,
@@ -213,13 +220,18 @@ def fit_radiation(ds, dofs=None, *, tol: float = 0.02, max_order: int = 30, omeg
     # the groups are fitted on the refined grid; their gate takes the BEM frequencies at full weight
     # (interpolated ones at INTERP_WEIGHT), so it is the error reported here
     parts, pre, info = [], [], []  # pre: the unconstrained fits (what passive=False returns)
+    done = []                      # groups fitted so far: an identical one reuses its fit
     for gidx in groups:
         common = (wf, Kf[:, gidx][:, :, gidx], link[np.ix_(gidx, gidx)], np.isin(wf, w), ainf[gidx],
                   (wf >= lo) & (wf <= hi) & given & (device is None))
-        rest = (tol, max_order, n_iter, dc_zero, refit, group_markov(gidx),
-                p_tail, passive_max_states if passive else 0)
-        abc, rep, before = _best_scaled_fit(common, rest, [dofs[i] for i in gidx], passive,
-                                            None if device is None else gate_f.on(gidx))
+        markov_g, judge = group_markov(gidx), None if device is None else gate_f.on(gidx)
+        rest = (tol, max_order, n_iter, dc_zero, refit, markov_g, p_tail,
+                passive_max_states if passive else 0)
+        reused = same_group_fit(done, common, markov_g, judge, tol)
+        abc, rep, before = reused or _best_scaled_fit(common, rest, [dofs[i] for i in gidx],
+                                                      passive, judge)
+        if reused is None:
+            done.append((common, markov_g, abc, rep, before, group_error(abc, common, judge)))
         parts.append((gidx, *abc))
         pre.append((gidx, *before))
         info.append({"dofs": [dofs[i] for i in gidx], **rep})
@@ -229,12 +241,12 @@ def fit_radiation(ds, dofs=None, *, tol: float = 0.02, max_order: int = 30, omeg
     A, B, C, order = model.A, model.B, model.C, model.order
     k0_data = _cos_transform(*_with_tail(w, K.real, None)[:2], np.zeros(1))[0]
     pas = {"enforce": bool(passive), "enforced": any(g.get("passivity", {}).get("enforced") for g in info),
-           **passivity_test(A, B, C).as_dict()}
+           **passivity_test_groups(parts).as_dict()}
     if pas["enforced"]:  # the unconstrained fit's numbers, for comparison
         m0, _, e0 = _assemble(pre, w, Ks, dofs, groups, ainf, inband)
         if device is not None:
             e0 = float(np.max(gate_w.errors(m0.frequency_response(w))))
-        t0 = passivity_test(m0.A, m0.B, m0.C).as_dict()
+        t0 = passivity_test_groups(pre).as_dict()
         pas.update(before={"fit_error": e0, "n_states": m0.order, **{k: t0[k] for k in (
             "passive", "margin", "min_eig", "omega_at_min", "max_eig", "bands", "grid_min_eig")}},
             fit_error_growth=err / e0 if e0 > 0 else 1.0,

@@ -244,18 +244,33 @@ def _cluster_pays(serial_s: float, n_workers: int, method: str = "spawn") -> boo
     return start + rest / n_workers + CLOSE_MARGIN * close < serial_s
 
 
+def idle_cores() -> int:
+    """Cores not busy with other work: the machine's, less the 1-minute load average beyond
+    this process (os.getloadavg; all of them where it is not available)."""
+    cores = os.cpu_count() or 1
+    try:
+        busy = max(0, round(os.getloadavg()[0]) - 1)
+    except (AttributeError, OSError):
+        return cores
+    return max(1, cores - busy)
+
+
 def _local(queue: list, save, n: int, per_task) -> str:
     """Run `queue` (emptied) on a local cluster of n workers when it pays, else leave it to
-    the caller's serial loop. Returns where the cases ran."""
+    the caller's serial loop. Returns where the cases ran. Workers only share the cores other
+    work leaves idle: on a machine already busy (a test suite with a worker per core) a
+    cluster's processes would only take turns with it, and its start and close are lost."""
     forced = os.environ.get(CLUSTER_ENV) == "always"
     method = _start_method()
     if not forced:
+        if min(n, idle_cores()) < 2:
+            return "serial"
         timed = []
         while queue and len(timed) < 2:    # the first pays one-off costs (code, caches)
             t0 = time.perf_counter()
             save([run_case(queue.pop(0))])
             timed.append(time.perf_counter() - t0)
-        if not queue or not _cluster_pays(min(timed) * len(queue), n, method):
+        if not queue or not _cluster_pays(min(timed) * len(queue), min(n, idle_cores()), method):
             return "serial"
     first = queue[0]
     starter = _ClusterStarter(n, (first.model, tuple(sorted(first.resolved()[1].items())),

@@ -90,3 +90,22 @@ def test_a_cluster_that_never_starts_is_abandoned_and_the_cases_run_here(monkeyp
         result = runner.execute(cases, store, workers=2, progress=False)
     assert result["where"] == "serial" and result["computed"] == 2
     assert all(store.has(c.key) for c in cases)
+
+
+def test_a_busy_machine_runs_the_sweep_here(monkeypatch):
+    """Workers share the cores other work leaves idle: with the load average already at the
+    core count, a sweep on 2 workers runs here, without timing a case or starting a cluster."""
+    monkeypatch.setattr(runner.os, "cpu_count", lambda: 2)
+    monkeypatch.setattr(runner.os, "getloadavg", lambda: (1.0, 1.0, 1.0))   # this process alone
+    assert runner.idle_cores() == 2
+    monkeypatch.setattr(runner.os, "getloadavg", lambda: (2.2, 2.0, 2.0))   # and one more job
+    assert runner.idle_cores() == 1
+    started = []           # a sweep that would pay on an idle machine; a start is recorded
+    monkeypatch.setattr(runner, "_cluster_pays", lambda *args: True)
+    monkeypatch.setattr(runner._ClusterStarter, "start", lambda self: started.append(self))
+    monkeypatch.setattr(runner, "START_TIMEOUT_S", 0.1)
+    monkeypatch.setattr(runner, "run_case", lambda case: {"case": case.key})
+    cases = build_cases("sphere", grid([1.0], [8.0, 10.0, 12.0]), duration=50.0, dt=0.1)
+    store = CaseStore(None)
+    assert runner.execute(cases, store, workers=2, progress=False)["where"] == "serial"
+    assert not started and all(store.has(c.key) for c in cases)

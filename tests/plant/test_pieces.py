@@ -1,0 +1,61 @@
+"""f in compiled pieces (mbcontrol.plant.pieces; issue 38 item 3), against the expanded plant:
+the one SX expression f that every other consumer (linearisation, export, the reference
+integrators) uses. A long chain's steps call the pieces; here a barge chain's trajectory,
+stepped by the compiled chunks in pieces, is compared with RK4 written out in numpy on the
+expanded f, both fed the same excitation at the same nodes."""
+import numpy as np
+import pytest
+
+import mbcontrol.plant.pieces as pieces
+from mbcontrol import waves
+from mbcontrol.plant import build_plant
+from mbcontrol.scene import load_scene
+from mbcontrol.sim.integrators import CALL_F_STATES, excitation_at_nodes, run_fixed_step
+
+DT, STEPS = 0.01, 1000          # 10 s of a 1.1 s wave: ten periods from rest
+
+
+@pytest.fixture(scope="module")
+def chain():
+    plant = build_plant(load_scene("barge_chain"))     # N = 4: 84 states, above CALL_F_STATES
+    assert plant.nx > CALL_F_STATES
+    assert not pieces.pays(plant)                      # a 6 x 6 mass matrix: f whole
+    return plant
+
+
+def test_a_chain_stepped_in_pieces_follows_the_expanded_plant(chain, monkeypatch):
+    monkeypatch.setattr(pieces, "PIECES_MASS_NONZEROS", 36)    # N = 4 stepped in pieces
+    assert pieces.pays(chain)
+    wave = waves.regular(0.03, 1.1)
+    nodes = (0.0, 0.5, 1.0)
+    W = excitation_at_nodes(chain, wave, STEPS, DT, nodes)
+    U = np.zeros((STEPS, len(chain.inputs)))
+    X, _ = run_fixed_step(chain, chain.x0(), U, W, chain.p0, DT, "rk4")
+    x, f, p, u = chain.x0(), chain.f, chain.p0, U[0]
+    reference = [x]
+    for k in range(STEPS):       # classic RK4 on the expanded f, interpreted
+        w0, w1, w2 = W[k]
+        k1 = np.asarray(f(x, u, w0, p)).ravel()
+        k2 = np.asarray(f(x + DT / 2 * k1, u, w1, p)).ravel()
+        k3 = np.asarray(f(x + DT / 2 * k2, u, w1, p)).ravel()
+        k4 = np.asarray(f(x + DT * k3, u, w2, p)).ravel()
+        x = x + DT / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+        reference.append(x)
+    reference = np.array(reference)
+    size = np.abs(reference).max(axis=0)
+    assert size[chain.n_q:2 * chain.n_q].min() > 1e-4       # every velocity moved
+    assert np.abs(X - reference).max(axis=0) == pytest.approx(0.0, abs=1e-9 * size.max())
+    assert np.all(np.abs(X - reference).max(axis=0) <= 1e-9 * np.maximum(size, 1e-12 * size.max()))
+
+
+def test_pieces_equal_f_with_parameters_in_every_piece():
+    """With hydro corrections (identification) the added mass, the radiation and the excitation
+    depend on parameters: in M, tau and chi' alike."""
+    plant = build_plant(load_scene("barge_chain"), hydro_corrections=True)
+    by_parts, rng = pieces.f_by_parts(plant), np.random.default_rng(3)
+    for scale in (0.01, 0.1):
+        args = [rng.normal(size=plant.f.sparsity_in(i).shape) * scale for i in range(3)]
+        p = plant.p0 * rng.uniform(0.8, 1.2, plant.p0.size)
+        expected = np.asarray(plant.f(*args, p)).ravel()
+        got = np.asarray(by_parts(*args, p)).ravel()
+        assert np.abs(got - expected).max() <= 1e-9 * np.abs(expected).max()
