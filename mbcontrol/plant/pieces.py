@@ -8,10 +8,10 @@ included), the rates q' and chi', and the solve s' = M \\ tau (the same symbolic
 so values equal f's to round-off; the compile took 9.9 s, and the steps run 5-9 % slower
 (M and tau each compute the bodies' kinematics: RTF 288 against 306-316).
 
-Stepping uses them only where the mass matrix is dense and large (`pays`: at least
-PIECES_MASS_NONZEROS entries, a 10-body chain): a farm's floats on vertical sliders have a diagonal M and an f that is mostly
-the radiation model, and there the pieces compiled slower than f (16 floats: 11 s against 7 s)
-and stepped 13 % slower; barge_chain N = 8 compiles in 1.5 s instead of 2.2 s.
+They are built only where the mass matrix is dense and large (at least PIECES_MASS_NONZEROS
+entries, a 10-body chain): a farm's floats on vertical sliders have a diagonal M and an f
+that is mostly the radiation model, and there the pieces compiled slower than f (16 floats:
+11 s against 7 s) and stepped 13 % slower; barge_chain N = 8 compiles in 1.5 s, not 2.2 s.
 
 Measured and not taken: holding the radiation matrices as data (sparse products over arrays,
 not unrolled into code) compiled a 16-float farm in 0.8 s instead of 7 s, but stepped it 4x
@@ -26,9 +26,12 @@ import casadi as ca
 PIECES_MASS_NONZEROS = 100
 
 
-def plant_parts(inputs, M, tau, q_dot, chi_dot) -> tuple:
+def plant_parts(inputs, M, tau, q_dot, chi_dot) -> tuple | None:
     """f's pieces (ProcessPlant.parts): SX Functions of f's inputs (x, u, w, p) for M, tau and
-    [q'; chi'], and (M, tau) -> M \\ tau."""
+    [q'; chi'], and (M, tau) -> M \\ tau; None (not built) where M has fewer than
+    PIECES_MASS_NONZEROS structural nonzeros."""
+    if M.nnz() < PIECES_MASS_NONZEROS:
+        return None
     names = ["x", "u", "w", "p"]
     mass = ca.Function("f_mass", inputs, [M], names, ["M"])
     loads = ca.Function("f_loads", inputs, [tau], names, ["tau"])
@@ -38,16 +41,10 @@ def plant_parts(inputs, M, tau, q_dot, chi_dot) -> tuple:
     return mass, loads, rates, solve
 
 
-def pays(plant) -> bool:
-    """True where stepping compiles f in pieces: M has PIECES_MASS_NONZEROS structural
-    nonzeros or more."""
-    return plant.parts is not None and plant.parts[0].sparsity_out(0).nnz() >= PIECES_MASS_NONZEROS
-
-
 def f_by_parts(plant) -> ca.Function:
     """The plant's f (same signature and values) as an MX Function calling its pieces (module
     docstring); f itself for a plant built without them. Stepping uses it where a step calls f
-    as a function (large plants) and it `pays`."""
+    as a function (large plants)."""
     if plant.parts is None:
         return plant.f
     mass, loads, rates, solve = plant.parts

@@ -22,7 +22,7 @@ import hashlib
 import casadi as ca
 import numpy as np
 
-from ..plant.pieces import f_by_parts, pays
+from ..plant.pieces import f_by_parts
 from .compiled import compile_function
 from .methods import METHODS, method, radiation_exponential, radiation_split
 
@@ -98,7 +98,7 @@ def step_function(plant, method_name: str = "rk4", law=None) -> ca.Function:
     p_plant = p[:len(plant.p0)]
     # MX symbols (a large plant): f is called, not inlined, and called in its parts, so that
     # gcc compiles four moderate functions instead of one long one (module plant.pieces)
-    plant_f = f_by_parts(plant) if isinstance(x, ca.MX) and pays(plant) else plant.f
+    plant_f = f_by_parts(plant) if isinstance(x, ca.MX) else plant.f
 
     def f(xs, c):
         return plant_f(xs, u_held, W[:, column[c]], p_plant)

@@ -15,17 +15,18 @@ from mbcontrol.sim.integrators import CALL_F_STATES, excitation_at_nodes, run_fi
 DT, STEPS = 0.01, 1000          # 10 s of a 1.1 s wave: ten periods from rest
 
 
-@pytest.fixture(scope="module")
-def chain():
-    plant = build_plant(load_scene("barge_chain"))     # N = 4: 84 states, above CALL_F_STATES
-    assert plant.nx > CALL_F_STATES
-    assert not pieces.pays(plant)                      # a 6 x 6 mass matrix: f whole
+@pytest.fixture
+def chain(monkeypatch):
+    """barge_chain N = 4 (84 states, above CALL_F_STATES) with its f in pieces, which its
+    6 x 6 mass matrix would not get by itself."""
+    assert build_plant(load_scene("barge_chain")).parts is None
+    monkeypatch.setattr(pieces, "PIECES_MASS_NONZEROS", 36)
+    plant = build_plant(load_scene("barge_chain"))
+    assert plant.nx > CALL_F_STATES and plant.parts is not None
     return plant
 
 
-def test_a_chain_stepped_in_pieces_follows_the_expanded_plant(chain, monkeypatch):
-    monkeypatch.setattr(pieces, "PIECES_MASS_NONZEROS", 36)    # N = 4 stepped in pieces
-    assert pieces.pays(chain)
+def test_a_chain_stepped_in_pieces_follows_the_expanded_plant(chain):
     wave = waves.regular(0.03, 1.1)
     nodes = (0.0, 0.5, 1.0)
     W = excitation_at_nodes(chain, wave, STEPS, DT, nodes)
@@ -48,9 +49,10 @@ def test_a_chain_stepped_in_pieces_follows_the_expanded_plant(chain, monkeypatch
     assert np.all(np.abs(X - reference).max(axis=0) <= 1e-9 * np.maximum(size, 1e-12 * size.max()))
 
 
-def test_pieces_equal_f_with_parameters_in_every_piece():
+def test_pieces_equal_f_with_parameters_in_every_piece(monkeypatch):
     """With hydro corrections (identification) the added mass, the radiation and the excitation
     depend on parameters: in M, tau and chi' alike."""
+    monkeypatch.setattr(pieces, "PIECES_MASS_NONZEROS", 36)
     plant = build_plant(load_scene("barge_chain"), hydro_corrections=True)
     by_parts, rng = pieces.f_by_parts(plant), np.random.default_rng(3)
     for scale in (0.01, 0.1):
