@@ -182,7 +182,7 @@ MEANING = {
                                 "of `mbcontrol defaults`)",
     ("hydro", "radiation_fit"): "`coupled` (one pole set per coupled group), `columns` (per "
                                 "column, symmetric columns shared: arrays and farms) or `auto` "
-                                "(columns from 9 bodies)",
+                                "(columns from 9 bodies that radiation couples)",
     ("hydro", "fit_omega_max"): "highest frequency the radiation fit sees",
     ("hydro", "fit_judged_by"): "\"response\": the radiation fit's order is set by the error it causes in "
                                 "the device's response; \"kernel\": by K(jω)'s own error",
