@@ -1,7 +1,7 @@
 """How cost grows with the number of bodies: barge_chain with N = 2, 4, 8, 16 (`make bench`).
 
-Per N, in a fresh cache folder (a cold first use: nothing precomputed, nothing cached), in one run
-on this machine:
+Per N, in a fresh cache folder (a cold first use: nothing cached; what the catalogue ships,
+N = 4's BEM data and fit, is used as a user gets it), in one run on this machine:
   - hydro: BEM data and radiation fit (the barges are solved alone and identical ones share one
     fit, so this grows slowly with N);
   - build: symbolic assembly of the process plant (CasADi), hydro already in memory;
