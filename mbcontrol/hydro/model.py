@@ -27,7 +27,7 @@ from .bem.neighbours import compute_within
 from .fit.radiation import RadiationModel, coupled_groups
 from .fit.response_error import Device
 from .fit.store import FITS_SERVED, cached_fit, fit_band_limit, model_from_arrays, shipped_fits_dir  # noqa: F401 (the model's face)
-from .fit.ssforms import modal_form
+from .fit.ssforms import modal_blocks
 
 
 @dataclass(frozen=True)
@@ -142,11 +142,7 @@ class HydroModel:
         B, C, D = r.B[:, order], r.C[order, :], r.D[np.ix_(order, order)]
         if self.fit_method == "columns":   # already real block-diagonal, poles shared by columns
             return r.A, B, C, D
-        try:
-            A, B, C = modal_form(r.A, B, C)
-        except ValueError:
-            A = r.A
-        return A, B, C, D
+        return (*modal_blocks(r.A, B, C), D)
 
     def restricted(self, dofs) -> "HydroModel":
         dofs = tuple(dofs)

@@ -40,7 +40,7 @@ class ProcessPlant:
     f: ca.Function = field(repr=False)
     h: ca.Function = field(repr=False)
     notes: dict = field(default_factory=dict)   # build-time findings (plant.checks.rest_checks)
-    parts: tuple | None = field(default=None, repr=False)   # f's pieces (module plant.pieces)
+    parts: dict | None = field(default=None, repr=False)    # f's pieces (module plant.pieces)
 
     @property
     def name(self) -> str:
@@ -126,11 +126,14 @@ def assemble_plant(scene: Scene | str, hydro: HydroModel | None = None, *,
 
     tau = -tree.bias(q, s, added_mass)
     chi_dot, power = ca.SX(0, 1), {"radiated_power": 0, "excitation_power": 0}
+    radiation_apart = None             # what plant.pieces needs to compile the radiation apart
     if hydro and not radiation:
         tau += ca.mtimes(P, ca.mtimes(select.T, w_h))
         power = {"radiated_power": 0, "excitation_power": ca.dot(nu_h, w_h)}
     elif hydro:
         A_r, B_r, C_r, D_r = hydro.radiation_matrices()
+        if scale is None:
+            radiation_apart = (chi, ca.mtimes(P, select.T), nu_h, (A_r, B_r, C_r, D_r))
         R = scale["radiation"] if scale is not None else ca.DM.eye(len(hydro_dofs))
         nu_r = ca.mtimes(R, nu_h)           # the kernel S^1/2 K S^1/2 as a state-space model
         mu_h = ca.mtimes(R, ca.mtimes(C_r, chi) + ca.mtimes(D_r, nu_r))
@@ -176,7 +179,8 @@ def assemble_plant(scene: Scene | str, hydro: HydroModel | None = None, *,
     h = ca.Function("h", [x, u, w, p], [y], ["x", "u", "w", "p"], ["y"])
     return ProcessPlant(scene, topo, hydro, tuple(states), tuple(inputs), tuple(disturbances),
                         tuple(output_names), tuple(params.names), np.array(params.values),
-                        f, h, notes, plant_parts([x, u, w, p], M, tau, x_dot[:tree.n_q], chi_dot))
+                        f, h, notes, plant_parts([x, u, w, p], M, tau, x_dot[:tree.n_q], chi_dot,
+                                                 radiation_apart))
 
 
 def _preloads(scene, topo, q, s, u, w, chi, tau, pto_signals, params):

@@ -23,6 +23,10 @@ def chain(monkeypatch):
     monkeypatch.setattr(pieces, "PIECES_MASS_NONZEROS", 36)
     plant = build_plant(load_scene("barge_chain"))
     assert plant.nx > CALL_F_STATES and plant.parts is not None
+    # 8 radiation blocks (each barge's surge-pitch pair and its heave), identical ones compiled
+    # once: the barges share fits
+    assert len(plant.parts["radiation"]["blocks"]) == 8
+    assert pieces.distinct_radiation_functions(plant) < 8
     return plant
 
 

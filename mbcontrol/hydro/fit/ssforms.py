@@ -69,3 +69,27 @@ def _block_diag(blocks):
         out[i:i + k, i:i + k] = b
         i += k
     return out
+
+
+def modal_blocks(A, B, C):
+    """modal_form block by block: each set of states that A and B connect (a decoupled DOF
+    group) on its own, in place. Identical groups (identical bodies sharing a fit) then get
+    identical realisations, and repeated poles of different groups cannot mix them (the
+    whole matrix's eigenvectors within a repeated eigenvalue are any basis of its eigenspace).
+    A block that modal_form refuses (defective) is kept as it is."""
+    from scipy.sparse.csgraph import connected_components
+    A, B, C = (np.array(M, dtype=float) for M in (A, B, C))
+    n = A.shape[0]
+    if n == 0:
+        return A, B, C
+    graph = np.zeros((n + B.shape[1],) * 2, bool)
+    graph[:n, :n], graph[:n, n:] = A != 0, B != 0
+    _, label = connected_components(graph, directed=False)
+    for k in np.unique(label[:n]):
+        s = np.flatnonzero(label[:n] == k)
+        try:
+            a, b, c = modal_form(A[np.ix_(s, s)], B[s], C[:, s])
+        except ValueError:
+            continue
+        A[np.ix_(s, s)], B[s], C[:, s] = a, b, c
+    return A, B, C
