@@ -18,9 +18,10 @@ Built where f is large: a mass matrix of PIECES_MASS_NONZEROS entries or more (a
 chain), or a radiation output matrix C_r of PIECES_RADIATION_NONZEROS or more (a farm).
 Measured 2026-11-28 (step compile; real-time factor or a 60 s record's wall time):
 barge_chain N = 16 8.4 s against 23-25 s (RTF 280 against 306-316); array_grid 16 floats
-3.3 s against 7 s (RTF 557 against 633); 25 floats 15.3 s against 174 s, its 60 s record
-0.61-0.69 s against 0.45 s. The pieces step 9-12 % slower (35-50 % at 25 floats): the
-price of compiling in seconds what took minutes, once per machine (the code is cached).
+3.3 s against 7 s (RTF 557 against 633); 25 floats 15.3-15.9 s against 174 s (the first
+60 s record, compile included, 19.5 s against 169 s; then 0.53 s against 0.46 s, best of 5).
+The pieces step 9-16 % slower: the price of compiling in seconds what took minutes, once per
+machine (the code is cached).
 
 Measured and not taken: holding the radiation matrices as data (sparse products over arrays,
 not unrolled into code) compiled a 16-float farm in 0.8 s instead of 7 s, but stepped it 4x
@@ -117,7 +118,9 @@ def f_by_parts(plant) -> ca.Function:
         # one gather of the blocks' rates into state order, one sparse sum of their forces
         # (element-wise writes into a long vector copy it each time: 50 % slower at 25 floats)
         order = np.concatenate([states for states, *_ in blocks])
-        chi_dot = ca.vertcat(*rates)[np.argsort(order).tolist()]
+        chi_dot = ca.vertcat(*rates)
+        if not np.array_equal(order, np.arange(order.size)):     # blocks not in state order
+            chi_dot = chi_dot[np.argsort(order).tolist()]
         rows = np.concatenate([outputs for *_, outputs, _ in blocks])
         gather = ca.DM(ca.Sparsity.triplet(G.shape[1], rows.size, rows.tolist(),
                                            list(range(rows.size))), 1.0)
