@@ -115,8 +115,8 @@ def f_by_parts(plant) -> ca.Function:
         chi, blocks = args[0][start:], radiation["blocks"]
         forces, rates = zip(*[block(chi[states.tolist()], nu[inputs.tolist()])
                               for states, inputs, _, block in blocks])
-        # one gather of the blocks' rates into state order, one sparse sum of their forces
-        # (element-wise writes into a long vector copy it each time: 50 % slower at 25 floats)
+        # the blocks' rates joined (reordered only if they are not in state order) and their
+        # forces summed by one sparse product, rather than a write into a long vector per block
         order = np.concatenate([states for states, *_ in blocks])
         chi_dot = ca.vertcat(*rates)
         if not np.array_equal(order, np.arange(order.size)):     # blocks not in state order
