@@ -34,7 +34,8 @@ import hashlib
 
 import casadi as ca
 import numpy as np
-from scipy.sparse.csgraph import connected_components
+
+from ..hydro.fit.ssforms import state_blocks
 
 PIECES_MASS_NONZEROS = 100
 PIECES_RADIATION_NONZEROS = 5000
@@ -74,17 +75,8 @@ def radiation_blocks(A, B, C) -> dict:
     connected set of states with the inputs that drive them; blocks with equal numbers share
     one Function (named by its content)."""
     A, B, C = (np.asarray(m, float) for m in (A, B, C))
-    n = A.shape[0]
-    coupling = np.zeros((n + B.shape[1],) * 2, bool)       # states, then inputs, as one graph
-    coupling[:n, :n] = A != 0
-    coupling[:n, n:] = B != 0
-    count, label = connected_components(coupling, directed=False)
     functions, blocks = {}, []
-    for k in range(count):
-        members = np.flatnonzero(label == k)
-        states, inputs = members[members < n], members[members >= n] - n
-        if states.size == 0:
-            continue
+    for states, inputs in state_blocks(A, B):
         outputs = np.flatnonzero(np.any(C[:, states] != 0, axis=1))
         a, b, c = A[np.ix_(states, states)], B[np.ix_(states, inputs)], C[np.ix_(outputs, states)]
         key = hashlib.sha256(b"".join(np.ascontiguousarray(m).tobytes() + str(m.shape).encode()
@@ -95,7 +87,7 @@ def radiation_blocks(A, B, C) -> dict:
             functions[key] = ca.Function(f"f_radiation_{key}", [chi_b, nu_b],
                                          [ca.mtimes(c, chi_b), ca.mtimes(a, chi_b) + ca.mtimes(b, nu_b)])
         blocks.append((states, inputs, outputs, functions[key]))
-    return {"blocks": blocks, "n": n}
+    return {"blocks": blocks, "n": A.shape[0]}
 
 
 def f_by_parts(plant) -> ca.Function:

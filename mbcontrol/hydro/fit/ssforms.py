@@ -71,22 +71,31 @@ def _block_diag(blocks):
     return out
 
 
+def state_blocks(A, B) -> list[tuple[np.ndarray, np.ndarray]]:
+    """[(states, inputs)]: the sets of states that A and B connect, each with the inputs that
+    drive it (a decoupled DOF group of a fit, or a column of a column fit), in order of their
+    first state."""
+    from scipy.sparse.csgraph import connected_components
+    A, B = np.asarray(A), np.asarray(B)
+    n = A.shape[0]
+    graph = np.zeros((n + B.shape[1],) * 2, bool)          # states, then inputs, as one graph
+    graph[:n, :n], graph[:n, n:] = A != 0, B != 0
+    _, label = connected_components(graph, directed=False)
+    out = []
+    for k in dict.fromkeys(label[:n]):                      # first-seen order
+        members = np.flatnonzero(label == k)
+        out.append((members[members < n], members[members >= n] - n))
+    return out
+
+
 def modal_blocks(A, B, C):
     """modal_form block by block: each set of states that A and B connect (a decoupled DOF
     group) on its own, in place. Identical groups (identical bodies sharing a fit) then get
     identical realisations, and repeated poles of different groups cannot mix them (the
     whole matrix's eigenvectors within a repeated eigenvalue are any basis of its eigenspace).
     A block that modal_form refuses (defective) is kept as it is."""
-    from scipy.sparse.csgraph import connected_components
     A, B, C = (np.array(M, dtype=float) for M in (A, B, C))
-    n = A.shape[0]
-    if n == 0:
-        return A, B, C
-    graph = np.zeros((n + B.shape[1],) * 2, bool)
-    graph[:n, :n], graph[:n, n:] = A != 0, B != 0
-    _, label = connected_components(graph, directed=False)
-    for k in np.unique(label[:n]):
-        s = np.flatnonzero(label[:n] == k)
+    for s, _ in state_blocks(A, B):
         try:
             a, b, c = modal_form(A[np.ix_(s, s)], B[s], C[:, s])
         except ValueError:

@@ -263,14 +263,15 @@ def _local(queue: list, save, n: int, per_task) -> str:
     forced = os.environ.get(CLUSTER_ENV) == "always"
     method = _start_method()
     if not forced:
-        if min(n, idle_cores()) < 2:
+        usable = min(n, idle_cores())
+        if usable < 2:
             return "serial"
         timed = []
         while queue and len(timed) < 2:    # the first pays one-off costs (code, caches)
             t0 = time.perf_counter()
             save([run_case(queue.pop(0))])
             timed.append(time.perf_counter() - t0)
-        if not queue or not _cluster_pays(min(timed) * len(queue), min(n, idle_cores()), method):
+        if not queue or not _cluster_pays(min(timed) * len(queue), usable, method):
             return "serial"
     first = queue[0]
     starter = _ClusterStarter(n, (first.model, tuple(sorted(first.resolved()[1].items())),
