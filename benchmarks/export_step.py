@@ -113,7 +113,8 @@ def main() -> None:
     print("|---|---|---|---|---|")
     for r in rows:
         k, f, z = r["check"], r["check"]["fmu"], r["check"]["round_off_floor"]
-        print(f"| {r['model']}, {r['controller']} | {k['max_rel_force_error']:.1e}, "
+        label = " (H 2.5 m regular)" if r["wave"] == "binding" else ""
+        print(f"| {r['model']}, {r['controller']}{label} | {k['max_rel_force_error']:.1e}, "
               f"{k['mean_power_rel_error']:.1e} | {f['max_rel_force_error']:.1e}, "
               f"{f['max_rel_position_error']:.1e} | {z['max_rel_force_error']:.1e}, "
               f"{z['mean_power_rel_error']:.1e} | {k['python_mean_power_W']:.4g}, "

@@ -17,7 +17,7 @@ V = ctypes.c_void_p
 class _Qp(ctypes.Structure):
     _fields_ = [("n", ctypes.c_int), ("m", ctypes.c_int), ("H", V), ("A_start", V),
                 ("A_col", V), ("A_val", V), ("Jt0", V), ("work", V), ("iwork", V),
-                ("iterations", ctypes.c_int)]
+                ("iterations", ctypes.c_int), ("max_iter", ctypes.c_int)]
 
 
 @pytest.fixture(scope="module")
@@ -36,7 +36,7 @@ def solver(tmp_path_factory):
                 np.ascontiguousarray(col, np.int32), np.ascontiguousarray(val, float),
                 np.zeros(n * n), np.zeros(3 * n * n + 6 * n + 3 * m + 1),
                 np.zeros(3 * n + 2 * m, np.int32)]
-        qp = _Qp(n, m, *[a.ctypes.data_as(V) for a in keep], 0)
+        qp = _Qp(n, m, *[a.ctypes.data_as(V) for a in keep], 0, 0)   # max_iter 0: the default
         assert lib.mbc_qp_setup(ctypes.byref(qp)) == 0
         args = [np.ascontiguousarray(v, float) for v in (g, lbx, ubx, lba, uba)]
         x = np.zeros(n)
@@ -55,14 +55,28 @@ def _qpoases(H, A, g, lbx, ubx, lba, uba):
     return s.stats()["success"], np.asarray(r["x"]).ravel()
 
 
-def test_same_minimiser_and_same_infeasibility_verdict_as_qpoases(solver):
+def _rows(rng, m, n, structure):
+    """Constraint rows: nonzeros scattered at random, or each row one run of consecutive
+    columns (the exported MPC's stroke and slew rows, which the solver takes as dense runs)."""
+    if structure == "scattered":
+        return rng.standard_normal((m, n)) * (rng.random((m, n)) < 0.5)
+    A = np.zeros((m, n))
+    for row in A:
+        first = int(rng.integers(0, n))
+        last = int(rng.integers(first + 1, n + 1))
+        row[first:last] = rng.standard_normal(last - first)
+    return A
+
+
+@pytest.mark.parametrize("structure", ["scattered", "runs"])
+def test_same_minimiser_and_same_infeasibility_verdict_as_qpoases(solver, structure):
     rng = np.random.default_rng(7)
     solved = infeasible = 0
     for _ in range(150):
         n, m = int(rng.integers(2, 30)), int(rng.integers(0, 40))
         M = rng.standard_normal((n, n))
         H = M @ M.T + 0.1 * np.eye(n)
-        A = rng.standard_normal((m, n)) * (rng.random((m, n)) < 0.5)   # sparse rows too
+        A = _rows(rng, m, n, structure)
         g = 5 * rng.standard_normal(n)
         lbx, ubx = -rng.uniform(0.1, 2, n), rng.uniform(0.1, 2, n)
         lbx[rng.random(n) < 0.2] = -np.inf

@@ -46,12 +46,48 @@ static double slack(const mbc_qp *qp, int c, const double *x, const double *ax,
     return (c % 2 == 0) ? ax[r] - lba[r] : uba[r] - ax[r];
 }
 
-static double row_dot(const mbc_qp *qp, int r, const double *v)
+/* a row's nonzeros as one dense run when its columns are consecutive (the MPC's stroke and
+ * slew rows are): returns the run's length (0: not consecutive), its values and first column */
+static int row_run(const mbc_qp *qp, int r, const double **val, int *first)
+{
+    int a = qp->A_start[r], b = qp->A_start[r + 1];
+    if (b == a || qp->A_col[b - 1] - qp->A_col[a] != b - 1 - a) return 0;
+    *val = qp->A_val + a;
+    *first = qp->A_col[a];
+    return b - a;
+}
+
+/* four partial sums: the compiler may then use vector registers (it keeps one sum's order) */
+static double dense_dot(const double *a, const double *b, int len)
 {
     int k;
+    double t0 = 0.0, t1 = 0.0, t2 = 0.0, t3 = 0.0;
+    for (k = 0; k + 3 < len; k += 4) {
+        t0 += a[k] * b[k];
+        t1 += a[k + 1] * b[k + 1];
+        t2 += a[k + 2] * b[k + 2];
+        t3 += a[k + 3] * b[k + 3];
+    }
+    for (; k < len; ++k) t0 += a[k] * b[k];
+    return (t0 + t1) + (t2 + t3);
+}
+
+static double row_dot(const mbc_qp *qp, int r, const double *v)
+{
+    const double *val;
+    int k, first, len = row_run(qp, r, &val, &first);
     double t = 0.0;
+    if (len) return dense_dot(val, v + first, len);
     for (k = qp->A_start[r]; k < qp->A_start[r + 1]; ++k) t += qp->A_val[k] * v[qp->A_col[k]];
     return t;
+}
+
+/* sqrt(a^2 + b^2) for a Givens rotation: libm's hypot guards against overflow at a cost
+ * that was a tenth of a solve; the plain form is exact enough wherever it cannot overflow */
+static double norm2(double a, double b)
+{
+    double h = sqrt(a * a + b * b);
+    return (h > 1e-150 && h < 1e150) ? h : hypot(a, b);
 }
 
 static void product(const mbc_qp *qp, const double *x, double *ax)
@@ -60,14 +96,6 @@ static void product(const mbc_qp *qp, const double *x, double *ax)
     for (r = 0; r < qp->m; ++r) ax[r] = row_dot(qp, r, x);
 }
 
-static int bounded(const mbc_qp *qp, int c, const double *lbx, const double *ubx,
-                   const double *lba, const double *uba)
-{
-    int n = qp->n;
-    if (c < 2 * n) return isfinite((c % 2 == 0) ? lbx[c / 2] : ubx[c / 2]);
-    c -= 2 * n;
-    return isfinite((c % 2 == 0) ? lba[c / 2] : uba[c / 2]);
-}
 
 /* d = J' c_p: row j of Jt dotted with the normal */
 static void project(const mbc_qp *qp, const double *Jt, int c, double *d)
@@ -78,7 +106,13 @@ static void project(const mbc_qp *qp, const double *Jt, int c, double *d)
         for (j = 0; j < n; ++j) d[j] = sign * Jt[j * n + c / 2];
         return;
     }
-    for (j = 0; j < n; ++j) d[j] = sign * row_dot(qp, (c - 2 * n) / 2, Jt + j * n);
+    {
+        const double *val;
+        int first, len = row_run(qp, (c - 2 * n) / 2, &val, &first);
+        for (j = 0; j < n; ++j)
+            d[j] = sign * (len ? dense_dot(val, Jt + j * n + first, len)
+                               : row_dot(qp, (c - 2 * n) / 2, Jt + j * n));
+    }
 }
 
 static double normal_dot(const mbc_qp *qp, int c, const double *z)
@@ -125,25 +159,32 @@ int mbc_qp_solve(mbc_qp *qp, const double *g, const double *lbx, const double *u
         int p = -1;
         double worst = -TOL, up = 0.0;
         product(qp, x, ax);
-        for (i = 0; i < nc; ++i) {          /* step 1: the most violated constraint */
-            if (is_active[i] || !bounded(qp, i, lbx, ubx, lba, uba)) continue;
-            s[i] = slack(qp, i, x, ax, lbx, ubx, lba, uba);
-            if (s[i] < worst) { worst = s[i]; p = i; }
+        /* step 1: the most violated constraint (an infinite bound's slack is +inf) */
+        for (k = 0; k < n; ++k) {
+            s[2 * k] = x[k] - lbx[k];
+            s[2 * k + 1] = ubx[k] - x[k];
         }
+        for (k = 0; k < m; ++k) {
+            s[2 * n + 2 * k] = ax[k] - lba[k];
+            s[2 * n + 2 * k + 1] = uba[k] - ax[k];
+        }
+        for (i = 0; i < nc; ++i)
+            if (s[i] < worst && !is_active[i]) { worst = s[i]; p = i; }
         if (p < 0) { qp->iterations = iter; return MBC_QP_SOLVED; }
         for (;;) {                          /* step 2: move towards satisfying p */
             double t1 = INFINITY, t2 = INFINITY, zz = 0.0, t;
             int l = -1;
             project(qp, Jt, p, d);
-            memset(z, 0, sizeof(double) * n);   /* primal direction z = J2 d2 */
-            for (j = q; j < n; ++j)
-                for (k = 0; k < n; ++k) z[k] += Jt[j * n + k] * d[j];
-            for (k = 0; k < n; ++k) zz += z[k] * z[k];
-            for (j = q - 1; j >= 0; --j) {  /* dual direction r = R^-1 d1 */
-                double acc = d[j];
-                for (k = j + 1; k < q; ++k) acc -= R[j * n + k] * r[k];
-                r[j] = acc / R[j * n + j];
+            memset(z, 0, sizeof(double) * n);   /* primal direction z = J2 d2, two rows a pass */
+            for (j = q; j + 1 < n; j += 2) {
+                const double *a = Jt + j * n, *b = a + n;
+                for (k = 0; k < n; ++k) z[k] += a[k] * d[j] + b[k] * d[j + 1];
             }
+            if (j < n)
+                for (k = 0; k < n; ++k) z[k] += Jt[j * n + k] * d[j];
+            zz = dense_dot(z, z, n);
+            for (j = q - 1; j >= 0; --j)    /* dual direction r = R^-1 d1 */
+                r[j] = (d[j] - dense_dot(R + j * n + j + 1, r + j + 1, q - j - 1)) / R[j * n + j];
             for (j = 0; j < q; ++j)
                 if (r[j] > 0.0 && u[j] / r[j] < t1) { t1 = u[j] / r[j]; l = j; }
             if (zz > 1e-28) t2 = -s[p] / normal_dot(qp, p, z);
@@ -154,7 +195,7 @@ int mbc_qp_solve(mbc_qp *qp, const double *g, const double *lbx, const double *u
             up += t;
             if (isfinite(t2) && t2 <= t1) { /* full step: add p */
                 for (j = n - 1; j > q; --j) {
-                    double h = hypot(d[j - 1], d[j]), cs, sn;
+                    double h = norm2(d[j - 1], d[j]), cs, sn;
                     if (h == 0.0) continue;
                     cs = d[j - 1] / h; sn = d[j] / h;
                     d[j - 1] = h; d[j] = 0.0;
@@ -174,7 +215,7 @@ int mbc_qp_solve(mbc_qp *qp, const double *g, const double *lbx, const double *u
             }
             --q;
             for (j = l; j < q; ++j) {
-                double h = hypot(R[j * n + j], R[(j + 1) * n + j]), cs, sn;
+                double h = norm2(R[j * n + j], R[(j + 1) * n + j]), cs, sn;
                 if (h == 0.0) continue;
                 cs = R[j * n + j] / h; sn = R[(j + 1) * n + j] / h;
                 for (k = j; k < q; ++k) {
