@@ -17,6 +17,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import linalg
 
+from mbcontrol.plant import controlled_params
+
 from .base import signal_indices
 
 
@@ -57,14 +59,11 @@ class ControlPlant:
         return self.Bd.shape[1]
 
 
-def controller_params(plant) -> dict:
-    """The plant as a controller sees it: every PTO's own law zeroed (the controller owns the
-    force) and no Coulomb friction (a linear model cannot hold it)."""
-    base = {f"{f.name}__coulomb": 0.0 for f in plant.scene.frictions}
-    for pto in plant.scene.ptos:
-        base[f"{pto.name}__damping"] = 0.0
-        base[f"{pto.name}__stiffness"] = 0.0
-    return base
+def controller_params(plant, params=None) -> dict:
+    """The plant as a controller sees it (mbcontrol.plant.ownership): every PTO's scene law
+    off unless `params` sets it (the controller owns the force), no Coulomb friction (a
+    linear model cannot hold it)."""
+    return controlled_params(plant, params, linear=True)
 
 
 def default_measurements(plant) -> list[str]:
@@ -83,7 +82,7 @@ def build_control_plant(plant, dt: float, *, ptos=None, measured=None, order=Non
     ptos = list(ptos or [p.name for p in plant.scene.ptos])
     measured = list(measured or default_measurements(plant))
     signal_indices(plant, measured)
-    base = {**controller_params(plant), **(params or {})}
+    base = controller_params(plant, params)
     extra = list(extra_outputs or [])
     outputs = ([f"{n}__position" for n in ptos] + [f"{n}__velocity" for n in ptos] + measured
                + extra)

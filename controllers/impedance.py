@@ -8,27 +8,24 @@ from __future__ import annotations
 
 import numpy as np
 
+from mbcontrol.plant import controlled_params
+
 
 def base_params(plant, pto: str, params=None) -> dict:
-    """Parameters of the plant as a controller sees it: no Coulomb friction (linear theory
-    cannot hold it) and every PTO's own law zeroed (in closed loop the controller owns it)."""
-    base = dict(params or {})
-    for friction in plant.scene.frictions:
-        base.setdefault(f"{friction.name}__coulomb", 0.0)
-    for other in plant.scene.ptos:
-        if other.name != pto:
-            base.setdefault(f"{other.name}__damping", 0.0)
-            base.setdefault(f"{other.name}__stiffness", 0.0)
-    base.setdefault(f"{pto}__stiffness", 0.0)
-    return base
+    """Parameters of the plant as a controller of `pto` sees it (mbcontrol.plant.ownership):
+    no Coulomb friction (linear theory cannot hold it), every PTO's scene law off unless
+    `params` sets it: a law `params` sets, on `pto` itself too, is a damper or spring in
+    parallel with the controller, part of the plant it faces (and of Z_i)."""
+    return controlled_params(plant, params, linear=True)
 
 
 def intrinsic_impedance(plant, omega, *, pto: str | None = None, params=None,
                         direction: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
     """(Z_i, F_eq) at each omega (rad/s), exp(+i omega t): the PTO's Thevenin equivalent.
 
-    Z_i (N s/m or N m s/rad): the impedance the PTO sees (everything but the PTO: inertia,
-    added mass, radiation damping, restoring, the other PTOs as set by params); F_eq (N per m
+    Z_i (N s/m or N m s/rad): the impedance the PTO's controller sees (everything but the
+    controller: inertia, added mass, radiation damping, restoring, the other PTOs and a law
+    on this PTO itself as set by params, base_params); F_eq (N per m
     of wave amplitude): the force that drives it, so that with a PTO impedance Z_pto the PTO
     velocity is F_eq / (Z_i + Z_pto). Read off two FD solutions (mbcontrol.analysis) with
     different PTO damping c: V(c) = F_eq / (Z_i + c) is exact for a linear model, for any
@@ -38,10 +35,11 @@ def intrinsic_impedance(plant, omega, *, pto: str | None = None, params=None,
     name = pto or plant.scene.ptos[0].name
     omega = np.atleast_1d(np.asarray(omega, float))
     base = base_params(plant, name, params)
+    parallel = base[f"{name}__damping"]       # a damper params sets beside the controller
 
     def velocity(c: float) -> np.ndarray:
         return frequency_domain_response(plant, omega, direction=direction,
-                                         params={**base, f"{name}__damping": c},
+                                         params={**base, f"{name}__damping": parallel + c},
                                          outputs=[f"{name}__velocity"])[:, 0]
 
     v0 = velocity(0.0)
@@ -114,7 +112,6 @@ def margin_function(plant, name: str, params=None):
 
     from mbcontrol.analysis import linearize
     base = base_params(plant, name, params)
-    base[f"{name}__damping"] = 0.0
     sys = linearize(plant, params=base, inputs=[f"u__{name}"],
                     outputs=[f"{name}__position", f"{name}__velocity"])
 

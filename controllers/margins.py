@@ -104,7 +104,6 @@ def plant_loop(plant, *, pto: str | None = None, params=None) -> control.StateSp
     from .impedance import base_params
     name = pto or plant.scene.ptos[0].name
     base = base_params(plant, name, params)
-    base[f"{name}__damping"] = 0.0
     return linearize(plant, params=base, inputs=[f"u__{name}"],
                      outputs=[f"{name}__position", f"{name}__velocity"])
 

@@ -14,7 +14,7 @@ import casadi as ca
 import numpy as np
 
 from .base import per_pto, signal_indices
-from .impedance import default_bounds
+from .impedance import base_params, default_bounds
 from .limits import casadi_saturate, force_limits, limits_report, saturate
 from .tuning import constrained_tuning, electrical_winding
 
@@ -126,16 +126,12 @@ def optimal_damping(plant, wave, *, pto: str | None = None, params=None, bounds=
 
     from mbcontrol.analysis import frequency_domain_response
     name = pto or plant.scene.ptos[0].name
-    base = dict(params or {})
-    for friction in plant.scene.frictions:
-        base.setdefault(f"{friction.name}__coulomb", 0.0)
-    for other in plant.scene.ptos:
-        base.setdefault(f"{other.name}__damping", 0.0)
-        base.setdefault(f"{other.name}__stiffness", 0.0)
+    base = base_params(plant, name, params)
+    parallel = base[f"{name}__damping"]       # a damper params sets beside the controller
 
-    def power(damping: float) -> float:
+    def power(damping: float) -> float:       # the controller's own: its force times velocity
         v = frequency_domain_response(plant, wave.omega, direction=wave.direction,
-                                      params={**base, f"{name}__damping": damping},
+                                      params={**base, f"{name}__damping": parallel + damping},
                                       outputs=[f"{name}__velocity"])[:, 0]
         return float(np.sum(0.5 * damping * np.abs(v * wave.amplitude) ** 2))
 

@@ -23,6 +23,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
+from mbcontrol.plant import controlled_params
 from mbcontrol.sim import sampled as zoh_loop
 
 if TYPE_CHECKING:       # python-control costs 2.5 s to import: only where it is used
@@ -67,13 +68,8 @@ def joint_plant(plant, *, params=None) -> control.StateSpace:
     every PTO's position and velocity (outputs <pto>__position, <pto>__velocity, PTO by PTO),
     with no Coulomb friction and the PTOs' scene laws zeroed unless `params` sets them."""
     from mbcontrol.analysis import linearize
-    base = dict(params or {})
-    for friction in plant.scene.frictions:
-        base.setdefault(f"{friction.name}__coulomb", 0.0)
+    base = controlled_params(plant, params, linear=True)
     names = [p.name for p in plant.scene.ptos]
-    for name in names:
-        base.setdefault(f"{name}__damping", 0.0)
-        base.setdefault(f"{name}__stiffness", 0.0)
     return linearize(plant, params=base, inputs=[f"u__{n}" for n in names],
                      outputs=[f"{n}__{s}" for n in names for s in ("position", "velocity")])
 

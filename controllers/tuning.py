@@ -91,9 +91,7 @@ def constrained_tuning(plant, wave, *, pto: str | None = None, params=None,
         return st[key], feasible, st
 
     if bounds is None:
-        base = base_params(plant, name, params)
-        base[f"{name}__damping"] = 0.0
-        bounds = default_bounds(plant, wave, name, base)
+        bounds = default_bounds(plant, wave, name, base_params(plant, name, params))
     x = np.linspace(np.log(bounds[0]), np.log(bounds[1]), 400)
     objective, feasible, st = evaluate(np.exp(x), 0.0)
     if env is not None and not feasible.any():

@@ -159,12 +159,9 @@ def envelope_bound(plant, wave, pto: str, *, share: float = ENVELOPE_SHARE,
     """
     import cvxpy as cp
 
-    from .ports import linear_params, port_responses
-    base = linear_params(plant, [pto], params)
-    for other in plant.scene.ptos:
-        if other.name != pto:
-            base.setdefault(f"{other.name}__damping", 0.0)
-            base.setdefault(f"{other.name}__stiffness", 0.0)
+    from ..plant import controlled_params
+    from .ports import port_responses
+    base = controlled_params(plant, params, whole=[pto], linear=True)
     Y, H = port_responses(plant, wave.omega, [pto], wave.direction, base)
     y, h = Y[:, 0, 0], H[:, 0] * np.asarray(wave.amplitude, float)
     unconstrained = float(np.sum(np.abs(h) ** 2 / (8 * y.real)))

@@ -40,12 +40,14 @@ import math
 
 import numpy as np
 
+from ..plant import derived
+
 POWER_ALLOWANCE = 0.10            # share above the bound a reported mean power may reach
 ENERGY_TOLERANCE = 0.05           # of the excitation's absolute work over the record
 ANGLE_MAX_RAD = math.radians(30.0)
 DRAFT_FACTOR = 1.0                # relative heave limit in mean drafts
 
-_RESPONSES: dict = {}             # (plant id, params, direction, omega) -> (plant, (Y, H))
+RESPONSE_GRIDS_KEPT = 256         # (params, direction, frequency grid) a plant keeps responses for
 
 
 def wave_of(ds):
@@ -68,16 +70,16 @@ def power_bound(plant, wave, params, window=None) -> dict:
     and frequency grid (seeds of one sea share it)."""
     from .ports import multiport_bound, port_responses, window_mean_power
     p = np.asarray(params, float)
-    key = (id(plant), p.tobytes(), np.asarray(wave.direction, float).tobytes(),
+    kept = derived(plant, ("analysis.port_responses",), dict)
+    key = (p.tobytes(), np.asarray(wave.direction, float).tobytes(),
            np.asarray(wave.omega).tobytes())
-    if key not in _RESPONSES:
-        if len(_RESPONSES) > 256:
-            _RESPONSES.clear()
+    if key not in kept:
+        if len(kept) > RESPONSE_GRIDS_KEPT:
+            kept.clear()
         names = [pto.name for pto in plant.scene.ptos]
-        # the plant is kept with its responses, so that its id is not reused while cached
-        _RESPONSES[key] = (plant, port_responses(plant, wave.omega, names, wave.direction,
-                                                 dict(zip(plant.parameters, p))))
-    bound = multiport_bound(plant, wave, responses=_RESPONSES[key][1])
+        kept[key] = port_responses(plant, wave.omega, names, wave.direction,
+                                   dict(zip(plant.parameters, p)))
+    bound = multiport_bound(plant, wave, responses=kept[key])
     out = {"bound_W": bound.power, "window_bound_W": None}
     if window is not None:
         out["window_bound_W"] = window_mean_power(bound, *window)

@@ -17,17 +17,14 @@ from pathlib import Path
 import casadi as ca
 import numpy as np
 
+from ..plant import controlled_params
 from .build import (FMU_FILES, c_array, c_number, compile_library, csrc, generate_casadi,
                     identifier, model_description, platform_folder, variable, zip_fmu)
 
 
 def plant_parameters(plant) -> np.ndarray:
     """The parameter vector with every PTO's own linear law off (a controller owns it)."""
-    off = {}
-    for pto in plant.scene.ptos:
-        off[f"{pto.name}__damping"] = 0.0
-        off[f"{pto.name}__stiffness"] = 0.0
-    return np.asarray(plant.params(**off), float)
+    return np.asarray(plant.params(**controlled_params(plant)), float)
 
 
 def export_plant(plant, wave, out_dir, *, dt: float, model: str | None = None) -> Path:

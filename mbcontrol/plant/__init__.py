@@ -5,7 +5,9 @@ symbolic parameters. Modules: `process` (ProcessPlant and its assembly), `loads`
 friction, moorings, drag, end stops, gravity, hydrostatics), `catenary` and `catenary_line`
 (quasi-static mooring lines), `checks` (rest checks), `fidelity` (simplified models),
 `freeze` (DOFs removed: blocked by a rig, or not excited by the waves),
-`jacobians` (exact Jacobians, shared downstream), `mechanical` (the linear mechanics at rest), `provenance` (content hashes of what
+`jacobians` (exact Jacobians, shared downstream), `workspace` (what is derived from a
+plant, kept with it and freed with it), `mechanical` (the linear mechanics at rest), `ownership` (which PTO parameters a
+controller owns: one rule for every stage), `provenance` (content hashes of what
 made a plant), `build` (the entry point).
 """
 from .build import build_plant
@@ -13,11 +15,13 @@ from .catenary import CatenarySolution, solve_catenary
 from .catenary_line import CatenaryLine, catenary_line
 from .fidelity import Fidelity, FidelityError, plant_for
 from .jacobians import jacobians
-from .mechanical import MechanicalMatrices, dof_selector, linear_params, mechanical_matrices
+from .mechanical import MechanicalMatrices, dof_selector, mechanical_matrices
+from .ownership import controlled_params, linear_params
 from .process import ProcessPlant, active_hydro_dofs, device_around, response_error_of
 from .provenance import provenance
+from .workspace import derived, workspace_size
 
 __all__ = ["build_plant", "ProcessPlant", "active_hydro_dofs", "dof_selector", "jacobians",
            "Fidelity", "FidelityError", "plant_for", "CatenaryLine", "CatenarySolution",
            "catenary_line", "solve_catenary", "provenance", "MechanicalMatrices", "mechanical_matrices",
-           "device_around", "linear_params", "response_error_of"]
+           "device_around", "linear_params", "controlled_params", "response_error_of", "derived", "workspace_size"]

@@ -66,19 +66,3 @@ def mechanical_matrices(plant, params=None) -> MechanicalMatrices:
         B -= P_h @ plant.hydro.radiation_matrices()[3] @ P_h.T
     return MechanicalMatrices(M, A_inf, K, B, P_h, C[:, :tree.n_q],
                               C[:, tree.n_q:tree.n_q + n])
-
-
-def linear_params(plant, ptos, params=None) -> dict:
-    """Parameter overrides for linear theory seen from `ptos`: their own damping and
-    stiffness zero (the decision force is the PTO's whole force), Coulomb friction removed
-    (its smoothed slope at rest is not linear physics); `params` (dict or full vector) kept
-    for everything else."""
-    if params is not None and not isinstance(params, dict):
-        params = dict(zip(plant.parameters, np.asarray(params, float)))
-    out = dict(params or {})
-    for friction in plant.scene.frictions:
-        out[f"{friction.name}__coulomb"] = 0.0
-    for name in ptos:
-        out[f"{name}__damping"] = 0.0
-        out[f"{name}__stiffness"] = 0.0
-    return out

@@ -21,11 +21,12 @@ from ..hydro.fit.response_error import Device
 from ..multibody import Topology, build_topology
 from ..scene import DOF_NAMES, Scene, load_scene
 from . import checks, loads
-from .mechanical import dof_selector, linear_params, mechanical_matrices
+from .mechanical import dof_selector, mechanical_matrices
+from .ownership import linear_params
 from .pieces import plant_parts
 
 
-@dataclass(frozen=True, eq=False)      # identity semantics: compiled code is cached per plant
+@dataclass(frozen=True, eq=False)      # identity semantics: derived data is kept per plant
 class ProcessPlant:
     """x' = f(x, u, w, p), y = h(x, u, w, p) with named signals; built once, immutable."""
     scene: Scene
@@ -41,6 +42,11 @@ class ProcessPlant:
     h: ca.Function = field(repr=False)
     notes: dict = field(default_factory=dict)   # build-time findings (plant.checks.rest_checks)
     parts: dict | None = field(default=None, repr=False)    # f's pieces (module plant.pieces)
+    # derived data and compiled code, freed with the plant (module plant.workspace)
+    workspace: dict = field(default_factory=dict, init=False, repr=False, compare=False)
+
+    def __getstate__(self):               # a pickled plant travels without its compiled code
+        return {**self.__dict__, "workspace": {}}
 
     @property
     def name(self) -> str:

@@ -12,10 +12,9 @@ import numpy as np
 import xarray as xr
 
 from ..errors import SimulationError
+from ..plant import derived
 from . import integrators
 from .compiled import compile_function
-
-_BATCH: dict = {}
 
 
 def simulate_batch(plant, waves=None, params=None, *, duration: float, dt: float,
@@ -110,22 +109,24 @@ def _vector(plant, params) -> np.ndarray:
 def _batch_function(plant, method, length, n_cases, compiled):
     """(x (nx x cases), U, W, P (np x cases), h, *extras) -> X (nx x length*cases), compiled
     once per (plant, method, chunk length, cases)."""
+    return derived(plant, ("sim.batch", method, length, n_cases, compiled),
+                   lambda: _build_batch(plant, method, length, n_cases, compiled))
+
+
+def _build_batch(plant, method, length, n_cases, compiled):
     import casadi as ca
-    key = (id(plant), method, length, n_cases, compiled)
-    if key not in _BATCH:
-        chunk = integrators.chunk_symbolic(plant, method, None, length)
-        mapped = chunk.map(n_cases)
-        x = ca.MX.sym("x", plant.nx, n_cases)
-        U = ca.MX.sym("U", len(plant.inputs), length * n_cases)
-        W = ca.MX.sym("W", chunk.size1_in(2), chunk.size2_in(2) * n_cases)
-        P, h = ca.MX.sym("P", len(plant.p0), n_cases), ca.MX.sym("h")
-        extras = [ca.MX.sym(f"e{i}", chunk.sparsity_in(5 + i))
-                  for i in range(chunk.n_in() - 5)]
-        X, _ = mapped(x, U, W, P, ca.repmat(h, 1, n_cases),
-                      *[ca.repmat(e, 1, n_cases) for e in extras])
-        fun = ca.Function("batch", [x, U, W, P, h, *extras], [X])
-        _BATCH[key] = (compile_function(fun, enabled=compiled), plant)
-    return _BATCH[key][0]
+    chunk = integrators.chunk_symbolic(plant, method, None, length)
+    mapped = chunk.map(n_cases)
+    x = ca.MX.sym("x", plant.nx, n_cases)
+    U = ca.MX.sym("U", len(plant.inputs), length * n_cases)
+    W = ca.MX.sym("W", chunk.size1_in(2), chunk.size2_in(2) * n_cases)
+    P, h = ca.MX.sym("P", len(plant.p0), n_cases), ca.MX.sym("h")
+    extras = [ca.MX.sym(f"e{i}", chunk.sparsity_in(5 + i))
+              for i in range(chunk.n_in() - 5)]
+    X, _ = mapped(x, U, W, P, ca.repmat(h, 1, n_cases),
+                  *[ca.repmat(e, 1, n_cases) for e in extras])
+    fun = ca.Function("batch", [x, U, W, P, h, *extras], [X])
+    return compile_function(fun, enabled=compiled)
 
 
 def _run(fun, plant, method, x0, W_nodes, P, dt, n, length):

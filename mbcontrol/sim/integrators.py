@@ -22,6 +22,7 @@ import hashlib
 import casadi as ca
 import numpy as np
 
+from ..plant import derived
 from ..plant.pieces import f_by_parts
 from .compiled import compile_function
 from .methods import METHODS, method, radiation_exponential, radiation_split
@@ -152,9 +153,6 @@ def step_extras(plant, method_name: str, dt: float) -> list[np.ndarray]:
 
 # --- chunks of steps, compiled --------------------------------------------------------------
 
-_CHUNKS: dict = {}
-
-
 def chunk_length(n: int) -> int:
     """Steps per compiled call: CHUNK, or the next power of two for short runs (few variants
     to compile, little padding)."""
@@ -190,21 +188,15 @@ def law_key(law):
 
 
 def _chunk_function(plant, method_name, law, compiled: bool, length: int) -> ca.Function:
-    """The compiled chunk of `length` steps of a plant (and law), built once per process."""
-    key = (id(plant), method_name, law_key(law), compiled, length)
-    if key not in _CHUNKS:
-        chunk = chunk_symbolic(plant, method_name, law, length)
-        # keep the plant alive so that its id stays unique while cached
-        _CHUNKS[key] = (compile_function(chunk, enabled=compiled), plant)
-    return _CHUNKS[key][0]
+    """The compiled chunk of `length` steps of a plant (and law), built once per plant."""
+    return derived(plant, ("sim.chunk", method_name, law_key(law), compiled, length),
+                   lambda: compile_function(chunk_symbolic(plant, method_name, law, length),
+                                            enabled=compiled))
 
 
 def prepare(plant, n: int, method_name: str = "rk4", law=None, compiled=True) -> None:
     """Build and compile what run_fixed_step will need for n steps (so timings exclude it)."""
     _chunk_function(plant, method_name, law, compiled, chunk_length(n))
-
-
-_COEFFICIENTS: dict = {}
 
 
 def excitation_at_nodes(plant, wave, n: int, dt: float, nodes) -> np.ndarray:
@@ -218,11 +210,10 @@ def excitation_at_nodes(plant, wave, n: int, dt: float, nodes) -> np.ndarray:
         if wave.directional:            # a spread sea: each component's own direction
             coeffs = plant.hydro.excitation_at(wave.omega, wave.direction)
             return coefficient_offsets(wave, coeffs, n, dt, nodes)
-        key = (id(plant), wave.direction)
-        if key not in _COEFFICIENTS:     # the data's coefficients: selected once per plant
-            _COEFFICIENTS[key] = (plant.hydro.excitation_coefficients(wave.direction), plant)
-        return excitation_at_offsets(wave, plant.hydro.omega, _COEFFICIENTS[key][0], n, dt,
-                                     nodes)
+        # the data's coefficients: selected once per plant and direction
+        coeffs = derived(plant, ("sim.excitation_coefficients", wave.direction),
+                         lambda: plant.hydro.excitation_coefficients(wave.direction))
+        return excitation_at_offsets(wave, plant.hydro.omega, coeffs, n, dt, nodes)
     except HydroError:
         raise
     except ValueError as exc:
@@ -282,9 +273,6 @@ def run_fixed_step(plant, x0, U, W_nodes, p, dt, method_name="rk4", law=None, co
     return X, U_applied
 
 
-_OUTPUT_MAPS: dict = {}
-
-
 def outputs(plant, X, U, W, p, compiled=True) -> np.ndarray:
     """Plant outputs y_i = h(x_i, u_i, w_i, p) for every row, in compiled chunks (bounded memory).
 
@@ -292,15 +280,8 @@ def outputs(plant, X, U, W, p, compiled=True) -> np.ndarray:
     """
     n = X.shape[0]
     length = chunk_length(n)
-    key = (id(plant), compiled, length)
-    if key not in _OUTPUT_MAPS:
-        x, u = ca.MX.sym("x", plant.nx, length), ca.MX.sym("u", len(plant.inputs), length)
-        w, p_sym = ca.MX.sym("w", len(plant.disturbances), length), ca.MX.sym("p", len(plant.p0))
-        y = plant.h.map(length)(x, u, w, ca.repmat(p_sym, 1, length))
-        fun = ca.Function("outputs_chunk", [x, u, w, p_sym], [y])
-        _OUTPUT_MAPS[key] = (compile_function(fun, enabled=compiled, optimise=plant.nx <= PLAIN_OUTPUTS_STATES),
-                             plant)
-    fun = _OUTPUT_MAPS[key][0]
+    fun = derived(plant, ("sim.outputs", compiled, length),
+                  lambda: _output_map(plant, compiled, length))
     Y = np.empty((n, len(plant.outputs)))
     buffer, _ = fun.buffer()
     p = np.ascontiguousarray(p, dtype=float)
@@ -317,6 +298,14 @@ def outputs(plant, X, U, W, p, compiled=True) -> np.ndarray:
         buffer._eval()
         Y[start:stop] = out[:stop - start]
     return Y
+
+
+def _output_map(plant, compiled: bool, length: int) -> ca.Function:
+    x, u = ca.MX.sym("x", plant.nx, length), ca.MX.sym("u", len(plant.inputs), length)
+    w, p_sym = ca.MX.sym("w", len(plant.disturbances), length), ca.MX.sym("p", len(plant.p0))
+    y = plant.h.map(length)(x, u, w, ca.repmat(p_sym, 1, length))
+    fun = ca.Function("outputs_chunk", [x, u, w, p_sym], [y])
+    return compile_function(fun, enabled=compiled, optimise=plant.nx <= PLAIN_OUTPUTS_STATES)
 
 
 def cvodes_integrator(plant, wave_terms, t_grid, rtol=1e-8, atol=1e-10,

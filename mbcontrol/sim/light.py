@@ -20,6 +20,7 @@ import time
 
 import numpy as np
 
+from ..plant import derived
 from . import integrators
 from .simulate import _divergence_check, _parameters, _warn_stiff, energy_audit
 
@@ -115,7 +116,7 @@ def _last_excitation(plant, wave, t_end, W_nodes, nodes):
 
 # --- excitation at the nodes, one inverse FFT -----------------------------------------------
 
-_COEFFICIENTS: dict = {}
+COEFFICIENT_GRIDS_KEPT = 256      # frequency grids a plant keeps coefficients for
 
 
 def excitation_at_nodes(plant, wave, n: int, dt: float, nodes) -> np.ndarray:
@@ -132,16 +133,16 @@ def excitation_at_nodes(plant, wave, n: int, dt: float, nodes) -> np.ndarray:
 def _coefficients(plant, wave) -> np.ndarray:
     from ..errors import HydroError
     direction = wave.direction if not wave.directional else np.asarray(wave.direction).tobytes()
-    key = (id(plant), direction, wave.omega.size, float(wave.omega[0]),
-           float(wave.d_omega))
-    if key not in _COEFFICIENTS:
-        if len(_COEFFICIENTS) > 256:
-            _COEFFICIENTS.clear()
+    kept = derived(plant, ("sim.light.coefficients",), dict)
+    key = (direction, wave.omega.size, float(wave.omega[0]), float(wave.d_omega))
+    if key not in kept:
+        if len(kept) > COEFFICIENT_GRIDS_KEPT:
+            kept.clear()
         try:
             coeffs = plant.hydro.excitation_at(wave.omega, wave.direction)
         except HydroError:
             raise
         except ValueError as exc:
             raise HydroError(f"{plant.hydro.source}: {exc}") from None
-        _COEFFICIENTS[key] = (coeffs, plant)          # the plant kept alive: its id stays unique
-    return _COEFFICIENTS[key][0]
+        kept[key] = coeffs
+    return kept[key]

@@ -13,6 +13,8 @@ import numpy as np
 import scipy.linalg
 from scipy.sparse.csgraph import connected_components
 
+from ..plant import derived
+
 
 @dataclass(frozen=True)
 class Tableau:
@@ -80,18 +82,13 @@ def method(name: str) -> Method:
 
 # --- the radiation split used by the exponential method -----------------------------------
 
-_SPLITS: dict = {}
-
-
 def radiation_split(plant):
     """(first radiation state index, A_r, block sparsity of exp(A_r tau), block labels).
 
     The plant's radiation states are the last n_r states with chi' = A_r chi + B_r nu_h; A_r
     is in real modal form (1x1 and 2x2 blocks), so exp(A_r tau) has the same small blocks.
     """
-    if id(plant) not in _SPLITS:
-        _SPLITS[id(plant)] = (_radiation_split(plant), plant)
-    return _SPLITS[id(plant)][0]
+    return derived(plant, ("sim.radiation_split",), lambda: _radiation_split(plant))
 
 
 def _radiation_split(plant):

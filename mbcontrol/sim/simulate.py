@@ -23,7 +23,7 @@ import xarray as xr
 from .. import defaults
 from ..cache import progress_bar
 from ..errors import SimulationError
-from ..plant import provenance
+from ..plant import controlled_params, provenance
 from ..results import jsonable
 from . import diagnose, integrators, sampled
 from .held import HeldStepper
@@ -198,16 +198,13 @@ def _command(controller, t, y, x, nu) -> np.ndarray:
 
 
 def _parameters(plant, params, controller) -> np.ndarray:
-    """Parameter vector. A controller owns the PTO force, so the scene's linear PTO law
-    (damping, stiffness) is set to zero unless `params` names it explicitly."""
+    """Parameter vector. A controller owns the PTO force (plant.ownership: the scene's PTO
+    law off unless `params` sets it); a full vector is taken as it is."""
     if params is not None and not isinstance(params, dict):
         return np.asarray(params, float)
-    overrides = dict(params or {})
-    if controller is not None:
-        for pto in plant.scene.ptos:
-            overrides.setdefault(f"{pto.name}__damping", 0.0)
-            overrides.setdefault(f"{pto.name}__stiffness", 0.0)
-    return plant.params(**overrides)
+    if controller is None:
+        return plant.params(**(params or {}))
+    return plant.params(**controlled_params(plant, params))
 
 
 def _run_fixed(plant, method, controller, law, embedded, x0, W_nodes, p, dt, n, compiled,

@@ -21,21 +21,20 @@ import numpy as np
 
 from ..cache import progress_bar
 from ..errors import SimulationError
+from ..plant import derived
 from . import integrators
 
-_STEP_JACOBIANS: dict = {}
+def _step_jacobian(plant, method: str):
+    """(d x_next / d x as a Function of the step's inputs, the step)."""
+    step = integrators.step_function(plant, method)
+    args = [ca.SX.sym(step.name_in(i), step.sparsity_in(i)) for i in range(step.n_in())]
+    return ca.Function("G", args, [ca.jacobian(step(*args)[0], args[0])]), step
 
 
 def step_map_radius(plant, method: str, dt: float, params=None, x=None, u=None) -> float:
     """Spectral radius of the one-step map linearised at (x, u) (default rest, u = 0; w = 0),
     step dt (s). (x, u) should be an equilibrium (see `held_equilibrium`)."""
-    key = (id(plant), method)
-    if key not in _STEP_JACOBIANS:
-        step = integrators.step_function(plant, method)
-        args = [ca.SX.sym(step.name_in(i), step.sparsity_in(i)) for i in range(step.n_in())]
-        jac = ca.Function("G", args, [ca.jacobian(step(*args)[0], args[0])])
-        _STEP_JACOBIANS[key] = (jac, step, plant)
-    jac, step, _ = _STEP_JACOBIANS[key]
+    jac, step = derived(plant, ("sim.step_jacobian", method), lambda: _step_jacobian(plant, method))
     p = plant.p0 if params is None else (plant.params(**params) if isinstance(params, dict)
                                          else np.asarray(params, float))
     extras = [ca.DM(step.sparsity_in(5 + i), e) for i, e in

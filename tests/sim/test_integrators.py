@@ -92,17 +92,15 @@ def test_methods_agree_in_an_irregular_sea():
 def test_compiled_code_is_keyed_by_structure_not_values(tmp_path, monkeypatch):
     """One library per (plant structure, method, chunk length): other parameter values, steps
     and seas reuse it, in this process and (by its content hash) in the next."""
-    import mbcontrol.sim.integrators as integ
     monkeypatch.setenv("MBCONTROL_CACHE", str(tmp_path))
-    monkeypatch.setattr(integ, "_CHUNKS", {})
-    plant = build_plant("sphere")
+    plant = build_plant("sphere")      # a new plant: its workspace holds no compiled code yet
     for dt, damping in ((0.1, 1e5), (0.05, 4e5)):
         for seed in (1, 2):
             simulate(plant, waves.irregular(2.0, 8.0, seed=seed, duration=51.2), duration=51.2,
                      dt=dt, method="exp-rk4", params={"pto__damping": damping})
     chunks = sorted(p.name for p in (tmp_path / "compiled").glob("chunk_*.so"))
     assert len(chunks) == 1, chunks     # 512 and 1024 steps both use the 512-step chunk
-    monkeypatch.setattr(integ, "_CHUNKS", {})                  # a "new process"
+    # a "new process": a new plant, its workspace empty, finds the library on disk
     simulate(build_plant("sphere"), None, duration=51.2, dt=0.1, method="exp-rk4")
     assert sorted(p.name for p in (tmp_path / "compiled").glob("chunk_*.so")) == chunks
 
@@ -116,9 +114,9 @@ def test_a_step_that_calls_f_equals_the_inlined_step(case, monkeypatch, method):
     inlined = simulate(plant, wave, duration=10.0, dt=0.05, method=method)
     monkeypatch.setattr(integrators, "CALL_F_STATES", 0)
     monkeypatch.setattr(integrators, "PLAIN_OUTPUTS_STATES", 0)
-    integrators._CHUNKS.clear()
-    integrators._OUTPUT_MAPS.clear()
+    plant.workspace.clear()            # the compiled chunk and output map, built again
     called = simulate(plant, wave, duration=10.0, dt=0.05, method=method)
+    plant.workspace.clear()            # the shared plant's later users get the inlined code
     for name in ("heave", "heave__vel", "pto__force", "pto__power"):
         a, b = called[name].values, inlined[name].values
         assert np.abs(a - b).max() <= 1e-10 * np.abs(b).max(), name

@@ -24,6 +24,10 @@ from collections import defaultdict
 
 from ...cache import progress_bar
 
+# The plants this process built, most recent last: cases run a plant at a time (`groups`),
+# so a few suffice, and a sweep over scene parameters (each value a plant with its compiled
+# code) does not keep every one it has passed
+PLANTS_KEPT = 4
 _PLANTS: dict = {}
 # The last light run of this process, kept until the next one has its arrays: freed at once,
 # a run's records (35 MB for rm3 over an hour) top glibc's heap and go back to the kernel, and
@@ -32,13 +36,25 @@ _LAST_RUN: list = []
 
 
 def _plant(model: str, scene_params: tuple):
-    """The plant of a model and scene parameters, built once per process."""
+    """The plant of a model and scene parameters, built once while it is among the last
+    PLANTS_KEPT used in this process."""
     key = (model, scene_params)
-    if key not in _PLANTS:
+    if key in _PLANTS:
+        keep_plant(model, scene_params, _PLANTS.pop(key))
+    else:
         from ...plant import build_plant
         from ...scene import load_scene
-        _PLANTS[key] = build_plant(load_scene(model, dict(scene_params) or None))
+        keep_plant(model, scene_params, build_plant(load_scene(model, dict(scene_params) or None)))
     return _PLANTS[key]
+
+
+def keep_plant(model: str, scene_params: tuple, plant) -> None:
+    """Remember `plant` as the one of (model, sorted scene-parameter items) for the cases run
+    in this process (a plant the caller has already built is not built again)."""
+    _PLANTS.pop((model, scene_params), None)
+    _PLANTS[(model, scene_params)] = plant
+    while len(_PLANTS) > PLANTS_KEPT:
+        _PLANTS.pop(next(iter(_PLANTS)))
 
 
 def run_case(case) -> dict:

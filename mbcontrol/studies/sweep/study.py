@@ -17,7 +17,7 @@ from ...plant import provenance
 from ...results import jsonable
 from .cases import build_cases, roles_for
 from ...waves import annual_energy_MWh, site_energy_flux
-from .runner import _PLANTS, execute
+from .runner import execute, keep_plant
 from .store import CaseStore, assemble
 
 
@@ -64,7 +64,7 @@ def sweep(model: str, seas, *, seeds: int = 1, vary: dict | None = None, params=
             raise ValueError(f"--design tunes a controller for each sea: give --controller, one "
                              f"of {', '.join(DESIGNABLE)} (got {controller})")
     plant = build_plant(scene)
-    _PLANTS[(model, tuple(sorted((scene_params or {}).items())))] = plant   # serial path: reuse
+    keep_plant(model, tuple(sorted((scene_params or {}).items())), plant)   # serial path: reuse
     roles = roles_for(vary, scene, plant.parameters, REGISTRY.get(controller))
     if identified is not None:
         from .uncertainty import read_identified

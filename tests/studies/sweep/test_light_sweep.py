@@ -109,3 +109,21 @@ def test_a_busy_machine_runs_the_sweep_here(monkeypatch):
     store = CaseStore(None)
     assert runner.execute(cases, store, workers=2, progress=False)["where"] == "serial"
     assert not started and all(store.has(c.key) for c in cases)
+
+
+def test_a_process_keeps_only_its_last_plants(monkeypatch):
+    """A sweep over scene parameters builds a plant per value; a worker keeps the last
+    PLANTS_KEPT (cases run a plant at a time), not every one it has passed."""
+    monkeypatch.setattr(runner, "_PLANTS", {})
+    built = []
+    monkeypatch.setattr("mbcontrol.plant.build_plant", lambda scene: built.append(scene) or object())
+    monkeypatch.setattr("mbcontrol.scene.load_scene", lambda model, params=None: (model, params))
+    keys = [(("mass", float(m)),) for m in range(runner.PLANTS_KEPT + 3)]
+    plants = [runner._plant("sphere", key) for key in keys]
+    assert len(runner._PLANTS) == runner.PLANTS_KEPT and len(built) == len(keys)
+    assert runner._plant("sphere", keys[-1]) is plants[-1] and len(built) == len(keys)
+    runner._plant("sphere", keys[0])                     # dropped long ago: built again
+    assert len(built) == len(keys) + 1
+    mine = object()
+    runner.keep_plant("sphere", (("mass", -1.0),), mine)   # a plant the caller built
+    assert runner._plant("sphere", (("mass", -1.0),)) is mine and len(built) == len(keys) + 1
