@@ -15,8 +15,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import linalg
 
+from mbcontrol.lti import frequency_response, zoh
 from mbcontrol.plant import controlled_params
 
 from .base import signal_indices
@@ -104,7 +104,7 @@ def build_control_plant(plant, dt: float, *, ptos=None, measured=None, order=Non
                          f"the control-plant model expects a strictly proper plant")
     Bu_c, Bw = B[:, :nu], B[:, nu:]
     Bd_c, S = _disturbance_basis(Bw)
-    Ad, Bud = _zoh(A, np.hstack([Bu_c, Bd_c]), dt)
+    Ad, Bud = zoh(A, np.hstack([Bu_c, Bd_c]), dt)
     x_rest = plant.x0()
     y_rest = np.asarray(plant.h(x_rest, np.zeros(len(plant.inputs)),
                                 np.zeros(len(plant.disturbances)), plant.params(**base))).ravel()
@@ -124,22 +124,11 @@ def _disturbance_basis(Bw: np.ndarray, rtol: float = 1e-9):
     return U[:, :r], s[:r, None] * Vt[:r]
 
 
-def _zoh(A: np.ndarray, B: np.ndarray, dt: float):
-    """Exact zero-order-hold discretisation: (e^{A dt}, int_0^dt e^{A s} ds B)."""
-    n, m = B.shape
-    block = np.zeros((n + m, n + m))
-    block[:n, :n], block[:n, n:] = A, B
-    E = linalg.expm(block * dt)
-    return E[:n, :n], E[:n, n:]
-
-
 def pto_admittance(cp, omega) -> np.ndarray:
     """|force -> velocity| of each PTO at omega (rad/s): (n_omega, n_pto), m/s per N (or
     rad/s per N m), from the control plant's continuous model."""
-    omega = np.atleast_1d(np.asarray(omega, float))
-    eye = np.eye(cp.nz)
-    return np.array([np.abs(np.diag(cp.Cv @ np.linalg.solve(1j * w * eye - cp.A, cp.Bu_c)))
-                     for w in omega])
+    G = frequency_response(cp.A, cp.Bu_c, cp.Cv, None, omega)
+    return np.abs(np.diagonal(G, axis1=1, axis2=2))
 
 
 def pto_impedance(cp, omega: float) -> np.ndarray:

@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 from scipy import linalg
 
-from .control_plant import _zoh
+from mbcontrol.lti import frequency_response, zoh
 
 
 def wave_frequencies(wave=None, fallback: float | None = None, n: int = 3) -> np.ndarray:
@@ -70,7 +70,7 @@ class ExcitationKalman:
         A = np.zeros((nz + nxi, nz + nxi))
         A[:nz, :nz], A[:nz, nz:], A[nz:, nz:] = cp.A, cp.Bd_c @ C_xi, A_xi
         B = np.vstack([cp.Bu_c, np.zeros((nxi, cp.Bu_c.shape[1]))])
-        self.Phi, self.Gamma = _zoh(A, B, cp.dt)
+        self.Phi, self.Gamma = zoh(A, B, cp.dt)
         self.Phi_xi = self.Phi[nz:, nz:]
         self.C_xi, self.nz, self.nxi = C_xi, nz, nxi
         C = np.hstack([cp.Cm, np.zeros((cp.Cm.shape[0], nxi))])
@@ -86,11 +86,8 @@ class ExcitationKalman:
         cp = self.cp
         w = np.geomspace(omegas.min() / 3, omegas.max() * 3, 60)
         nd = max(cp.nd, 1)
-        peak = np.zeros(cp.Cm.shape[0])
-        for wk in w:
-            G = cp.Cm @ np.linalg.solve(1j * wk * np.eye(cp.nz) - cp.A,
-                                        cp.Bd_c if cp.nd else np.zeros((cp.nz, nd)))
-            peak = np.maximum(peak, np.abs(G).max(axis=1))
+        G = frequency_response(cp.A, cp.Bd_c if cp.nd else np.zeros((cp.nz, nd)), cp.Cm, None, w)
+        peak = np.abs(G).max(axis=(0, 2))
         return np.where(peak > 0, peak, 1.0)
 
     def reset(self) -> None:

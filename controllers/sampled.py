@@ -10,7 +10,7 @@ a loop with the others left free is not the loop simulated.
 Here the plant is linearised about rest (mbcontrol.analysis.linearize: no Coulomb friction,
 every PTO's own scene law zeroed unless `params` sets it, as in closed-loop simulation) from
 every PTO force u_p to every PTO position and velocity, discretised exactly with the hold
-(mbcontrol.sim.sampled.zoh) and closed with u_k = -G y_k, the command computed from the
+(mbcontrol.lti.zoh) and closed with u_k = -G y_k, the command computed from the
 outputs sampled at t_k and applied over [t_k, t_k + h) (no further delay: simulate's). The
 loop is stable when the spectral radius rho < 1; -ln(rho) / h is its equivalent continuous
 decay rate (1/s).
@@ -23,6 +23,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
+from mbcontrol.lti import zoh
 from mbcontrol.plant import controlled_params
 from mbcontrol.sim import sampled as zoh_loop
 
@@ -134,7 +135,7 @@ def discrete_loop(plant, gains: dict, period: float, pto: str, *, params=None):
     if np.any(np.asarray(sys.D)):
         raise ValueError(f"{plant.name}: PTO positions and velocities should not depend on the "
                          f"force directly (D != 0)")
-    Phi, Gamma = zoh_loop.zoh(sys.A, sys.B, float(period))
+    Phi, Gamma = zoh(sys.A, sys.B, float(period))
     G, C = gain_matrix(gains, names), np.asarray(sys.C)
     i = names.index(pto)
     rest = [j for j in range(len(names)) if j != i]
@@ -215,7 +216,7 @@ def held_dampers(plant, damping: dict, period: float, *, params=None) -> tuple[d
     names = [p.name for p in plant.scene.ptos]
     sys = joint_plant(plant, params=params)
     A, B, C = (np.asarray(M) for M in (sys.A, sys.B, sys.C))
-    Phi, Gamma = zoh_loop.zoh(A, B, float(period))
+    Phi, Gamma = zoh(A, B, float(period))
 
     def acceptable(f):
         G = gain_matrix({n: (f * damping.get(n, 0.0), 0.0) for n in names}, names)

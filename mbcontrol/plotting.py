@@ -16,6 +16,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from .atomic import atomic_path
+from .lti import frequency_response
 
 
 def save(fig, path) -> Path:
@@ -34,11 +35,9 @@ def bode(sys, pairs, omega, *, title=None, path=None, fd=None):
     """
     fig, (ax_mag, ax_ph) = plt.subplots(2, 1, sharex=True, figsize=(7.5, 6))
     A, B, C, D = (np.asarray(M) for M in (sys.A, sys.B, sys.C, sys.D))
-    eye = np.eye(A.shape[0])
     for inp, out in pairs:
         i, o = sys.input_labels.index(inp), sys.output_labels.index(out)
-        G = np.array([C[o] @ np.linalg.solve(1j * w * eye - A, B[:, i]) + D[o, i]
-                      for w in omega])
+        G = frequency_response(A, B[:, i], C[o], D[o, i], omega)[:, 0, 0]
         line, = ax_mag.loglog(omega, np.abs(G), label=f"{signal_label(inp)} → {signal_label(out)}")
         ax_ph.semilogx(omega, np.degrees(np.unwrap(np.angle(G))), color=line.get_color())
         if fd and (inp, out) in fd:

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..lti import frequency_chunks, frequency_response, state_response
 from ..plant import MechanicalMatrices, mechanical_matrices  # noqa: F401 (their public home here too)
 
 
@@ -61,9 +62,7 @@ def excitation_transfer(plant, omega, *, params=None, outputs=None, sys=None) ->
         w_idx = [sys.input_labels.index(f"w__{d}") for d in plant.hydro.dofs]
         y_idx = [sys.output_labels.index(o) for o in (outputs or sys.output_labels)]
         A, B, C, D = (np.asarray(M) for M in (sys.A, sys.B, sys.C, sys.D))
-        eye = np.eye(A.shape[0])
-        return np.stack([C[y_idx] @ np.linalg.solve(1j * w * eye - A, B[:, w_idx])
-                         + D[np.ix_(y_idx, w_idx)] for w in omega])
+        return frequency_response(A, B[:, w_idx], C[y_idx], D[np.ix_(y_idx, w_idx)], omega)
     mech = mechanical_matrices(plant, params)
     A_w, B_w = plant.hydro.frequency_domain_matrices(omega)
     idx = [plant.outputs.index(o) for o in (outputs or plant.outputs)]
@@ -84,22 +83,8 @@ def statespace_response(sys, plant, omega, *, direction: float = 0.0, outputs=No
     names = outputs or sys.output_labels
     y_idx = [sys.output_labels.index(o) for o in names]
     A, B, C, D = (np.asarray(M) for M in (sys.A, sys.B, sys.C, sys.D))
-    eye = np.eye(A.shape[0])
-    out = np.empty((omega.size, len(y_idx)), dtype=complex)
-    # G(i w) in stacked solves of a few MB each: a Python loop of rm3's 40 x 40 solves cost a
-    # sweep's uncertainty budget 5 s over 92 seas; one stack of raft3's 275 x 275 is 240 MB
-    for k in frequency_chunks(omega.size, A.shape[0]):
-        X = np.linalg.solve(1j * omega[k, None, None] * eye - A, B[:, w_idx])
-        G = C[y_idx] @ X + D[np.ix_(y_idx, w_idx)]
-        out[k] = (G @ F[k, :, None])[..., 0]
-    return out
-
-
-def frequency_chunks(n_omega: int, n: int, budget: int = 1 << 19):
-    """Slices of the frequencies whose n x n complex matrices fill about 8 MB: a stacked
-    solve per slice, rather than a Python loop of small solves or one huge stack."""
-    step = max(1, budget // (n * n))
-    return [slice(k, k + step) for k in range(0, max(n_omega, 1), step)]   # one if empty
+    G = frequency_response(A, B[:, w_idx], C[y_idx], D[np.ix_(y_idx, w_idx)], omega)
+    return np.einsum("wom,wm->wo", G, F)
 
 
 def steady_amplitude(ds, name: str, period: float, n_periods: int = 10) -> float:
@@ -125,8 +110,7 @@ def steady_state_initial(sys, plant, wave) -> np.ndarray:
     F = np.conj(interpolate_complex(hyd.omega, hyd.excitation_coefficients(wave.direction),
                                     np.array([w]))[0] * a)
     w_idx = [sys.input_labels.index(f"w__{d}") for d in hyd.dofs]
-    A, B = np.asarray(sys.A), np.asarray(sys.B)[:, w_idx]
-    X = np.linalg.solve(1j * w * np.eye(A.shape[0]) - A, B @ F)
+    X = state_response(sys.A, np.asarray(sys.B)[:, w_idx] @ F, [w])[0, :, 0]
     return plant.x0() + X.real
 
 

@@ -36,7 +36,8 @@ def output_responses(plant, omega, ptos, outputs, direction: float = 0.0, params
     (n_omega, n_out) per unit wave amplitude with the PTOs free (exp(-i omega t), straight
     from the BEM data), so that with PTO forces F the outputs are G F + H A. params:
     overrides as `linear_params`; the PTOs named in `ptos` are freed."""
-    from .frequency import frequency_chunks, mechanical_matrices
+    from ..lti import frequency_chunks
+    from .frequency import mechanical_matrices
     from .linearize import jacobians
 
     if plant.hydro is None:

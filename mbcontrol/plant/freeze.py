@@ -7,6 +7,7 @@ import dataclasses
 import numpy as np
 
 from ..errors import FidelityError
+from ..lti import frequency_response
 from ..scene import DOF_NAMES, Scene
 from ..waves import Wave
 from .jacobians import jacobians
@@ -116,12 +117,9 @@ def _linear_rms(plant, wave, outputs):
     A, _, Bw, C, _, Dw = (np.asarray(M) for M in jacobians(plant)(
         plant.x0(), np.zeros(len(plant.inputs)), np.zeros(n_w), plant.p0))
     rows = [plant.outputs.index(o) for o in outputs]
-    C, Dw, eye = C[rows], Dw[rows], np.eye(A.shape[0])
-    power = np.zeros(len(rows))
-    for w, f in zip(wave.omega, np.conj(F)):      # exp(+i w t) phasors, as python-control's
-        y = C @ np.linalg.solve(1j * w * eye - A, Bw @ f) + Dw @ f
-        power += 0.5 * np.abs(y) ** 2
-    return rms_w, np.sqrt(power)
+    G = frequency_response(A, Bw, C[rows], Dw[rows], wave.omega)    # exp(+i w t) phasors
+    y = np.einsum("wom,wm->wo", G, np.conj(F))
+    return rms_w, np.sqrt(np.sum(0.5 * np.abs(y) ** 2, axis=0))
 
 
 def as_wave_list(waves) -> list[Wave]:

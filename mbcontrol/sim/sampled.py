@@ -23,20 +23,9 @@ invalid when the loop is unstable.
 from __future__ import annotations
 
 import numpy as np
-import scipy.linalg
 
+from ..lti import zoh
 from . import diagnose
-
-
-def zoh(A, B, period: float) -> tuple[np.ndarray, np.ndarray]:
-    """(Phi, Gamma): the exact zero-order-hold discretisation of x' = A x + B u over `period`
-    s, from the exponential of the augmented matrix [[A, B], [0, 0]] (Van Loan)."""
-    A, B = np.atleast_2d(np.asarray(A, float)), np.asarray(B, float).reshape(len(A), -1)
-    n, m = A.shape[0], B.shape[1]
-    M = np.zeros((n + m, n + m))
-    M[:n, :n], M[:n, n:] = A, B
-    E = scipy.linalg.expm(M * period)
-    return E[:n, :n], E[:n, n:]
 
 
 def closed_loop_map(A, B, C, D, K, period: float) -> np.ndarray:
