@@ -1,7 +1,19 @@
-"""Saving results: netCDF written to a temporary file and renamed, so nothing half-written;
-and `jsonable`, the one conversion of results to strict JSON."""
+"""Results on disk: one netCDF codec for every file mbcontrol writes (hydrodynamic caches,
+`simulate --out`, sweeps, benchmarks), each written to a temporary file and renamed, so
+nothing half-written; and `jsonable`, the one conversion of results to strict JSON.
+
+netCDF cannot hold complex numbers, booleans, dictionaries or (portably) infinite
+attributes. They are encoded on write and decoded on read, so that
+``read_dataset(write_dataset(ds, p))`` returns a dataset equal to ``ds``:
+
+- a complex variable gets a leading dimension ``complex = ["re", "im"]`` (Capytaine's own
+  convention, so ``capytaine.io.xarray.merge_complex_values`` reads it too);
+- attributes that are bool, dict, list, tuple or non-finite float are stored as strings,
+  and their original type is recorded in the attribute ``mbc_encoded_attrs`` (JSON).
+"""
 from __future__ import annotations
 
+import json
 import math
 from pathlib import Path
 
@@ -9,6 +21,13 @@ import numpy as np
 import xarray as xr
 
 from .atomic import atomic_path
+from .errors import MbcontrolError
+
+ENCODED_ATTRS = "mbc_encoded_attrs"
+
+
+class DataFileError(MbcontrolError, ValueError):
+    """A results file cannot be read: names the file and what was expected."""
 
 
 def jsonable(obj):
@@ -31,28 +50,115 @@ def jsonable(obj):
     return obj
 
 
-def save_dataset(ds: xr.Dataset, path, *, precision: str = "float64", every: int = 1) -> Path:
-    """Write `ds` to netCDF at `path` atomically (complex variables split into re/im), each
-    variable deflate-compressed (lossless). precision "float32" stores floating variables in
-    single precision (relative rounding 6e-8, half the size again); every = k keeps every k-th
-    time sample (a figure needs far fewer than the integrator's steps)."""
+def write_dataset(ds: xr.Dataset, path, *, precision: str = "float64", every: int = 1,
+                  compress: bool = False) -> Path:
+    """Write `ds` to netCDF at `path` atomically, encoded as the module says. precision
+    "float32" stores floating variables in single precision (relative rounding 6e-8);
+    every = k keeps every k-th time sample; compress: deflate each variable (lossless)."""
     if precision not in ("float64", "float32"):
         raise ValueError(f"precision {precision!r}: expected float64 or float32")
     if every < 1:
         raise ValueError(f"every = {every}: expected a positive number of samples")
     path = Path(path)
-    out = ds.copy()
-    if every > 1 and "time" in out.dims:
-        out = out.isel(time=slice(None, None, every))
-    for name in [v for v in out.data_vars if out[v].dtype.kind == "c"]:
-        out[f"{name}__re"], out[f"{name}__im"] = out[name].real, out[name].imag
-        out = out.drop_vars(name)
+    if every > 1 and "time" in ds.dims:
+        ds = ds.isel(time=slice(None, None, every))
+    out = encode(ds)
     encoding = {}
     for name, var in out.data_vars.items():
-        if var.dtype.kind in "fiu" and var.ndim > 0:
-            encoding[name] = {"zlib": True, "complevel": 4}
-            if precision == "float32" and var.dtype.kind == "f":
-                encoding[name]["dtype"] = "float32"
+        options = {}
+        if compress and var.dtype.kind in "fiu" and var.ndim > 0:
+            options.update(zlib=True, complevel=4)
+        if precision == "float32" and var.dtype.kind == "f":
+            options["dtype"] = "float32"
+        if options:
+            encoding[name] = options
     with atomic_path(path, ".nc") as tmp:
-        out.to_netcdf(tmp, encoding=encoding)
+        out.to_netcdf(tmp, engine="netcdf4", encoding=encoding)
     return path
+
+
+def read_dataset(path) -> xr.Dataset:
+    """A file `write_dataset` wrote (any mbcontrol netCDF: a `simulate --out` record, a
+    sweep's sweep.nc, a hydrodynamic cache), fully into memory and decoded."""
+    path = Path(path)
+    if not path.is_file():
+        raise DataFileError(f"{path}: no such file (expected a netCDF file mbcontrol wrote)")
+    try:
+        with xr.open_dataset(path, engine="netcdf4") as raw:
+            return decode(raw.load())
+    except Exception as exc:  # netCDF4/HDF5 raise several unrelated types
+        raise DataFileError(f"{path}: unreadable or corrupt netCDF file ({type(exc).__name__}: "
+                            f"{exc})") from exc
+
+
+def save_dataset(ds: xr.Dataset, path, *, precision: str = "float64", every: int = 1) -> Path:
+    """A result (a `simulate` record, a report) to `path`: `write_dataset`, compressed."""
+    return write_dataset(ds, path, precision=precision, every=every, compress=True)
+
+
+def encode(ds: xr.Dataset) -> xr.Dataset:
+    """`ds` as netCDF can hold it (module docstring)."""
+    out = ds.copy()
+    for name in list(out.data_vars):
+        da = out[name]
+        if np.iscomplexobj(da.values):
+            split = xr.concat([da.real, da.imag], dim="complex").transpose("complex", *da.dims)
+            split.attrs = _encode_attrs(da.attrs)
+            out[name] = split
+        else:
+            out[name].attrs = _encode_attrs(da.attrs)
+    if "complex" in out.dims:
+        out = out.assign_coords(complex=["re", "im"])
+    out.attrs = _encode_attrs(ds.attrs)
+    return out
+
+
+def decode(ds: xr.Dataset) -> xr.Dataset:
+    """The dataset `encode` made `ds` from."""
+    out = ds.copy()
+    for name in list(out.data_vars):
+        da = out[name]
+        attrs = _decode_attrs(da.attrs)
+        if "complex" in da.dims:
+            da = da.sel(complex="re", drop=True) + 1j * da.sel(complex="im", drop=True)
+        da.attrs = attrs
+        out[name] = da
+    if "complex" in out.coords:
+        out = out.drop_vars("complex")
+    out.attrs = _decode_attrs(ds.attrs)
+    # String coordinates come back as object arrays; make them plain unicode again.
+    for c in out.coords:
+        if out[c].dtype == object:
+            out = out.assign_coords({c: out[c].values.astype(str)})
+    return out
+
+
+def _encode_attrs(attrs: dict) -> dict:
+    out, kinds = {}, {}
+    for k, v in attrs.items():
+        if isinstance(v, (bool, np.bool_)):
+            out[k], kinds[k] = int(bool(v)), "bool"
+        elif isinstance(v, (dict, list, tuple)):
+            out[k], kinds[k] = json.dumps(v), "json"
+        elif isinstance(v, (float, np.floating)) and not math.isfinite(float(v)):
+            out[k], kinds[k] = repr(float(v)), "float"  # 'inf', '-inf', 'nan'
+        else:
+            out[k] = v
+    if kinds:
+        out[ENCODED_ATTRS] = json.dumps(kinds)
+    return out
+
+
+def _decode_attrs(attrs: dict) -> dict:
+    attrs = dict(attrs)
+    kinds = json.loads(attrs.pop(ENCODED_ATTRS, "{}"))
+    for k, kind in kinds.items():
+        if k not in attrs:
+            continue
+        if kind == "bool":
+            attrs[k] = bool(int(attrs[k]))
+        elif kind == "json":
+            attrs[k] = json.loads(attrs[k])
+        elif kind == "float":
+            attrs[k] = float(attrs[k])
+    return attrs

@@ -9,6 +9,7 @@ import csv
 from pathlib import Path
 
 from ..atomic import atomic_path
+from ..results import write_dataset
 from ..sim import stability as stab
 from . import workprecision as wp
 
@@ -21,7 +22,7 @@ def bench(scene, wave, *, duration: float, methods, radiation_tols=(), stability
     out.mkdir(parents=True, exist_ok=True)
     ds = wp.work_precision(scene, wave, duration=duration, methods=methods,
                            radiation_tols=radiation_tols, repeats=repeats, progress=True)
-    _atomic(out / "work_precision.nc", lambda path: ds.to_netcdf(path))
+    write_dataset(ds, out / "work_precision.nc")
     _atomic(out / "work_precision.csv", lambda path: ds.to_dataframe().to_csv(path))
     wp.plot(ds, out / "work_precision.png", tol=tol)
     echo(wp.table(ds))

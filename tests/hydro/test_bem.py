@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 import os
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -338,10 +339,11 @@ def test_atomic_write_leaves_nothing_on_failure(tmp_path, monkeypatch):
     path = netcdf.write_netcdf_atomic(ds, tmp_path / "ok.nc")
     xr.testing.assert_identical(netcdf.read_netcdf(path), ds)  # complex, inf and bool round-trip
 
-    def fail(_):
+    def fail(self, path, **_):          # half a file written, then the disk is full
+        Path(path).write_bytes(b"CDF\x01 half")
         raise OSError("disk full")
 
-    monkeypatch.setattr(netcdf, "_encode", fail)
+    monkeypatch.setattr(xr.Dataset, "to_netcdf", fail)
     with pytest.raises(OSError):
         netcdf.write_netcdf_atomic(ds, tmp_path / "bad.nc")
     assert sorted(os.listdir(tmp_path)) == ["ok.nc"]

@@ -209,7 +209,7 @@ def test_hinged_raft_free_floating():
 def test_results_carry_units_and_round_trip(barge, tmp_path):
     import xarray as xr
 
-    from mbcontrol.results import save_dataset
+    from mbcontrol.results import read_dataset, save_dataset
     ds = simulate(barge, waves.irregular(0.03, 1.1, seed=4, duration=20.0), duration=20.0,
                   dt=0.01, controller=make("passive", damping=1.0))
     expected = {"pivot": "rad", "hinge__vel": "rad/s", "barge2__Heave": "m", "barge2__Pitch":
@@ -217,7 +217,7 @@ def test_results_carry_units_and_round_trip(barge, tmp_path):
                 "N m", "w__barge2__Heave": "N", "w__barge2__Pitch": "N m", "energy": "J"}
     assert {k: ds[k].attrs["units"] for k in expected} == expected
     path = save_dataset(ds, tmp_path / "run.nc")
-    back = xr.load_dataset(path)
+    back = read_dataset(path)                        # the reader of every mbcontrol file
     xr.testing.assert_identical(back, ds)            # values, coordinates and attrs
     assert "tmp" not in " ".join(p.name for p in tmp_path.iterdir())   # no leftovers
     assert oct(path.stat().st_mode & 0o777) != oct(0o600)             # readable by others

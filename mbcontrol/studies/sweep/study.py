@@ -107,8 +107,8 @@ def sweep(model: str, seas, *, seeds: int = 1, vary: dict | None = None, params=
         ds["capture_width_ratio"] = ds["capture_width_m"] / width
         ds.attrs["characteristic_width_m"] = width
     if store is not None:
-        from ...hydro import write_netcdf_atomic
-        write_netcdf_atomic(ds, Path(store) / "sweep.nc")
+        from ...results import write_dataset
+        write_dataset(ds, Path(store) / "sweep.nc")
     summary = _summary(ds, seas, run, time.perf_counter() - start, len(cases))
     from mbcontrol.controllers import absorbs_nothing
     why = None if design else absorbs_nothing(controller, settings, vary)

@@ -13,6 +13,7 @@ import xarray as xr
 from mbcontrol import waves
 from mbcontrol.analysis import summary
 from mbcontrol.plant import build_plant
+from mbcontrol.results import read_dataset
 from mbcontrol.sim import simulate
 from mbcontrol.studies.sweep import grid, sweep
 from mbcontrol.studies.sweep.runner import CLUSTER_ENV
@@ -73,8 +74,9 @@ def test_killed_sweep_resumes_with_each_case_once(tmp_path):
     assert len(list((store / "cases").glob("*.json"))) == 6
     again = json.loads(_cli(store, "--workers", "0").stdout)
     assert (again["computed"], again["reused"]) == (0, 6)   # same inputs: nothing to do
-    ds = xr.open_dataset(store / "sweep.nc")
+    ds = read_dataset(store / "sweep.nc")       # the reader of `simulate --out` files too
     assert np.all(np.isfinite(ds["mean_power_W"].values))
+    assert ds.attrs["model"] == "sphere"
 
 
 def test_a_dead_worker_loses_only_its_task(tmp_path):
