@@ -3,6 +3,7 @@
 `make(name, **settings)` builds one by name (as the CLI's --controller NAME --set k=v does).
 """
 from __future__ import annotations
+from mbcontrol.errors import UnknownName
 
 from .base import Controller
 from .latching import Declutching, Latching
@@ -18,17 +19,17 @@ REGISTRY = {"passive": Passive, "reactive": Reactive, "latching": Latching,
 def make(name: str, **settings) -> Controller:
     """A controller by registry name with keyword settings, e.g. make('passive', damping=2)."""
     if name not in REGISTRY:
-        raise KeyError(f"unknown controller {name!r}; expected one of {', '.join(REGISTRY)}")
+        raise UnknownName(f"unknown controller {name!r}; expected one of {', '.join(REGISTRY)}")
     import inspect
     accepted = inspect.signature(REGISTRY[name]).parameters
     unknown = [k for k in settings if k not in accepted]
     if unknown:
-        raise KeyError(f"controller {name!r} has no setting {', '.join(map(repr, unknown))}; "
+        raise UnknownName(f"controller {name!r} has no setting {', '.join(map(repr, unknown))}; "
                        f"its settings are {', '.join(accepted)}")
     try:
         return REGISTRY[name](**settings)
     except TypeError as exc:
-        raise KeyError(f"controller {name!r}: {exc}; its settings are "
+        raise UnknownName(f"controller {name!r}: {exc}; its settings are "
                        f"{', '.join(accepted)}") from None
 
 

@@ -14,6 +14,7 @@ from __future__ import annotations
 from typing import Protocol, runtime_checkable
 
 import numpy as np
+from mbcontrol.errors import UnknownName
 
 
 @runtime_checkable
@@ -34,7 +35,7 @@ def signal_indices(plant, names: list[str]) -> list[int]:
     """Indices of named outputs, with an error that lists what the plant offers."""
     missing = [n for n in names if n not in plant.outputs]
     if missing:
-        raise KeyError(f"{plant.name}: no output(s) {missing}; outputs are "
+        raise UnknownName(f"{plant.name}: no output(s) {missing}; outputs are "
                        f"{', '.join(plant.outputs)}")
     return [plant.outputs.index(n) for n in names]
 
@@ -45,5 +46,5 @@ def per_pto(plant, value, what: str) -> np.ndarray:
     gains = value if isinstance(value, dict) else {n: value for n in names}
     unknown = set(gains) - set(names)
     if unknown:
-        raise KeyError(f"{plant.name}: {what} for unknown PTO(s) {sorted(unknown)}")
+        raise UnknownName(f"{plant.name}: {what} for unknown PTO(s) {sorted(unknown)}")
     return np.array([float(gains.get(n, 0.0)) for n in names])

@@ -51,7 +51,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from mbcontrol.errors import SimulationError
+from mbcontrol.errors import ControllerError, SimulationError
 from mbcontrol.results import jsonable
 
 from . import REGISTRY, make
@@ -146,10 +146,10 @@ def design(plant, wave, name: str, *, pto: str | None = None, simulate_s: float 
     (no wave, latching in a sea, latching in waves shorter than the natural period, ...).
     """
     if name not in REGISTRY:
-        raise ValueError(f"design: unknown controller {name!r}; expected one of "
+        raise ControllerError(f"design: unknown controller {name!r}; expected one of "
                          f"{', '.join(REGISTRY)}")
     if wave is None:
-        raise ValueError(f"design {name!r}: needs a wave to tune for")
+        raise ControllerError(f"design {name!r}: needs a wave to tune for")
     pto_obj = _pto(plant, pto)
     limit_values = {"force_max": float(pto_obj.force_max), "stroke_max": float(pto_obj.stroke_max),
                     "force_max_on": pto_obj.limited_force()}   # the machine's force or the hull's
@@ -162,7 +162,7 @@ def design(plant, wave, name: str, *, pto: str | None = None, simulate_s: float 
         parameters, predicted, tuner, extra = tune(plant, wave, name, pto_obj, limits,
                                                     model_params, notes, robust=robust)
     except ValueError as exc:
-        raise ValueError(f"design {name!r}: {exc}") from None
+        raise ControllerError(f"design {name!r}: {exc}") from None
     controller = make(name, **parameters, **extra)
     if isinstance(predicted, dict):                  # jointly tuned: one figure per PTO
         predicted = predicted[pto_obj.name]
@@ -258,11 +258,11 @@ def design(plant, wave, name: str, *, pto: str | None = None, simulate_s: float 
 def _pto(plant, pto):
     ptos = {p.name: p for p in plant.scene.ptos}
     if not ptos:
-        raise ValueError(f"design: {plant.name} has no PTO to control")
+        raise ControllerError(f"design: {plant.name} has no PTO to control")
     if pto is None:
         return plant.scene.ptos[0]
     if pto not in ptos:
-        raise ValueError(f"design: {plant.name} has no PTO {pto!r}; PTOs are "
+        raise ControllerError(f"design: {plant.name} has no PTO {pto!r}; PTOs are "
                          f"{', '.join(ptos)}")
     return ptos[pto]
 

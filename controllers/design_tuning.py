@@ -9,6 +9,7 @@ import math
 from mbcontrol.results import jsonable
 
 from mbcontrol.analysis.envelope import ENVELOPE_SHARE
+from mbcontrol.errors import ControllerError
 
 from . import REGISTRY, make
 from .limits import command_limit
@@ -99,7 +100,7 @@ def tune(plant, wave, name, pto_obj, limits, model_params, notes, robust: bool =
     if name in ("latching", "declutching"):
         from .latching import optimal_declutch, optimal_latch_time
         if model_params:
-            raise ValueError("model_params: latching and declutching tune by simulating the "
+            raise ControllerError("model_params: latching and declutching tune by simulating the "
                              "plant itself")
         tuner, key = ((optimal_latch_time, "latch_time") if name == "latching"
                       else (optimal_declutch, "declutch_time"))
@@ -110,7 +111,7 @@ def tune(plant, wave, name, pto_obj, limits, model_params, notes, robust: bool =
                  "dt_s": wave.period / 500}, extra)
     # mpc (or another registered controller): no tuner; its defaults and the PTO's limits
     if model_params:
-        raise ValueError("model_params: this controller is not tuned, so there is no model "
+        raise ControllerError("model_params: this controller is not tuned, so there is no model "
                          "to get wrong")
     if name in ("mpc", "nmpc"):
         # one wave period ahead in 40 steps: the horizon that reaches the constrained bound

@@ -23,6 +23,7 @@ import numpy as np
 from scipy import linalg
 
 from mbcontrol.lti import frequency_response, zoh
+from mbcontrol.errors import ControllerError
 
 
 def wave_frequencies(wave=None, fallback: float | None = None, n: int = 3) -> np.ndarray:
@@ -37,7 +38,7 @@ def wave_frequencies(wave=None, fallback: float | None = None, n: int = 3) -> np
         cdf = np.cumsum(a) / a.sum()
         return np.interp((np.arange(n) + 0.5) / n, cdf, w)
     if fallback is None:
-        raise ValueError("wave_frequencies: give a wave or a fallback frequency")
+        raise ControllerError("wave_frequencies: give a wave or a fallback frequency")
     return fallback * np.geomspace(0.7, 1.4, n)
 
 
@@ -56,7 +57,7 @@ class ExcitationKalman:
         nz, nd = cp.nz, cp.nd
         omegas = np.atleast_1d(np.asarray(omegas, float))
         if np.any(omegas <= 0):
-            raise ValueError(f"wave-model frequencies must be > 0 rad/s, got {omegas}")
+            raise ControllerError(f"wave-model frequencies must be > 0 rad/s, got {omegas}")
         nh = omegas.size
         nxi = 2 * nh * nd
         A_xi, C_xi, q_xi = np.zeros((nxi, nxi)), np.zeros((nd, nxi)), np.zeros(nxi)

@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from mbcontrol.plant import controlled_params
+from mbcontrol.errors import ControllerError
 
 
 def base_params(plant, pto: str, params=None) -> dict:
@@ -78,7 +79,7 @@ def electrical_optimum(plant, wave, *, pto: str | None = None, params=None) -> d
     name = pto or plant.scene.ptos[0].name
     drive = next(p for p in plant.scene.ptos if p.name == name).drivetrain
     if drive is None:
-        raise ValueError(f"PTO {name!r} has no [pto.drivetrain]: its electrical optimum is "
+        raise ControllerError(f"PTO {name!r} has no [pto.drivetrain]: its electrical optimum is "
                          f"the complex-conjugate bound times its efficiency")
     Z, F = intrinsic_impedance(plant, wave.omega, pto=name, params=params,
                                direction=wave.direction)

@@ -23,6 +23,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+from mbcontrol.errors import ControllerError
 
 from .impedance import phasor_statistics
 from .tuning import multistart
@@ -61,7 +62,7 @@ class PortModel:
         n = len(self.ptos)
         sys = joint_plant(plant, params=linear_params(plant, self.ptos, params))
         if np.any(np.asarray(sys.D) != 0):
-            raise ValueError(f"{plant.name}: a PTO's position or velocity depends directly "
+            raise ControllerError(f"{plant.name}: a PTO's position or velocity depends directly "
                              f"on a PTO force")
         self._A, self._B, self._C = (np.asarray(m) for m in (sys.A, sys.B, sys.C))
         self._n = n
@@ -130,7 +131,7 @@ def joint_tuning(plant, wave, *, passive: bool = False, params=None, force_max=N
     values = [evaluate(np.full(n, cc), np.zeros(n))[:2] for cc in dampings]
     feasible = [v for (v, ok) in values if ok]
     if not feasible:
-        raise ValueError(f"{plant.name}: no common damping in {dampings[0]:.4g}.."
+        raise ControllerError(f"{plant.name}: no common damping in {dampings[0]:.4g}.."
                          f"{dampings[-1]:.4g} keeps every PTO's predicted peaks within its "
                          f"limits")
     best = int(np.argmax([v if ok else -np.inf for (v, ok) in values]))
@@ -168,7 +169,7 @@ def joint_tuning(plant, wave, *, passive: bool = False, params=None, force_max=N
     best = multistart(cost, starts, xatol=1e-5, fatol_rel=1e-8, fatol_abs=1e-12,
                       maxiter=400 * 2 * n)
     if not np.isfinite(best.fun):
-        raise ValueError(f"{plant.name}: joint tuning found no stable law within the limits")
+        raise ControllerError(f"{plant.name}: joint tuning found no stable law within the limits")
     c, k = unpack(best.x)
     return _result(model, c, k, evaluate, "search (Nelder-Mead from a common damping and "
                                           "each PTO's own match)")

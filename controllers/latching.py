@@ -34,6 +34,7 @@ of the force from the velocity change under the force it really applied.
 from __future__ import annotations
 
 import numpy as np
+from mbcontrol.errors import ControllerError
 
 from .base import per_pto, signal_indices
 from .impedance import intrinsic_impedance
@@ -58,7 +59,7 @@ class _Switching:
         names = [p.name for p in plant.scene.ptos]
         self._c = per_pto(plant, self.damping, f"{self.name} damping")
         if np.any(self._c < 0) or self._hold_time < 0:
-            raise ValueError(f"{self.name}: damping and hold time must be >= 0, got "
+            raise ControllerError(f"{self.name}: damping and hold time must be >= 0, got "
                              f"{self._c}, {self._hold_time}")
         self._names = names
         self._limits = force_limits(plant, self.force_max)
@@ -188,7 +189,7 @@ def _port_inertia(plant, names) -> np.ndarray:
                     outputs=[f"{n}__velocity" for n in names])
     gain = np.diag(np.asarray(sys.C) @ np.asarray(sys.B))
     if np.any(gain <= 0):
-        raise ValueError(f"{plant.name}: PTO force does not accelerate its own coordinate "
+        raise ControllerError(f"{plant.name}: PTO force does not accelerate its own coordinate "
                          f"(dv/dt per unit u = {gain}); cannot build a latching brake")
     return 1.0 / gain
 
@@ -213,7 +214,7 @@ def steady_mean_power(ds, pto: str, period: float, skip_periods: int = 5,
     start = skip_periods * period
     n = int(np.floor((t[-1] - start) / period + 1e-9))
     if n < 1:
-        raise ValueError(f"record of {t[-1]:.4g} s too short to skip {skip_periods} periods of "
+        raise ControllerError(f"record of {t[-1]:.4g} s too short to skip {skip_periods} periods of "
                          f"{period:.4g} s and average over one")
     return mean_power(ds, pto, start, start + n * period, key)
 
@@ -226,7 +227,7 @@ def natural_period(plant, *, pto: str | None = None, params=None) -> float:
     X = intrinsic_impedance(plant, omega, pto=pto, params=params)[0].imag
     j = np.flatnonzero((X[:-1] < 0) & (X[1:] >= 0))
     if j.size == 0:
-        raise ValueError(f"{plant.name}: no resonance inside the hydro data's band")
+        raise ControllerError(f"{plant.name}: no resonance inside the hydro data's band")
     j = int(j[0])
     w_n = omega[j] - X[j] * (omega[j + 1] - omega[j]) / (X[j + 1] - X[j])
     return float(2 * np.pi / w_n)
@@ -272,7 +273,7 @@ def _bracket_search(objective, lo, hi, step, xatol):
 
 def _regular(wave, what):
     if wave.omega.size != 1:
-        raise ValueError(f"{what} tunes for a regular wave; for a sea state tune on the "
+        raise ControllerError(f"{what} tunes for a regular wave; for a sea state tune on the "
                          f"regular wave at its peak period (or simulate a grid)")
     return wave.period
 
@@ -302,7 +303,7 @@ def optimal_latch_time(plant, wave, *, damping: float | None = None, pto: str | 
     dt = T / 500 if dt is None else dt
     T_n = natural_period(plant, pto=name)
     if T_n >= T:
-        raise ValueError(f"{plant.name}: latching helps for waves longer than the natural "
+        raise ControllerError(f"{plant.name}: latching helps for waves longer than the natural "
                          f"period; T = {T:.4g} s <= T_n = {T_n:.4g} s (try declutching)")
     if damping is None:
         damping = float(intrinsic_impedance(plant, [2 * np.pi / T_n], pto=name)[0][0].real)

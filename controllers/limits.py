@@ -6,6 +6,7 @@ import math
 
 import casadi as ca
 import numpy as np
+from mbcontrol.errors import ControllerError
 
 from .base import per_pto
 
@@ -34,7 +35,7 @@ def force_limits(plant, force_max=None) -> np.ndarray:
     elif force_max is not None:
         limits = np.full(len(ptos), float(force_max))
     if not np.all(limits > 0):                           # NaN fails too
-        raise ValueError(f"{plant.name}: force_max must be > 0 (inf: none), got {limits}")
+        raise ControllerError(f"{plant.name}: force_max must be > 0 (inf: none), got {limits}")
     return limits
 
 
@@ -111,5 +112,5 @@ def per_pto_values(plant, value, scene_values, what) -> np.ndarray:
     else:
         out = per_pto(plant, value, f"mpc {what}")[:len(scene_values)]
     if np.any(out <= 0):
-        raise ValueError(f"mpc: {what} must be > 0, got {out}")
+        raise ControllerError(f"mpc: {what} must be > 0, got {out}")
     return out

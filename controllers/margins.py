@@ -44,6 +44,7 @@ from dataclasses import dataclass, field
 
 import control
 import numpy as np
+from mbcontrol.errors import ControllerError, UnknownName
 
 @dataclass(frozen=True)
 class Margins:
@@ -112,7 +113,7 @@ def _gains(law, pto: str):
     """(label, K): K a 1x2 static gain [stiffness, damping] or an LTI system, u = -K y."""
     if isinstance(law, (control.StateSpace, control.TransferFunction)):
         if law.ninputs != 2 or law.noutputs != 1:
-            raise ValueError(f"margins: an LTI law K(s) maps [x, v] (2 inputs) to the PTO "
+            raise ControllerError(f"margins: an LTI law K(s) maps [x, v] (2 inputs) to the PTO "
                              f"force (1 output); got {law.ninputs} inputs, {law.noutputs} "
                              f"outputs")
         return "lti", law
@@ -121,7 +122,7 @@ def _gains(law, pto: str):
     else:
         label = getattr(law, "name", type(law).__name__)
         if label not in ("passive", "reactive"):
-            raise ValueError(f"margins: {label!r} is not a linear law (passive, reactive, a "
+            raise ControllerError(f"margins: {label!r} is not a linear law (passive, reactive, a "
                              f"dict of damping and stiffness, or an LTI K(s)); switching and "
                              f"predictive controllers have no loop transfer")
         settings = {"damping": law.damping, "stiffness": getattr(law, "stiffness", 0.0)}
@@ -188,12 +189,12 @@ def pto_gains(plant, law, others: dict | None = None) -> dict:
     for n in names:
         label, K = _gains(law, n)
         if label == "lti":
-            raise ValueError("margins: a sampled loop takes a static law (damping, stiffness); "
+            raise ControllerError("margins: a sampled loop takes a static law (damping, stiffness); "
                              "an LTI K(s) has no hold model here")
         gains[n] = K
     unknown = set(others or {}) - set(names)
     if unknown:
-        raise KeyError(f"{plant.name}: gains for unknown PTO(s) {sorted(unknown)}")
+        raise UnknownName(f"{plant.name}: gains for unknown PTO(s) {sorted(unknown)}")
     gains.update({n: tuple(map(float, v)) for n, v in (others or {}).items()})
     return gains
 

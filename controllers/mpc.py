@@ -63,6 +63,7 @@ import warnings
 import numpy as np
 
 from mbcontrol.analysis.electrical import winding_coefficient
+from mbcontrol.errors import ControllerError
 from mbcontrol.results import jsonable
 
 from .base import signal_indices
@@ -121,11 +122,11 @@ class Mpc:
         _choice("solver", solver, ("qpoases", "cvxpy"))
         _choice("objective", objective, ("auto", "electrical", "mechanical"))
         if forecast == "known" and wave is None:
-            raise ValueError("mpc: forecast 'known' needs the wave (wave=...)")
+            raise ControllerError("mpc: forecast 'known' needs the wave (wave=...)")
         if warm_up_s is not None and not warm_up_s >= 0:
-            raise ValueError(f"mpc: warm_up_s must be >= 0 s, got {warm_up_s}")
+            raise ControllerError(f"mpc: warm_up_s must be >= 0 s, got {warm_up_s}")
         if horizon_s < dt_s or dt_s <= 0:
-            raise ValueError(f"mpc: expected 0 < dt_s <= horizon_s, got dt_s={dt_s}, "
+            raise ControllerError(f"mpc: expected 0 < dt_s <= horizon_s, got dt_s={dt_s}, "
                              f"horizon_s={horizon_s}")
         self.horizon_s, self.dt_s = float(horizon_s), float(dt_s)
         self.force_max, self.stroke_max, self.rate_max = force_max, stroke_max, rate_max
@@ -176,12 +177,11 @@ class Mpc:
                               stroke_penalty=self.stroke_penalty, soft_stroke=self.soft_stroke,
                               solver=self.solver, envelope=self.env.rows(cp), hull=hull)
         if self.estimator == "kalman":
-            self.kalman = ExcitationKalman(cp, omega,
-                                           measurement_noise=self.measurement_noise)
+            self.kalman = ExcitationKalman(cp, omega, measurement_noise=self.measurement_noise)
         else:
             self.kalman = None
             if self.forecast != "known":
-                raise ValueError("mpc: estimator 'state' knows no excitation; use forecast 'known'")
+                raise ControllerError("mpc: estimator 'state' knows no excitation; use forecast 'known'")
         self.warm_up_planned = self._warm_up_time(cp)
         self.ar = (ArPredictor(cp.nd, self.dt_s, order=self.ar_order,
                                min_samples=int(math.ceil(self.warm_up_planned / self.dt_s - 1e-9))
@@ -397,4 +397,4 @@ class Mpc:
 
 def _choice(what, value, allowed):
     if value not in allowed:
-        raise ValueError(f"mpc: {what} must be one of {', '.join(allowed)}, got {value!r}")
+        raise ControllerError(f"mpc: {what} must be one of {', '.join(allowed)}, got {value!r}")

@@ -7,6 +7,7 @@ import contextlib
 import numpy as np
 
 from mbcontrol.cache import flush_c_stdio
+from mbcontrol.errors import ControllerError
 
 from .mpc_active_set import ActiveSetQp
 
@@ -53,7 +54,7 @@ class CondensedQp:
         Gs = 0.5 * (G + G.T)
         lam = float(np.max(np.linalg.eigvalsh(Gs)))
         if lam <= 0:
-            raise ValueError("mpc: the control plant absorbs no energy from the PTO (energy "
+            raise ControllerError("mpc: the control plant absorbs no energy from the PTO (energy "
                              "Hessian not positive); check the PTO and the model")
         self.passivity_defect = float(max(-np.min(np.linalg.eigvalsh(Gs)) / lam, 0.0))
         force, stroke, rate = limits["force"], limits["stroke"], limits["rate"]

@@ -38,6 +38,7 @@ import casadi as ca
 import numpy as np
 
 from mbcontrol.sim.integrators import rk4_step
+from mbcontrol.errors import ControllerError, UnknownName
 
 from .base import signal_indices
 
@@ -82,16 +83,16 @@ class Nmpc:
                  params: dict | None = None, max_iter: int = 200, tol: float = 1e-6,
                  max_cpu_time: float | None = None, ipopt: dict | None = None):
         if wave is None:
-            raise ValueError("Nmpc needs the wave it forecasts (wave=...)")
+            raise ControllerError("Nmpc needs the wave it forecasts (wave=...)")
         n = round(horizon_s / dt_s) if dt_s > 0 else 0
         if n < 1 or abs(n * dt_s - horizon_s) > 1e-9 * horizon_s:
-            raise ValueError(f"horizon_s ({horizon_s}) must be a whole number >= 1 of "
+            raise ControllerError(f"horizon_s ({horizon_s}) must be a whole number >= 1 of "
                              f"dt_s ({dt_s})")
         if substeps < 1 or stroke_penalty <= 0 or (force_penalty is not None
                                                    and force_penalty < 0):
-            raise ValueError("expected substeps >= 1, stroke_penalty > 0, force_penalty >= 0")
+            raise ControllerError("expected substeps >= 1, stroke_penalty > 0, force_penalty >= 0")
         if rate_max is not None and rate_max <= 0:
-            raise ValueError(f"rate_max must be > 0 (N/s) or None, got {rate_max}")
+            raise ControllerError(f"rate_max must be > 0 (N/s) or None, got {rate_max}")
         self.wave, self.horizon_s, self.dt_s, self.substeps = wave, horizon_s, dt_s, substeps
         self.force_max, self.stroke_max, self.rate_max = force_max, stroke_max, rate_max
         self.force_penalty, self.stroke_penalty = force_penalty, stroke_penalty
@@ -109,12 +110,12 @@ class Nmpc:
         model = self.model if self.model is not None else plant
         if tuple(model.states) != tuple(plant.states) or \
                 tuple(model.inputs) != tuple(plant.inputs):
-            raise ValueError(f"nmpc: prediction model {model.name!r} must have the states and "
+            raise ControllerError(f"nmpc: prediction model {model.name!r} must have the states and "
                              f"inputs of the plant {plant.name!r}")
         ptos = {p.name: p for p in plant.scene.ptos}
         name = self.pto or plant.scene.ptos[0].name
         if name not in ptos:
-            raise KeyError(f"{plant.name}: no PTO {name!r}; PTOs are {', '.join(ptos)}")
+            raise UnknownName(f"{plant.name}: no PTO {name!r}; PTOs are {', '.join(ptos)}")
         self._model, self._pto_name, self._nu = model, name, len(plant.inputs)
         self._i_u = plant.inputs.index(f"u__{name}")
         zero_law = {f"{p.name}__{k}": 0.0 for p in plant.scene.ptos
@@ -122,7 +123,7 @@ class Nmpc:
         p = model.params(**{**zero_law, **self.params})
 
         if self.force_max is None and ptos[name].limited_force() == "hull":
-            raise ValueError(f"nmpc: PTO {name!r} limits the force on the hull (force_max_on = "
+            raise ControllerError(f"nmpc: PTO {name!r} limits the force on the hull (force_max_on = "
                              f"'hull'); the NMPC limits the machine's command only: give it "
                              f"force_max (a machine limit) explicitly")
         fmax = ptos[name].force_max if self.force_max is None else self.force_max
@@ -231,7 +232,7 @@ class Nmpc:
             peak = np.maximum(peak, np.abs(X).max(axis=1))
             x, t0 = X[:, -1], t0 + self.horizon_s
         if not np.all(np.isfinite(peak)) or peak.max() > 1e12:
-            raise ValueError(f"nmpc: the prediction model diverges with {self.substeps} RK4 "
+            raise ControllerError(f"nmpc: the prediction model diverges with {self.substeps} RK4 "
                              f"substep(s) of {self.dt_s / self.substeps:.4g} s; raise substeps")
         return np.where(peak > 1e-9 * max(peak.max(), 1e-300), peak, 1.0)
 

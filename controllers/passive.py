@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import casadi as ca
 import numpy as np
+from mbcontrol.errors import ControllerError
 
 from .base import per_pto, signal_indices
 from .impedance import base_params, default_bounds
@@ -41,7 +42,7 @@ class Passive:
         names = [p.name for p in plant.scene.ptos]
         self._gains = per_pto(plant, self.damping, "passive damping")
         if np.any(self._gains < 0):
-            raise ValueError(f"passive damping must be >= 0, got {self._gains}")
+            raise ControllerError(f"passive damping must be >= 0, got {self._gains}")
         self._limits = force_limits(plant, self.force_max)
         self._velocity = signal_indices(plant, [f"{n}__velocity" for n in names])
         self._law = None

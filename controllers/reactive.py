@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import casadi as ca
 import numpy as np
+from mbcontrol.errors import ControllerError
 
 from .base import per_pto, signal_indices
 from .impedance import closed_loop_stability, intrinsic_impedance
@@ -63,7 +64,7 @@ class Reactive:
         self._c = per_pto(plant, self.damping, "reactive damping")
         self._k = per_pto(plant, self.stiffness, "reactive stiffness")
         if np.any(self._c < 0):
-            raise ValueError(f"reactive damping must be >= 0, got {self._c}")
+            raise ControllerError(f"reactive damping must be >= 0, got {self._c}")
         self._limits = force_limits(plant, self.force_max)
         self._velocity = signal_indices(plant, [f"{n}__velocity" for n in names])
         self._position = signal_indices(plant, [f"{n}__position" for n in names])
@@ -178,7 +179,7 @@ def reactive_tuning(plant, wave, pto: str | None = None, *, params=None,
         c, k = float(np.exp(best.x[0])), float(best.x[1] * k_scale)
     stable, margin = closed_loop_stability(plant, c, k, pto=name, params=params)
     if not stable:
-        raise ValueError(f"{plant.name}: reactive tuning (damping {c:.4g}, stiffness {k:.4g}) "
+        raise ControllerError(f"{plant.name}: reactive tuning (damping {c:.4g}, stiffness {k:.4g}) "
                          f"gives an unstable closed loop (margin {margin:.3g} 1/s)")
     return c, k, power(c, k)
 

@@ -26,6 +26,7 @@ from scipy.optimize import brentq, minimize_scalar
 from mbcontrol.lti import zoh
 from mbcontrol.plant import controlled_params
 from mbcontrol.sim import sampled as zoh_loop
+from mbcontrol.errors import ControllerError, UnknownName
 
 if TYPE_CHECKING:       # python-control costs 2.5 s to import: only where it is used
     import control
@@ -80,7 +81,7 @@ def _complete(plant, gains: dict) -> dict:
     names = [p.name for p in plant.scene.ptos]
     unknown = set(gains) - set(names)
     if unknown:
-        raise KeyError(f"{plant.name}: gains for unknown PTO(s) {sorted(unknown)}; PTOs are "
+        raise UnknownName(f"{plant.name}: gains for unknown PTO(s) {sorted(unknown)}; PTOs are "
                        f"{', '.join(names)}")
     return {n: tuple(map(float, gains.get(n, (0.0, 0.0)))) for n in names}
 
@@ -133,7 +134,7 @@ def discrete_loop(plant, gains: dict, period: float, pto: str, *, params=None):
     names = list(gains)
     sys = joint_plant(plant, params=params)
     if np.any(np.asarray(sys.D)):
-        raise ValueError(f"{plant.name}: PTO positions and velocities should not depend on the "
+        raise ControllerError(f"{plant.name}: PTO positions and velocities should not depend on the "
                          f"force directly (D != 0)")
     Phi, Gamma = zoh(sys.A, sys.B, float(period))
     G, C = gain_matrix(gains, names), np.asarray(sys.C)

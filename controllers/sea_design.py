@@ -4,6 +4,7 @@ model's envelope respected), and the bound the same envelope sets (analysis.enve
 from __future__ import annotations
 
 from mbcontrol.results import jsonable
+from mbcontrol.errors import ControllerError
 
 # what --design tunes: the controllers with a tuner or defaults fitted to the sea
 DESIGNABLE = ("passive", "reactive", "latching", "declutching", "mpc", "nmpc")
@@ -23,7 +24,7 @@ def design_for_sea(plant, wave, name: str, dt: float | None = None,
 
     from .design_tuning import tune
     if name not in DESIGNABLE:
-        raise ValueError(f"--design: {name!r} has no tuner; expected one of "
+        raise ControllerError(f"--design: {name!r} has no tuner; expected one of "
                          f"{', '.join(DESIGNABLE)}")
     ptos = plant.scene.ptos
     notes: list[str] = []

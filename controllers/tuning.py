@@ -5,12 +5,13 @@ from __future__ import annotations
 import numpy as np
 
 from mbcontrol.analysis.envelope import ENVELOPE_SHARE, envelope_response
+from mbcontrol.errors import ControllerError
 
 from .impedance import (base_params, default_bounds, fd_statistics, hull_impedance,
                         intrinsic_impedance, margin_function)
 
 
-class OutsideEnvelope(ValueError):
+class OutsideEnvelope(ControllerError):
     """No setting keeps the device inside its envelope in this sea. fallback: (damping,
     stiffness, predicted power W) of the damper that comes closest; ratio: its largest
     predicted significant motion over the limit."""
@@ -64,7 +65,7 @@ def constrained_tuning(plant, wave, *, pto: str | None = None, params=None,
     f_max = np.inf if force_max is None else float(force_max)
     s_max = np.inf if stroke_max is None else float(stroke_max)
     if not (f_max > 0 and s_max > 0):
-        raise ValueError(f"limits must be > 0, got force_max={force_max}, stroke_max={stroke_max}")
+        raise ControllerError(f"limits must be > 0, got force_max={force_max}, stroke_max={stroke_max}")
     key = "power_W" if efficiency is None and winding is None else "electrical_W"
     hull = hull_impedance(plant, name, wave.omega, force_on)
 
@@ -110,7 +111,7 @@ def constrained_tuning(plant, wave, *, pto: str | None = None, params=None,
                 fallback=(c, 0.0, float(st["power_W"][j])),
                 ratio=float(st["envelope_ratio"][j]))
     if not feasible.any():
-        raise ValueError(
+        raise ControllerError(
             f"{plant.name}: no damping in {bounds[0]:.4g}..{bounds[1]:.4g} keeps the predicted "
             f"peaks within force_max {f_max:.4g} and stroke_max {s_max:.4g} (least force peak "
             f"{st['force_peak'].min():.4g}, least stroke peak {st['stroke_peak'].min():.4g})")
@@ -161,7 +162,7 @@ def constrained_tuning(plant, wave, *, pto: str | None = None, params=None,
     best = multistart(cost, starts, xatol=1e-5, fatol_rel=1e-9, fatol_abs=1e-12, maxiter=600)
     c, k = float(np.exp(best.x[0])), float(best.x[1] * k_scale)
     if not np.isfinite(best.fun):
-        raise ValueError(f"{plant.name}: no stable spring-damper meets the limits")
+        raise ControllerError(f"{plant.name}: no stable spring-damper meets the limits")
     return c, k, float(evaluate(c, k)[2]["power_W"])
 
 
@@ -196,11 +197,11 @@ def electrical_winding(plant, pto: str | None, objective: str) -> float | None:
     one."""
     from mbcontrol.analysis.electrical import winding_coefficient
     if objective not in ("auto", "electrical", "mechanical"):
-        raise ValueError(f"objective {objective!r}: expected auto, electrical or mechanical")
+        raise ControllerError(f"objective {objective!r}: expected auto, electrical or mechanical")
     name = pto or plant.scene.ptos[0].name
     winding = None if objective == "mechanical" else winding_coefficient(plant, name)
     if objective == "electrical" and winding is None:
-        raise ValueError(f"objective 'electrical': PTO {name!r} has no [pto.drivetrain] "
+        raise ControllerError(f"objective 'electrical': PTO {name!r} has no [pto.drivetrain] "
                          f"(give one, or an efficiency to the reactive tuner)")
     return winding
 

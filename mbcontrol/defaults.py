@@ -19,6 +19,8 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
+from .errors import InputError, UnknownName
+
 
 @dataclass(frozen=True)
 class Default:
@@ -68,7 +70,7 @@ def _entry(key: str) -> Default:
     try:
         return _REGISTRY[key]
     except KeyError:
-        raise KeyError(f"unknown default {key!r}; expected one of {', '.join(keys())}") from None
+        raise UnknownName(f"unknown default {key!r}; expected one of {', '.join(keys())}") from None
 
 
 def _read(key: str, entry: Default, text: str):
@@ -83,7 +85,7 @@ def _read(key: str, entry: Default, text: str):
             raise ValueError
         return entry.kind(text)
     except ValueError:
-        raise ValueError(f"environment variable {name}={text!r}: expected "
+        raise InputError(f"environment variable {name}={text!r}: expected "
                          f"{'true or false' if entry.kind is bool else 'a ' + entry.kind.__name__}"
                          f" ({entry.doc})") from None
 

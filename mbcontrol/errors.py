@@ -23,3 +23,25 @@ class LinearizationError(MbcontrolError, ValueError):
 
 class FidelityError(MbcontrolError, ValueError):
     """A fidelity option is invalid or does not fit the scene; names the field and the value."""
+
+
+class ControllerError(MbcontrolError, ValueError):
+    """A controller's settings are invalid or its design cannot be met: names the setting,
+    the value and what was expected."""
+
+
+class WaveError(MbcontrolError, ValueError):
+    """A wave or sea description is invalid: names the field, the value and what was expected."""
+
+
+class InputError(MbcontrolError, ValueError):
+    """Bad input to a command, a study, an analysis or the simulator: names the option or
+    field, the value and what was expected."""
+
+
+class UnknownName(MbcontrolError, KeyError):
+    """A name (a parameter, signal, controller or model) that does not exist; the message
+    lists the known ones."""
+
+    def __str__(self):                # KeyError quotes its message; this one is a sentence
+        return str(self.args[0]) if self.args else ""

@@ -20,8 +20,8 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
+from .errors import InputError, MbcontrolError
 from .atomic import atomic_path
-from .errors import MbcontrolError
 
 ENCODED_ATTRS = "mbc_encoded_attrs"
 
@@ -56,9 +56,9 @@ def write_dataset(ds: xr.Dataset, path, *, precision: str = "float64", every: in
     "float32" stores floating variables in single precision (relative rounding 6e-8);
     every = k keeps every k-th time sample; compress: deflate each variable (lossless)."""
     if precision not in ("float64", "float32"):
-        raise ValueError(f"precision {precision!r}: expected float64 or float32")
+        raise InputError(f"precision {precision!r}: expected float64 or float32")
     if every < 1:
-        raise ValueError(f"every = {every}: expected a positive number of samples")
+        raise InputError(f"every = {every}: expected a positive number of samples")
     path = Path(path)
     if every > 1 and "time" in ds.dims:
         ds = ds.isel(time=slice(None, None, every))

@@ -30,7 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import MbcontrolError
+from ..errors import InputError, MbcontrolError, UnknownName
 from ..waves.realisation import repeat_period
 from .dense import OVERSAMPLE, dense_extremes
 
@@ -63,11 +63,11 @@ class Thevenin:
 def _pto_name(plant, pto: str | None) -> str:
     names = [p.name for p in plant.scene.ptos]
     if not names:
-        raise ValueError(f"{plant.name}: the scene has no PTO")
+        raise InputError(f"{plant.name}: the scene has no PTO")
     if pto is None:
         return names[0]
     if pto not in names:
-        raise KeyError(f"{plant.name}: no PTO {pto!r}; PTOs are {', '.join(names)}")
+        raise UnknownName(f"{plant.name}: no PTO {pto!r}; PTOs are {', '.join(names)}")
     return pto
 
 
@@ -206,7 +206,7 @@ class PseudoSpectralProblem:
                  omega_max: float | None = None, force_on: str | None = None):
         T, k_wave = repeat_period(wave)
         if harmonics > 1 and wave.omega.size != 1:
-            raise ValueError("harmonics > 1 needs a regular wave")
+            raise InputError("harmonics > 1 needs a regular wave")
         self.period = T
         cc = complex_conjugate_bound(plant, wave, pto, params)
         self.conjugate = cc
@@ -289,7 +289,7 @@ class PseudoSpectralProblem:
         solver: a cvxpy solver name, or "IPM" (analysis.box_qp: dense, fast on wide grids,
         and with a certified upper bound, PseudoSpectralBound.certified_power)."""
         if force_max <= 0 or stroke_max <= 0:
-            raise ValueError(f"limits must be > 0, got force_max={force_max}, "
+            raise InputError(f"limits must be > 0, got force_max={force_max}, "
                              f"stroke_max={stroke_max}")
         key = (bool(np.isfinite(force_max)), bool(np.isfinite(stroke_max)))
         if solver == "IPM":              # box_qp needs a box; without one cvxpy's default

@@ -13,6 +13,8 @@ import math
 
 import numpy as np
 
+from ..errors import InputError
+
 # The default collocation density, points per 2 k_max + 1 (the pseudo-spectral QP's n_t). A
 # sparser grid loosens the QP, so the figure falls towards its dense-grid limit as points are
 # added; measured excess over a dense grid (ov 32-64), %, [force overshoot between points, %]:
@@ -36,7 +38,7 @@ def trig_samples(harmonic, coefficients, n: int) -> np.ndarray:
     (exp(-i omega t), omega_k = 2 pi k_k / T) at n equally spaced times over T; n > max k."""
     harmonic = np.asarray(harmonic, int)
     if n <= harmonic.max():
-        raise ValueError(f"trig_samples: {n} samples alias harmonic {harmonic.max()}")
+        raise InputError(f"trig_samples: {n} samples alias harmonic {harmonic.max()}")
     spectrum = np.zeros(n, complex)
     np.add.at(spectrum, harmonic, np.asarray(coefficients, complex))
     return np.fft.fft(spectrum).real       # numpy's forward FFT carries exp(-2 pi i k j / n)

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import InputError
 from .bounds import PseudoSpectralBound, PseudoSpectralProblem, _pto_name
 
 
@@ -47,7 +48,7 @@ def electrical_bound(plant, wave, *, pto: str | None = None, force_max: float = 
     name = _pto_name(plant, pto)
     winding = winding_coefficient(plant, name)
     if winding is None:
-        raise ValueError(f"PTO {name!r} has no [pto.drivetrain]: no electrical bound")
+        raise InputError(f"PTO {name!r} has no [pto.drivetrain]: no electrical bound")
     problem = PseudoSpectralProblem(plant, wave, pto=name, params=params, omega_max=omega_max,
                                     force_on=force_on)
     problem.rho = problem.rho + winding          # mean loss winding x sum(c_k^2 + s_k^2) / 2

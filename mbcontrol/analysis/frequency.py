@@ -13,6 +13,7 @@ import numpy as np
 
 from ..lti import frequency_chunks, frequency_response, state_response
 from ..plant import MechanicalMatrices, mechanical_matrices  # noqa: F401 (their public home here too)
+from ..errors import InputError
 
 
 def frequency_domain_response(plant, omega, *, direction: float = 0.0, params=None,
@@ -104,7 +105,7 @@ def steady_state_initial(sys, plant, wave) -> np.ndarray:
     """
     from ..waves import interpolate_complex
     if wave.omega.size != 1:
-        raise ValueError("steady_state_initial needs a regular wave")
+        raise InputError("steady_state_initial needs a regular wave")
     w, a = float(wave.omega[0]), float(wave.amplitude[0]) * np.exp(-1j * wave.phase[0])
     hyd = plant.hydro
     F = np.conj(interpolate_complex(hyd.omega, hyd.excitation_coefficients(wave.direction),

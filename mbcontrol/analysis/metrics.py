@@ -20,6 +20,8 @@ import math
 
 import numpy as np
 
+from ..errors import InputError
+
 
 _BODY_KEYS = {"Surge": "surge_amplitude_m", "Sway": "sway_amplitude_m",
               "Heave": "heave_amplitude_m", "Roll": "roll_amplitude_rad",
@@ -33,7 +35,7 @@ def analysis_window(ds) -> np.ndarray:
     start = info["start_s"]
     mask = t >= start - 1e-9
     if mask.sum() < 2:
-        raise ValueError(f"the record ({t[-1]:.4g} s) is too short for the metrics window "
+        raise InputError(f"the record ({t[-1]:.4g} s) is too short for the metrics window "
                          f"starting at {start:.4g} s ({info['note']}); simulate longer")
     return mask
 
@@ -138,7 +140,7 @@ def pto_metrics(ds, pto, start: float | None = None, end: float | None = None) -
     steps = (t_step >= lo) & (t_step < hi)
     samples = (t >= lo) & (t < hi)
     if steps.sum() < 1:
-        raise ValueError(f"empty metrics window [{start}, {end}) s in a {t[-1]:.4g} s record")
+        raise InputError(f"empty metrics window [{start}, {end}) s in a {t[-1]:.4g} s record")
     power = p_step[steps]
     # the force the limit acts on: the machine's, or with force_max_on "hull" the force the
     # drivetrain puts on the hull (the plant's <pto>__hull_force)
@@ -182,7 +184,7 @@ def wecccomp_score(ds, pto, start: float = 25.0, end: float | None = None) -> di
     """
     m = pto_metrics(ds, pto, start, end)
     if not (math.isfinite(m["force_max"]) and math.isfinite(m["stroke_max"])):
-        raise ValueError(f"PTO {getattr(pto, 'name', pto)!r}: the WECCCOMP score needs finite "
+        raise InputError(f"PTO {getattr(pto, 'name', pto)!r}: the WECCCOMP score needs finite "
                          f"force_max and stroke_max in the scene")
     denominator = (2 + m["f98"] / m["force_max"] + m["z98"] / m["stroke_max"]
                    - m["mean_abs_power_W"] / m["p98_W"])

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..plant import linear_params  # noqa: F401 (its public home here too)
+from ..errors import InputError
 
 
 def port_responses(plant, omega, ptos, direction: float = 0.0, params=None):
@@ -41,10 +42,10 @@ def output_responses(plant, omega, ptos, outputs, direction: float = 0.0, params
     from .linearize import jacobians
 
     if plant.hydro is None:
-        raise ValueError(f"{plant.name}: no hydrodynamic data, so no wave excitation")
+        raise InputError(f"{plant.name}: no hydrodynamic data, so no wave excitation")
     omega = np.atleast_1d(np.asarray(omega, float))
     if np.any(omega <= 0):
-        raise ValueError("output_responses: frequencies must be > 0 rad/s")
+        raise InputError("output_responses: frequencies must be > 0 rad/s")
     p = plant.params(**linear_params(plant, ptos, params))
     mech = mechanical_matrices(plant, p)
     n_q, n_s = plant.n_q, plant.topology.tree.n_s
@@ -53,7 +54,7 @@ def output_responses(plant, omega, ptos, outputs, direction: float = 0.0, params
     i_u = [plant.inputs.index(f"u__{name}") for name in ptos]
     i_y = [plant.outputs.index(name) for name in outputs]
     if np.any(Du[np.ix_(i_y, i_u)] != 0):
-        raise ValueError(f"{plant.name}: an output of {outputs} depends directly on a PTO "
+        raise InputError(f"{plant.name}: an output of {outputs} depends directly on a PTO "
                          f"force")
     # generalised force of unit PTO forces: s' = M_tot^-1 (... + b u), so b = M_tot ds'/du
     b = (mech.mass + mech.added_mass_inf) @ Bu[n_q:n_q + n_s][:, i_u]

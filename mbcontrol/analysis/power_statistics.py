@@ -27,6 +27,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import InputError
+
 
 def law_params(plant, gains: dict, params=None) -> dict:
     """Plant parameter overrides that put the linear law F = -(c v + k x) in place on each
@@ -71,7 +73,7 @@ def _quadrants(omega, responses: dict, gains: dict, window: tuple[float, float])
     omega = np.asarray(omega, float)
     t0, t1 = map(float, window)
     if not t1 > t0:
-        raise ValueError(f"power statistics: the window must have t1 > t0, got {window}")
+        raise InputError(f"power statistics: the window must have t1 > t0, got {window}")
     A = np.zeros((omega.size, omega.size), complex)
     B = np.zeros_like(A)
     for name, (c, k) in gains.items():
@@ -150,7 +152,7 @@ def record_power_statistics(plant, omega, amplitude, gains: dict, window: tuple[
     Returns {"mean_power_W", "std_W", "cv", "effective_samples" (1 / cv^2), "bandwidth_hz"
     (B_s of the power density), "window_s", "amplitudes"}."""
     if amplitudes not in ("random", "deterministic"):
-        raise ValueError(f"power statistics: amplitudes must be 'random' or 'deterministic', "
+        raise InputError(f"power statistics: amplitudes must be 'random' or 'deterministic', "
                          f"got {amplitudes!r}")
     omega = np.asarray(omega, float)
     responses = law_responses(plant, omega, gains, direction=direction, params=params)

@@ -13,6 +13,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 from scipy import linalg
 
+from ..errors import InputError
+
 if TYPE_CHECKING:       # python-control costs 2.5 s to import: only where it is used
     import control
 
@@ -37,10 +39,10 @@ def balanced_truncation(sys: control.StateSpace, order: int) -> Reduction:
     A, B, C, D = (np.asarray(M, float) for M in (sys.A, sys.B, sys.C, sys.D))
     n = A.shape[0]
     if not 1 <= order <= n:
-        raise ValueError(f"{sys.name}: reduced order must be in 1..{n}, got {order}")
+        raise InputError(f"{sys.name}: reduced order must be in 1..{n}, got {order}")
     worst = float(np.max(np.linalg.eigvals(A).real))
     if worst >= 0:
-        raise ValueError(f"{sys.name}: balanced truncation needs a stable model; the largest "
+        raise InputError(f"{sys.name}: balanced truncation needs a stable model; the largest "
                          f"pole real part is {worst:.3g}")
     Wc = linalg.solve_continuous_lyapunov(A, -B @ B.T)
     Wo = linalg.solve_continuous_lyapunov(A.T, -C.T @ C)
@@ -50,7 +52,7 @@ def balanced_truncation(sys: control.StateSpace, order: int) -> Reduction:
     keep = s[:order]
     if keep[-1] <= 1e-13 * s[0]:
         minimal = int(np.sum(s > 1e-13 * s[0]))
-        raise ValueError(f"{sys.name}: order {order} exceeds the model's numerically minimal "
+        raise InputError(f"{sys.name}: order {order} exceeds the model's numerically minimal "
                          f"order {minimal} (Hankel singular values below round-off)")
     scale = 1.0 / np.sqrt(keep)
     T = (scale[:, None] * U[:, :order].T) @ Lo.T            # order x n

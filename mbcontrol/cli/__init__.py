@@ -150,9 +150,8 @@ def _main(argv) -> int:
             with _stdout_for_json_only():
                 return args.run(args) or 0
         return args.run(args) or 0
-    except (MbcontrolError, KeyError, ValueError) as exc:
-        message = exc.args[0] if isinstance(exc, KeyError) and exc.args else exc
-        print(f"mbcontrol: error: {message}", file=sys.stderr)
+    except MbcontrolError as exc:       # bad input, named; anything else is a bug: its traceback
+        print(f"mbcontrol: error: {exc}", file=sys.stderr)
         return 1
 
 

@@ -4,6 +4,8 @@ from __future__ import annotations
 import json
 import sys
 
+from ..errors import InputError
+
 CODESIGN_HELP = """Vary a device's design and find the best: scene parameters (the hull: a
 revolution profile's radii and heights, box sizes; the drivetrain: gear, inertia, friction,
 rated force, whatever the scene writes as "{expr}" of its [parameters]), plant parameters and
@@ -100,7 +102,7 @@ def _floats(item: str, flag: str, sep: str) -> tuple[str, list[float]]:
         numbers = []
     if not name.strip() or not numbers or (sep == ":" and len(numbers) != 2):
         form = "NAME=LO:HI" if sep == ":" else "NAME=v1,v2,..."
-        raise ValueError(f"{flag} {item}: expected {form} with numbers")
+        raise InputError(f"{flag} {item}: expected {form} with numbers")
     return name.strip(), numbers
 
 
@@ -129,7 +131,7 @@ def run_codesign(args) -> int:
     optimize = {n: tuple(v) for n, v in (_floats(o, "--optimize", ":")
                                          for o in args.optimize or [])}
     if frozenset((args.objective, args.against)) in UNLIKE:   # before any work is done
-        raise ValueError(f"--against {args.against}: {args.objective} is absorbed "
+        raise InputError(f"--against {args.against}: {args.objective} is absorbed "
                          f"(mechanical) energy; compare it with mechanical_bound")
     result = codesign(spec, vary=vary or None, optimize=optimize or None, store=args.store,
                       workers=args.workers, scheduler=args.scheduler,

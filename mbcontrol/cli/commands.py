@@ -9,6 +9,7 @@ import sys
 import numpy as np
 
 from ..results import jsonable
+from ..errors import InputError
 
 
 HYDRO_SCALES = ("__added_mass_scale", "__radiation_scale", "__excitation_scale")
@@ -153,7 +154,7 @@ def run_bench(args) -> int:
                                  else 600.0)
     wave = _wave(args, plant, duration)
     if wave is None:
-        raise ValueError("bench needs a wave: --wave regular|jonswap|pm")
+        raise InputError("bench needs a wave: --wave regular|jonswap|pm")
     bench(plant.scene, wave, duration=duration, methods=args.methods,
           radiation_tols=args.radiation_tols, stability=args.stability,
           repeats=args.repeats, out=args.out or f"out/bench/{plant.name}")
@@ -166,7 +167,7 @@ def run_fidelity(args) -> int:
     duration = args.duration
     wave = _wave(args, plant, duration or 600.0)
     if wave is None:
-        raise ValueError("fidelity needs a wave: --wave regular|jonswap|pm")
+        raise InputError("fidelity needs a wave: --wave regular|jonswap|pm")
     report = auto(plant.scene, wave, tol=args.tol, duration=duration, progress=True)
     print(report)
     if args.out:
@@ -208,7 +209,7 @@ def _controller(args, wave=None):
     predictive controller's preview) is handed the simulated one, as `design` does."""
     if not args.controller:
         if args.set:
-            raise ValueError("--set needs --controller")
+            raise InputError("--set needs --controller")
         return None
     import inspect
 
@@ -242,17 +243,17 @@ def parse_settings(items, signature) -> dict:
     settings = {}
     for item in items:
         if "=" not in item:
-            raise ValueError(f"--set expects KEY=VALUE, got {item!r}")
+            raise InputError(f"--set expects KEY=VALUE, got {item!r}")
         key, text = (part.strip() for part in item.split("=", 1))
         key, _, pto = key.partition(".")
         value = _setting_value(text)
         # text only for a setting that is text (a choice), so a typo in a number is caught
         if isinstance(value, str) and not _takes_text(signature.get(key)):
-            raise ValueError(f"--set {key}: expected a number, true/false or none, got {text!r}")
+            raise InputError(f"--set {key}: expected a number, true/false or none, got {text!r}")
         if not pto:
             settings[key] = value
         elif not isinstance(settings.setdefault(key, {}), dict):
-            raise ValueError(f"--set {key}.{pto}: {key} was already set for every PTO")
+            raise InputError(f"--set {key}.{pto}: {key} was already set for every PTO")
         else:
             settings[key][pto] = value
     return settings
@@ -269,7 +270,7 @@ def _setting_value(text: str):
         return float(text)
     except ValueError:
         if not text:
-            raise ValueError("--set: empty value") from None
+            raise InputError("--set: empty value") from None
         return text
 
 
@@ -284,14 +285,14 @@ def _key_value(item: str, flag: str, text: bool = False):
     """(key, float value); with text, a value that is not a number stays a string (a
     controller's choice such as --set forecast=ar)."""
     if "=" not in item:
-        raise ValueError(f"{flag} expects KEY=VALUE, got {item!r}")
+        raise InputError(f"{flag} expects KEY=VALUE, got {item!r}")
     key, value = item.split("=", 1)
     try:
         return key.strip(), float(value)
     except ValueError:
         if text and value.strip():
             return key.strip(), value.strip()
-        raise ValueError(f"{flag} {key}: expected a number, got {value!r}") from None
+        raise InputError(f"{flag} {key}: expected a number, got {value!r}") from None
 
 
 def _print_summary(result: dict, plant) -> None:

@@ -4,6 +4,7 @@ from __future__ import annotations
 import json
 import sys
 
+from ..errors import InputError
 from .commands import _plant, _wave
 
 
@@ -11,7 +12,7 @@ def run_design(args) -> int:
     from mbcontrol.controllers.design import design
     plant = _plant(args)
     if args.wave == "none":
-        raise ValueError("design needs a wave: --wave regular|jonswap|pm")
+        raise InputError("design needs a wave: --wave regular|jonswap|pm")
     wave = _wave(args, plant, args.duration or 600.0)
     result = design(plant, wave, args.controller, pto=args.pto, simulate_s=args.duration,
                     dt=args.dt, bounds={"auto": True, "full": "full", "off": False}[args.bounds],

@@ -8,6 +8,7 @@ import math
 import sys
 from pathlib import Path
 
+from ..errors import InputError
 from .commands import _plant, _wave
 
 EXPORT_HELP = """Export a PTO controller as C and as FMI 2.0 co-simulation FMUs, with its plant.
@@ -61,7 +62,7 @@ def _controller(args, plant, wave):
 
     from .commands import _controller as from_settings
     if args.controller not in REGISTRY:
-        raise ValueError(f"export: unknown controller {args.controller!r}; expected one of "
+        raise InputError(f"export: unknown controller {args.controller!r}; expected one of "
                          f"{', '.join(REGISTRY)}")
     if args.controller == "mpc" and not any(s.split("=")[0].strip() == "envelope"
                                             for s in args.set):
@@ -87,7 +88,7 @@ def run_export(args) -> int:
     from mbcontrol.results import jsonable
     plant = _plant(args)
     if args.wave == "none":
-        raise ValueError("export needs a wave to design and check in: --wave regular|jonswap|pm")
+        raise InputError("export needs a wave to design and check in: --wave regular|jonswap|pm")
     period_hint = args.period if args.wave == "regular" else args.tp
     duration = args.duration or (20 * period_hint if args.wave == "regular" else 200.0)
     wave = _wave(args, plant, duration)

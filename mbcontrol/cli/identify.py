@@ -6,6 +6,7 @@ import sys
 import warnings
 from pathlib import Path
 
+from ..errors import InputError
 from .describe import default_help
 
 IDENTIFY_HELP = """Fit a model's unknown parameters so it reproduces measured regular-wave runs.
@@ -109,7 +110,7 @@ def _candidates(args) -> dict:
     for text in args.candidate:
         name, _, specs = text.partition("=")
         if not name or not specs:
-            raise ValueError(f"--candidate {text}: expected NAME=SPEC[,SPEC...]")
+            raise InputError(f"--candidate {text}: expected NAME=SPEC[,SPEC...]")
         out[name] = [s for s in specs.split(",") if s]
     return out or {"given" if args.fit else "scene [identify]": list(args.fit)}
 

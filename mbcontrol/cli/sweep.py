@@ -5,6 +5,7 @@ import json
 import sys
 
 from .. import defaults
+from ..errors import InputError
 from .describe import default_help
 
 SWEEP_HELP = """Simulate a model in closed loop over sea states (an Hs x Tp grid or a weighted
@@ -193,7 +194,7 @@ def spread_seas(seas, spread_deg: float | None, kind: str | None):
     from ..waves.sites import SPREAD_MAX_DEG
     if spread_deg is not None:
         if not 0 <= spread_deg < SPREAD_MAX_DEG:
-            raise ValueError(f"--spread {spread_deg:g}: expected a directional spread sigma from "
+            raise InputError(f"--spread {spread_deg:g}: expected a directional spread sigma from "
                              f"0 (long-crested) to below {SPREAD_MAX_DEG:.2f} degrees")
         seas = [dataclasses.replace(s, spread=math.radians(spread_deg)) for s in seas]
     if kind is not None:
@@ -206,7 +207,7 @@ def _workers(given: int | None) -> int | None:
     core), 0 serial, N."""
     n = defaults.resolve("sweep.workers", given)
     if n < -1:
-        raise ValueError(f"--workers {n}: expected -1 (one per core), 0 (serial) or a count")
+        raise InputError(f"--workers {n}: expected -1 (one per core), 0 (serial) or a count")
     return None if n == -1 else n
 
 
@@ -219,15 +220,15 @@ def run_sweep(args) -> int:
     from .commands import _key_value, _warn_if_absorbs_nothing, parse_settings
     if args.hs is not None:
         if not args.tp:
-            raise ValueError("--hs needs --tp (the grid's peak periods)")
+            raise InputError("--hs needs --tp (the grid's peak periods)")
         seas = grid(args.hs, args.tp, args.gamma)
     else:
         if args.tp:
-            raise ValueError("--tp goes with --hs; a --seas file gives its own periods")
+            raise InputError("--tp goes with --hs; a --seas file gives its own periods")
         seas = read_seas(args.seas, args.gamma)
     seas = spread_seas(seas, args.spread, args.spreading)
     if args.set and not args.controller:
-        raise ValueError("--set needs --controller")
+        raise InputError("--set needs --controller")
     cls = REGISTRY.get(args.controller) if args.controller else None
     settings = parse_settings(args.set, inspect.signature(cls).parameters if cls else {})
     vary = {}
@@ -236,9 +237,9 @@ def run_sweep(args) -> int:
         try:
             vary[name.strip()] = [float(v) for v in values.split(",") if v.strip()]
         except ValueError:
-            raise ValueError(f"--vary {item}: expected NAME=v1,v2,... with numbers") from None
+            raise InputError(f"--vary {item}: expected NAME=v1,v2,... with numbers") from None
         if not vary[name.strip()]:
-            raise ValueError(f"--vary {item}: expected NAME=v1,v2,... with at least one value")
+            raise InputError(f"--vary {item}: expected NAME=v1,v2,... with at least one value")
     if not args.design:
         _warn_if_absorbs_nothing(args.controller, settings, vary)
     common = dict(seeds=args.seeds, vary=vary, params=dict(_key_value(s, "--param") for s in args.param),
@@ -249,10 +250,10 @@ def run_sweep(args) -> int:
     scene_params = dict(_key_value(s, "--scene-param") for s in args.scene_param)
     if args.isolated:
         if args.identified:
-            raise ValueError("--identified with --isolated: not built (a farm's budget); "
+            raise InputError("--identified with --isolated: not built (a farm's budget); "
                              "sweep one device with --identified instead")
         if args.design:
-            raise ValueError("--design with --isolated: not built (a farm's controllers are "
+            raise InputError("--design with --isolated: not built (a farm's controllers are "
                              "tuned per device); tune one device with --design instead")
         from ..studies.farm import farm_sweep
         ds, summary = farm_sweep(args.model, seas, scene_params=scene_params,

@@ -8,6 +8,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..errors import InputError, UnknownName
+
 _DOUBLE_P = ctypes.POINTER(ctypes.c_double)
 
 
@@ -50,12 +52,12 @@ class CController:
         p = None if self.params is None else _ptr(self.params)
         status = self._init(self._ctx, p)
         if status != 0:
-            raise ValueError(f"{self.ident}_init refused the parameters (status {status})")
+            raise InputError(f"{self.ident}_init refused the parameters (status {status})")
 
     def reset(self, plant) -> None:
         missing = [n for n in self.inputs if n not in plant.outputs]
         if missing:
-            raise KeyError(f"{self.ident}: the plant has no output(s) {missing}")
+            raise UnknownName(f"{self.ident}: the plant has no output(s) {missing}")
         self._index = [plant.outputs.index(n) for n in self.inputs]
         self.start()
 

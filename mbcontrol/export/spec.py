@@ -15,6 +15,8 @@ from dataclasses import dataclass, field
 import casadi as ca
 import numpy as np
 
+from ..errors import InputError
+
 # The exported QP's iteration cap per variable: the bound on a step's time. Past it the step
 # takes the previous plan's next move (within the force and rate limits; mbc_mpc.c).
 QP_MAX_ITER_PER_VARIABLE = 3      # the sphere's 40-variable QPs in H 2.5 m waves took at most 62
@@ -58,7 +60,7 @@ def controller_spec(controller, plant) -> ControllerSpec:
         # s; the FMU samples on this grid (0: at every communication point)
         spec.defines["MBC_SAMPLE_PERIOD"] = repr(float(getattr(controller, "period", None) or 0.0))
         return spec
-    raise ValueError(f"export: controller {name!r} cannot be exported; exportable: passive, "
+    raise InputError(f"export: controller {name!r} cannot be exported; exportable: passive, "
                      f"reactive, latching, declutching, mpc (NMPC's solver, IPOPT, generates "
                      f"no C)")
 
@@ -140,11 +142,11 @@ def _switching_spec(c, plant) -> ControllerSpec:
 
 def _mpc_spec(c, plant) -> ControllerSpec:
     if c.forecast == "known" or c.uses_state:
-        raise ValueError("export: this MPC is an oracle (forecast 'known' or estimator "
+        raise InputError("export: this MPC is an oracle (forecast 'known' or estimator "
                          "'state'): it needs the future wave or the whole plant state, which a "
                          "device does not measure; export a causal one (forecast 'ar')")
     if c.qp.n_env:
-        raise ValueError("export: this MPC keeps the linear model's envelope (relative heave "
+        raise InputError("export: this MPC keeps the linear model's envelope (relative heave "
                          "against a surface probe, angles), which the C engine does not hold "
                          "yet; export one without it (--set envelope=false, "
                          "make('mpc', ..., envelope=False)) and keep the device in range "

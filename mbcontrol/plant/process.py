@@ -20,6 +20,7 @@ from ..hydro import HydroModel, RadiationModel, load_hydro_model
 from ..hydro.fit.response_error import Device
 from ..multibody import Topology, build_topology
 from ..scene import DOF_NAMES, Scene, load_scene
+from ..errors import UnknownName
 from . import checks, loads
 from .mechanical import dof_selector, mechanical_matrices
 from .ownership import linear_params
@@ -73,7 +74,7 @@ class ProcessPlant:
         p = self.p0.copy()
         for key, value in overrides.items():
             if key not in self.parameters:
-                raise KeyError(f"{self.name}: unknown parameter {key!r}; known: "
+                raise UnknownName(f"{self.name}: unknown parameter {key!r}; known: "
                                f"{', '.join(self.parameters)}")
             p[self.parameters.index(key)] = value
         return p

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from ..errors import SimulationError
+from ..errors import InputError, SimulationError
 from ..plant import derived
 from . import integrators
 from .compiled import compile_function
@@ -64,7 +64,7 @@ def batch_states(plant, waves=None, params=None, *, duration: float, dt: float,
     import time
     spec = integrators.method(method)
     if not spec.fixed_step:
-        raise ValueError(f"simulate_batch needs a fixed-step method, got {method!r}")
+        raise InputError(f"simulate_batch needs a fixed-step method, got {method!r}")
     waves_list, params_list = _cases(waves, params)
     n_cases = len(waves_list)
     P = np.array([_vector(plant, p) for p in params_list])                 # (cases, np)
@@ -87,7 +87,7 @@ def _cases(waves, params) -> tuple[list, list]:
     n_cases = max(len(waves_list), len(params_list))
     for name, items in (("waves", waves_list), ("params", params_list)):
         if len(items) not in (1, n_cases):
-            raise ValueError(f"simulate_batch: {name} has {len(items)} entries; expected 1 or "
+            raise InputError(f"simulate_batch: {name} has {len(items)} entries; expected 1 or "
                              f"{n_cases} (one per case)")
     waves_list = waves_list * n_cases if len(waves_list) == 1 else waves_list
     params_list = params_list * n_cases if len(params_list) == 1 else params_list
@@ -101,7 +101,7 @@ def _vector(plant, params) -> np.ndarray:
         return plant.params(**params)
     p = np.asarray(params, float)
     if p.shape != plant.p0.shape:
-        raise ValueError(f"{plant.name}: a parameter vector needs {plant.p0.size} values "
+        raise InputError(f"{plant.name}: a parameter vector needs {plant.p0.size} values "
                          f"({', '.join(plant.parameters)}), got {p.size}")
     return p
 

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import InputError
 from .integrators import _chunk_function, chunk_length, step_extras
 from .methods import METHODS
 
@@ -61,7 +62,7 @@ class HeldStepper:
         held: (k, nx), a view valid until the next call. W_nodes: (k, nodes, nw)."""
         k = W_nodes.shape[0]
         if k > self.steps:
-            raise ValueError(f"HeldStepper: {k} steps asked, built for {self.steps}")
+            raise InputError(f"HeldStepper: {k} steps asked, built for {self.steps}")
         self._x[:] = x
         self._U[:k] = u
         self._U[k:] = 0.0

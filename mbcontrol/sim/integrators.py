@@ -24,6 +24,7 @@ import numpy as np
 
 from ..plant import derived
 from ..plant.pieces import f_by_parts
+from ..errors import InputError
 from .compiled import compile_function
 from .methods import METHODS, method, radiation_exponential, radiation_split
 
@@ -91,7 +92,7 @@ def step_function(plant, method_name: str = "rk4", law=None) -> ca.Function:
     """
     m = method(method_name)
     if not m.fixed_step:
-        raise ValueError(f"{method_name!r} is adaptive: it has no fixed step")
+        raise InputError(f"{method_name!r} is adaptive: it has no fixed step")
     tab = m.tableau
     x, u, W, p, h = _symbols(plant, len(tab.nodes), law_parameters(law))
     u_held = _held_input(plant, law, x, u, W, p)

@@ -21,6 +21,7 @@ import time
 import numpy as np
 
 from ..plant import derived
+from ..errors import InputError
 from . import integrators
 from .simulate import _divergence_check, _parameters, _warn_stiff, energy_audit
 
@@ -72,10 +73,10 @@ def simulate_arrays(plant, wave=None, *, duration: float, dt: float, method: str
     attrs["wall_time_s"]: excitation and stepping, as `simulate` reports it.
     """
     if duration <= 0 or dt <= 0 or dt > duration:
-        raise ValueError(f"expected 0 < dt <= duration, got dt={dt}, duration={duration}")
+        raise InputError(f"expected 0 < dt <= duration, got dt={dt}, duration={duration}")
     spec = integrators.method(method)
     if not spec.fixed_step:
-        raise ValueError(f"simulate_arrays needs a fixed-step method, got {method!r}")
+        raise InputError(f"simulate_arrays needs a fixed-step method, got {method!r}")
     n = int(round(duration / dt))
     t = np.arange(n + 1) * dt
     p = _parameters(plant, params, None)

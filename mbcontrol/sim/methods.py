@@ -14,6 +14,7 @@ import scipy.linalg
 from scipy.sparse.csgraph import connected_components
 
 from ..plant import derived
+from ..errors import InputError
 
 
 @dataclass(frozen=True)
@@ -75,7 +76,7 @@ METHODS: dict[str, Method] = {m.name: m for m in (
 def method(name: str) -> Method:
     """The Method called `name`; ValueError listing the known ones otherwise."""
     if name not in METHODS:
-        raise ValueError(f"unknown integration method {name!r}; expected one of "
+        raise InputError(f"unknown integration method {name!r}; expected one of "
                          f"{', '.join(METHODS)}")
     return METHODS[name]
 

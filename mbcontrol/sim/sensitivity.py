@@ -15,6 +15,8 @@ import dataclasses
 
 import casadi as ca
 
+from ..errors import UnknownName
+
 
 def sensitivity_name(output: str, parameter: str) -> str:
     """The output name of d(output)/d(parameter)."""
@@ -30,7 +32,7 @@ def sensitivity_plant(plant, names, outputs):
     unknown = [n for n in names if n not in plant.parameters]
     missing = [o for o in outputs if o not in plant.outputs]
     if unknown or missing:
-        raise KeyError(f"{plant.name}: sensitivities of {missing or outputs} by {unknown or names}: "
+        raise UnknownName(f"{plant.name}: sensitivities of {missing or outputs} by {unknown or names}: "
                        f"{'unknown parameter(s) ' + str(unknown) if unknown else ''}"
                        f"{' unknown output(s) ' + str(missing) if missing else ''}")
     n_par = len(names)

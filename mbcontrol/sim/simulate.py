@@ -22,7 +22,7 @@ import xarray as xr
 
 from .. import defaults
 from ..cache import progress_bar
-from ..errors import SimulationError
+from ..errors import InputError, SimulationError
 from ..plant import controlled_params, provenance
 from ..results import jsonable
 from . import diagnose, integrators, sampled
@@ -51,7 +51,7 @@ def simulate(plant, wave=None, *, duration: float, dt: float | None = None, cont
     dt, method = defaults.resolve("sim.dt", dt), defaults.resolve("sim.method", method)
     rtol = defaults.resolve("sim.rtol", rtol)
     if duration <= 0 or dt <= 0 or dt > duration:
-        raise ValueError(f"expected 0 < dt <= duration, got dt={dt}, duration={duration}")
+        raise InputError(f"expected 0 < dt <= duration, got dt={dt}, duration={duration}")
     spec = integrators.method(method)
     n = int(round(duration / dt))
     t = np.arange(n + 1) * dt
@@ -271,7 +271,7 @@ def _period(controller, dt: float) -> float:
 def _steps_per_period(period: float, dt: float) -> int:
     m = int(round(period / dt))
     if m < 1 or abs(m * dt - period) > 1e-9 * max(1.0, period):
-        raise ValueError(f"controller period {period} s must be a whole number of steps of "
+        raise InputError(f"controller period {period} s must be a whole number of steps of "
                          f"dt = {dt} s")
     return m
 

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import InputError
 from .sweep import sweep
 
 
@@ -23,7 +24,7 @@ def device_count(model: str, scene_params: dict | None) -> int:
     from ..scene import load_scene
     scene = load_scene(model, scene_params or None)
     if not scene.ptos:
-        raise ValueError(f"{scene.name}: a farm needs a PTO per device; the scene has none")
+        raise InputError(f"{scene.name}: a farm needs a PTO per device; the scene has none")
     return len(scene.ptos)
 
 

@@ -22,7 +22,7 @@ import numpy as np
 import xarray as xr
 
 from ..cache import progress_bar
-from ..errors import SimulationError
+from ..errors import InputError, SimulationError
 from ..sim import METHODS
 
 ERROR_MEASURE = ("max over joint coordinates of RMS(q - q_ref) / RMS(q_ref) after the wave "
@@ -36,7 +36,7 @@ def coordinate_error(ds, ref, after: float, n_q: int) -> float:
     inside = idx < t_ref.size            # a coarse step may overshoot the record's end
     t, idx = t[inside], idx[inside]
     if np.max(np.abs(t_ref[idx] - t)) > 1e-9 * max(1.0, t[-1]):
-        raise ValueError("the reference's output grid must contain the run's")
+        raise InputError("the reference's output grid must contain the run's")
     mask = (t >= after)
     X = ds["state"].values[:inside.sum()][mask, :n_q]
     X_ref = ref["state"].values[idx[mask], :n_q]

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import WaveError
 from .sites import SeaState
 from .spectra import te_over_tp
 
@@ -27,7 +28,7 @@ def annual_energy_MWh(mean_power_W, weights) -> float:
     p = np.asarray(mean_power_W, float)
     w = np.asarray(weights, float)
     if np.any(np.isnan(p) & (w > 0)):
-        raise ValueError("annual energy: a sea state with weight > 0 has no power")
+        raise WaveError("annual energy: a sea state with weight > 0 has no power")
     return float(np.nansum(p * w) * HOURS_PER_YEAR / 1e6)
 
 

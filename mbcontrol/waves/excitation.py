@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import WaveError
 from .realisation import Wave
 from .synthesis import _synthesise, _synthesise_uniform, ramp, repeat_period
 
@@ -87,7 +88,7 @@ def interpolate_complex(omega_data, values, omega) -> np.ndarray:
     outside = (omega < lo * (1 - 1e-9)) | (omega > hi * (1 + 1e-9))
     if np.any(outside):
         bad = omega[outside]
-        raise ValueError(f"wave components at {bad.min():.3g}..{bad.max():.3g} rad/s lie "
+        raise WaveError(f"wave components at {bad.min():.3g}..{bad.max():.3g} rad/s lie "
                          f"outside the hydro data's band {lo:.3g}..{hi:.3g} rad/s")
     flat = values.reshape(values.shape[0], -1)
     out = np.empty((omega.size, flat.shape[1]), dtype=complex)

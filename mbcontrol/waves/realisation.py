@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..errors import WaveError
 from .spectra import jonswap_spectrum
 from .spreading import Spreading, component_directions
 from .synthesis import _synthesise, ramp
@@ -70,7 +71,7 @@ def regular(height: float, period: float, *, phase: float = 0.0, direction: floa
             ramp_time: float | None = None) -> Wave:
     """A regular wave of height H (m, crest to trough) and period T (s); ramp 2 T by default."""
     if height < 0 or period <= 0:
-        raise ValueError(f"regular wave: expected height >= 0 and period > 0, got "
+        raise WaveError(f"regular wave: expected height >= 0 and period > 0, got "
                          f"H={height}, T={period}")
     ramp_time = 2 * period if ramp_time is None else ramp_time
     return Wave("regular", np.array([2 * np.pi / period]), np.array([height / 2]),
@@ -90,7 +91,7 @@ def band_limits(tp: float, data_band=None, band=DEFAULT_BAND, what: str = "a sea
     wp = 2 * math.pi / tp
     lo, hi = max(band[0], data_band[0] / wp), min(band[1], data_band[1] / wp)
     if not lo < hi:
-        raise ValueError(f"{what} with Tp {tp:g} s lies outside the hydro data's band "
+        raise WaveError(f"{what} with Tp {tp:g} s lies outside the hydro data's band "
                          f"{data_band[0]:.3g}..{data_band[1]:.3g} rad/s")
     return (float(lo), float(hi))
 
@@ -129,7 +130,7 @@ def irregular(hs: float, tp: float, *, gamma: float = 3.3, seed: int = 0,
     narrower than the circle, "spreading_outside" (the largest share of D cut off).
     """
     if hs <= 0 or tp <= 0 or gamma < 1:
-        raise ValueError(f"{kind}: expected hs > 0, tp > 0, gamma >= 1; got {hs}, {tp}, {gamma}")
+        raise WaveError(f"{kind}: expected hs > 0, tp > 0, gamma >= 1; got {hs}, {tp}, {gamma}")
     gamma_used = gamma if kind == "jonswap" else 1.0
     kept = band_limits(tp, data_band, band, what=f"a {kind} sea")
     wp = 2 * np.pi / tp
@@ -139,7 +140,7 @@ def irregular(hs: float, tp: float, *, gamma: float = 3.3, seed: int = 0,
     omega = k * d_omega
     density = jonswap_spectrum(omega, hs, tp, gamma_used)
     if amplitudes not in ("deterministic", "random"):
-        raise ValueError(f"{kind}: amplitudes must be 'deterministic' or 'random', got "
+        raise WaveError(f"{kind}: amplitudes must be 'deterministic' or 'random', got "
                          f"{amplitudes!r}")
     amplitude = np.sqrt(2 * density * d_omega)
     rng = np.random.default_rng(seed)
@@ -171,14 +172,14 @@ def from_args(kind: str, *, height=None, period=None, hs=None, tp=None, gamma=3.
     the fraction of the spectrum's variance that fell outside)."""
     if kind == "regular":
         if height is None or period is None:
-            raise ValueError("a regular wave needs --height and --period")
+            raise WaveError("a regular wave needs --height and --period")
         return regular(height, period)
     if kind in ("jonswap", "pm"):
         if hs is None or tp is None:
-            raise ValueError(f"a {kind} sea needs --hs and --tp")
+            raise WaveError(f"a {kind} sea needs --hs and --tp")
         return irregular(hs, tp, gamma=gamma, seed=seed, duration=duration, kind=kind,
                          data_band=data_band)
-    raise ValueError(f"unknown wave type {kind!r}; expected regular, jonswap or pm")
+    raise WaveError(f"unknown wave type {kind!r}; expected regular, jonswap or pm")
 
 
 def from_elevation(t, eta, *, band: tuple[float, float] | None = None,
@@ -193,10 +194,10 @@ def from_elevation(t, eta, *, band: tuple[float, float] | None = None,
     """
     t, eta = np.asarray(t, float), np.asarray(eta, float)
     if t.ndim != 1 or t.size != eta.size or t.size < 4:
-        raise ValueError("from_elevation: expected 1-D t and eta of equal length (>= 4)")
+        raise WaveError("from_elevation: expected 1-D t and eta of equal length (>= 4)")
     step = t[1] - t[0]
     if not np.allclose(np.diff(t), step, rtol=1e-6, atol=0):
-        raise ValueError("from_elevation: t must be uniformly spaced")
+        raise WaveError("from_elevation: t must be uniformly spaced")
     n = t.size
     spectrum = np.fft.rfft(eta - eta.mean())
     k = np.arange(spectrum.size)
@@ -227,10 +228,10 @@ def repeat_period(wave) -> tuple[float, np.ndarray]:
     if omega.size == 1:
         return 2 * np.pi / float(omega[0]), np.array([1])
     if wave.d_omega is None:
-        raise ValueError("a repeat period: an irregular wave needs a uniform frequency "
+        raise WaveError("a repeat period: an irregular wave needs a uniform frequency "
                          "grid (Wave.d_omega) to be periodic")
     k = omega / wave.d_omega
     if np.max(np.abs(k - np.rint(k))) > 1e-6 or np.any(np.rint(k) < 1):
-        raise ValueError("a repeat period: the wave's frequencies are not positive "
+        raise WaveError("a repeat period: the wave's frequencies are not positive "
                          "multiples of its d_omega")
     return 2 * np.pi / wave.d_omega, np.rint(k).astype(int)

@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
+from ..errors import WaveError
 from .flux import G, RHO, energy_flux
 from .spectra import te_over_tp
 
@@ -85,14 +86,14 @@ def read_seas(path, gamma: float = 3.3) -> list[SeaState]:
         with path.open(newline="") as fh:
             rows = list(csv.DictReader(fh))
     except OSError as exc:
-        raise ValueError(f"{path}: cannot read the seas file ({exc.strerror})") from None
+        raise WaveError(f"{path}: cannot read the seas file ({exc.strerror})") from None
     if not rows:
-        raise ValueError(f"{path}: no sea states (expected a header with Hm0 and Tp or Te, "
+        raise WaveError(f"{path}: no sea states (expected a header with Hm0 and Tp or Te, "
                          f"then one row per sea)")
     columns = set(rows[0])
     period = "Tp" if "Tp" in columns else "Te" if "Te" in columns else None
     if "Hm0" not in columns or period is None:
-        raise ValueError(f"{path}: expected columns Hm0 and Tp (or Te), found "
+        raise WaveError(f"{path}: expected columns Hm0 and Tp (or Te), found "
                          f"{', '.join(sorted(c for c in columns if c))}")
     ratio = te_over_tp(gamma)
     seas = []
@@ -105,14 +106,14 @@ def read_seas(path, gamma: float = 3.3) -> list[SeaState]:
             try:
                 values[name] = float(text)
             except ValueError:
-                raise ValueError(f"{path}: row {i}, column {name}: expected a number, got "
+                raise WaveError(f"{path}: row {i}, column {name}: expected a number, got "
                                  f"{text!r}") from None
         for name in ("Hm0", period) + (("J",) if "J" in values else ()):
             if not values[name] > 0 or not math.isfinite(values[name]):
-                raise ValueError(f"{path}: row {i}, column {name}: expected a positive "
+                raise WaveError(f"{path}: row {i}, column {name}: expected a positive "
                                  f"number, got {values[name]:g}")
         if values.get("weights", 0.0) < 0:
-            raise ValueError(f"{path}: row {i}, column weights: expected >= 0, got "
+            raise WaveError(f"{path}: row {i}, column weights: expected >= 0, got "
                              f"{values['weights']:g}")
         _check_directional(path, i, values)
         tp = values[period] if period == "Tp" else values[period] / ratio
@@ -124,10 +125,10 @@ def read_seas(path, gamma: float = 3.3) -> list[SeaState]:
     if "weights" in columns:
         if any(math.isnan(w) for w in weights):
             row = 2 + next(k for k, w in enumerate(weights) if math.isnan(w))
-            raise ValueError(f"{path}: row {row}, column weights: missing (every row needs one)")
+            raise WaveError(f"{path}: row {row}, column weights: missing (every row needs one)")
         total = sum(weights)
         if abs(total - 1.0) > WEIGHT_SUM_TOLERANCE:
-            raise ValueError(f"{path}: weights sum to {total:.4g}; expected 1 within "
+            raise WaveError(f"{path}: weights sum to {total:.4g}; expected 1 within "
                              f"{WEIGHT_SUM_TOLERANCE} (shares of the year)")
         if abs(total - 1.0) > 1e-9:         # rounding in the file: shares of the year add to 1
             warnings.warn(f"{path}: weights sum to {total:.6g}; normalised to 1",
@@ -143,11 +144,11 @@ SPREAD_MAX_DEG = math.degrees(math.sqrt(2.0))   # 81.03 deg: s = 0, the uniform 
 def _check_directional(path, row: int, values: dict) -> None:
     """A seas file's direction (finite degrees) and spread (0 <= sigma < 81.03 degrees)."""
     if "direction" in values and not math.isfinite(values["direction"]):
-        raise ValueError(f"{path}: row {row}, column direction: expected a finite angle "
+        raise WaveError(f"{path}: row {row}, column direction: expected a finite angle "
                          f"(degrees, NED: where the waves travel to), got {values['direction']:g}")
     spread = values.get("spread", 0.0)
     if not 0 <= spread < SPREAD_MAX_DEG:
-        raise ValueError(f"{path}: row {row}, column spread: expected a directional spread "
+        raise WaveError(f"{path}: row {row}, column spread: expected a directional spread "
                          f"sigma from 0 (long-crested) to below {SPREAD_MAX_DEG:.2f} degrees "
                          f"(cos-2s, s > 0), got {spread:g}")
 
@@ -169,19 +170,19 @@ def read_year_weights(path) -> dict[str, np.ndarray]:
             try:
                 value = float(text)
             except ValueError:
-                raise ValueError(f"{path}: row {i}, column {column}: expected a number (the "
+                raise WaveError(f"{path}: row {i}, column {column}: expected a number (the "
                                  f"sea's share of that year), got {text!r}") from None
             if not value >= 0:
-                raise ValueError(f"{path}: row {i}, column {column}: expected >= 0, got "
+                raise WaveError(f"{path}: row {i}, column {column}: expected >= 0, got "
                                  f"{value:g}")
             values.append(value)
         total = sum(values)
         if abs(total - 1.0) > WEIGHT_SUM_TOLERANCE:
-            raise ValueError(f"{path}: column {column} sums to {total:.4g}; expected 1 within "
+            raise WaveError(f"{path}: column {column} sums to {total:.4g}; expected 1 within "
                              f"{WEIGHT_SUM_TOLERANCE} (shares of that year)")
         years[column[len("weights_"):]] = np.array(values) / total
     if len(years) == 1:
-        raise ValueError(f"{path}: one weights_<year> column ({columns[0]}); interannual "
+        raise WaveError(f"{path}: one weights_<year> column ({columns[0]}); interannual "
                          f"variability needs two or more years")
     return years
 
@@ -199,12 +200,12 @@ def read_ndbc_spectra(path) -> tuple[np.ndarray, np.ndarray, list]:
     try:
         f = np.array([float(h) for h in header[n_time:]])
     except ValueError:
-        raise ValueError(f"{path}: header {' '.join(header[:8])}...: expected date columns "
+        raise WaveError(f"{path}: header {' '.join(header[:8])}...: expected date columns "
                          f"then frequencies in Hz") from None
     stamps, rows = [], []
     for k, parts in enumerate(lines[1:], start=2):
         if len(parts) != n_time + f.size:
-            raise ValueError(f"{path}: line {k} has {len(parts)} values; expected "
+            raise WaveError(f"{path}: line {k} has {len(parts)} values; expected "
                              f"{n_time + f.size}")
         values = np.array([float(v) for v in parts[n_time:]])
         if np.any(values >= 999.0):

@@ -12,6 +12,8 @@ from functools import lru_cache
 
 import numpy as np
 
+from ..errors import WaveError
+
 
 def jonswap_spectrum(omega, hs: float, tp: float, gamma: float = 3.3) -> np.ndarray:
     """One-sided JONSWAP spectral density S(omega) (m^2 s/rad), DNV-RP-C205 form.
@@ -76,7 +78,7 @@ def gamma_for_te_over_tp(ratio: float) -> float:
     from scipy.optimize import brentq
     lo, hi = te_over_tp(1.0), te_over_tp(20.0)
     if not lo - 1e-6 <= ratio <= hi:
-        raise ValueError(f"Te/Tp = {ratio:.4g}: a JONSWAP spectrum with 1 <= gamma <= 20 has "
+        raise WaveError(f"Te/Tp = {ratio:.4g}: a JONSWAP spectrum with 1 <= gamma <= 20 has "
                          f"{lo:.4f} to {hi:.4f}")
     if ratio <= lo:
         return 1.0

@@ -29,6 +29,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.special import betainc, gammaln
 
+from ..errors import WaveError
+
 KINDS = ("cos2s", "mitsuyasu")
 SIGMA_MAX = math.sqrt(2.0)      # rad: s = 0, the uniform distribution
 GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0   # the Weyl sequence's step (`component_directions`)
@@ -47,13 +49,13 @@ class Spreading:
 
     def __post_init__(self):
         if self.kind not in KINDS:
-            raise ValueError(f"spreading: kind must be one of {KINDS}, got {self.kind!r}")
+            raise WaveError(f"spreading: kind must be one of {KINDS}, got {self.kind!r}")
         if not (math.isfinite(self.mean) and 0 < self.spread < SIGMA_MAX):
-            raise ValueError(f"spreading: expected a finite mean direction (rad) and a spread "
+            raise WaveError(f"spreading: expected a finite mean direction (rad) and a spread "
                              f"sigma in (0, {SIGMA_MAX:.4f}) rad (0 to 81 deg), got mean "
                              f"{self.mean!r}, spread {self.spread!r}")
         if not 0 < self.sector <= math.pi:
-            raise ValueError(f"spreading: sector must lie in (0, pi] rad, got {self.sector!r}")
+            raise WaveError(f"spreading: sector must lie in (0, pi] rad, got {self.sector!r}")
 
     @property
     def s_peak(self) -> float:
@@ -66,7 +68,7 @@ class Spreading:
         if self.kind == "cos2s":
             return np.full(omega.shape, self.s_peak)
         if omega_p is None or omega_p <= 0:
-            raise ValueError("mitsuyasu spreading: needs the peak frequency omega_p > 0 (rad/s)")
+            raise WaveError("mitsuyasu spreading: needs the peak frequency omega_p > 0 (rad/s)")
         r = omega / omega_p
         return self.s_peak * np.where(r <= 1.0, r ** 5, r ** -2.5)
 
@@ -115,7 +117,7 @@ class Spreading:
         h = np.asarray(headings, float)
         offset = wrap(h - self.mean)
         if np.any(np.diff(offset) <= 0):
-            raise ValueError("bin_weights: headings must increase in their offset from the mean")
+            raise WaveError("bin_weights: headings must increase in their offset from the mean")
         edges = np.concatenate([[-self.sector], 0.5 * (offset[1:] + offset[:-1]), [self.sector]])
         edges = np.clip(edges, -self.sector, self.sector)
         x, F = self._cdf(self.s(omega, omega_p))

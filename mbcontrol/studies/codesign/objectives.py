@@ -28,6 +28,8 @@ from __future__ import annotations
 import dataclasses
 import math
 
+from ...errors import InputError
+
 OBJECTIVES = ("electrical_bound", "mechanical_bound", "controller", "annual_energy")
 # objectives whose powers are not of one kind: annual_energy is absorbed (mechanical) energy
 UNLIKE = {frozenset(("annual_energy", "electrical_bound"))}
@@ -51,19 +53,19 @@ class Spec:
 
     def __post_init__(self):
         if self.objective not in OBJECTIVES:
-            raise ValueError(f"--objective {self.objective}: expected one of "
+            raise InputError(f"--objective {self.objective}: expected one of "
                              f"{', '.join(OBJECTIVES)}")
         if self.objective == "annual_energy" and not self.seas:
-            raise ValueError("--objective annual_energy needs --seas FILE.csv (weighted seas)")
+            raise InputError("--objective annual_energy needs --seas FILE.csv (weighted seas)")
         if self.objective in ("controller", "annual_energy") and not self.controller:
-            raise ValueError(f"--objective {self.objective} needs --controller (the law "
+            raise InputError(f"--objective {self.objective} needs --controller (the law "
                              f"designed for each point)")
         if self.objective in ("controller", "mechanical_bound", "electrical_bound") and \
                 not self.wave and not (self.seas and self.objective != "controller"):
-            raise ValueError(f"--objective {self.objective} needs a wave (--wave ...)"
+            raise InputError(f"--objective {self.objective} needs a wave (--wave ...)"
                              + ("" if self.objective == "controller" else " or --seas FILE.csv"))
         if self.wave and self.seas:
-            raise ValueError("give a wave or --seas, not both")
+            raise InputError("give a wave or --seas, not both")
 
     @property
     def unit(self) -> str:
@@ -155,7 +157,7 @@ def _site_bound(spec: Spec, plant, params) -> dict:
     from ..sweep.runner import sea_wave
     seas = read_seas(spec.seas)
     if any(math.isnan(s.weight) for s in seas):
-        raise ValueError(f"{spec.seas}: the site's bound needs a weights column")
+        raise InputError(f"{spec.seas}: the site's bound needs a weights column")
     per_sea, reasons = [], []
     for i, sea in enumerate(seas):
         out = _bound(spec.objective, plant, sea_wave(plant, sea, spec.duration), params,
@@ -233,5 +235,5 @@ def cost_proxy(per: str, scene, values: dict) -> float:
     else:
         value = arithmetic(per, {**scene.parameters, **values}, str(scene.path), "--per")
     if not (value > 0 and math.isfinite(value)):
-        raise ValueError(f"--per {per}: the cost proxy is {value!r}; expected a finite number > 0")
+        raise InputError(f"--per {per}: the cost proxy is {value!r}; expected a finite number > 0")
     return float(value)

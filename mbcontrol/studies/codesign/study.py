@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from ...atomic import write_text
+from ...errors import InputError
 from .objectives import Spec, evaluate
 
 
@@ -92,7 +93,7 @@ def codesign(spec: Spec, *, vary: dict | None = None, optimize: dict | None = No
     from ...scene import load_scene
     from ..sweep.cases import roles_for
     if sum(bool(s) for s in (vary, optimize, at)) != 1:
-        raise ValueError("codesign: give either --vary (a grid) or --optimize (a search), "
+        raise InputError("codesign: give either --vary (a grid) or --optimize (a search), "
                          "one of them")
     start = time.perf_counter()
     scene = load_scene(spec.model, dict(spec.scene_params) or None)
@@ -101,12 +102,12 @@ def codesign(spec: Spec, *, vary: dict | None = None, optimize: dict | None = No
     roles = roles_for(names, scene, plant.parameters, REGISTRY.get(spec.controller))
     bad = [n for n in names if roles[n] not in ("scene", "param", "setting")]
     if bad:
-        raise ValueError(f"codesign: {bad[0]} is the wave's heading; expected a scene "
+        raise InputError(f"codesign: {bad[0]} is the wave's heading; expected a scene "
                          f"parameter, a plant parameter or a controller setting")
     laws = {f"{p.name}__{k}" for p in scene.ptos for k in ("damping", "stiffness")}
     idle = [n for n in names if roles[n] == "param" and n in laws]
     if idle:          # the bounds free the PTO force, a controller replaces the scene's law
-        raise ValueError(f"codesign: {idle[0]} is the scene PTO's own law, which every "
+        raise InputError(f"codesign: {idle[0]} is the scene PTO's own law, which every "
                          f"objective sets aside; vary the controller's setting instead "
                          f"(e.g. damping with --controller passive)")
     text = Path(scene.path).read_text()
@@ -180,7 +181,7 @@ def _optimise(box: dict, run, max_evals: int) -> str:
     lo = np.array([box[n][0] for n in names], float)
     hi = np.array([box[n][1] for n in names], float)
     if np.any(hi <= lo):
-        raise ValueError(f"--optimize: expected LO < HI for each of {', '.join(names)}")
+        raise InputError(f"--optimize: expected LO < HI for each of {', '.join(names)}")
 
     def cost(x) -> float:
         record = run(dict(zip(names, np.atleast_1d(x).tolist())))

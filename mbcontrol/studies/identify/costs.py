@@ -14,6 +14,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ...errors import InputError
+
 
 def whole_periods(t, omega: float, start: float, end: float) -> tuple[float, float, int]:
     """(start, end, n): the window [start, end] shortened at its end to n >= 1 whole periods.
@@ -21,7 +23,7 @@ def whole_periods(t, omega: float, start: float, end: float) -> tuple[float, flo
     period = 2 * np.pi / omega
     n = int(np.floor((end - start) / period + 1e-9))
     if n < 1:
-        raise ValueError(f"window {start:.3f}..{end:.3f} s is shorter than one wave period "
+        raise InputError(f"window {start:.3f}..{end:.3f} s is shorter than one wave period "
                          f"({period:.3f} s)")
     return start, start + n * period, n
 
@@ -68,7 +70,7 @@ def peaks_and_lows(t, y, omega: float, start: float, end: float) -> np.ndarray:
     for k in range(n):
         seg = y[_in(t, start + k * period, start + (k + 1) * period)]
         if seg.size == 0:
-            raise ValueError(f"no sample in period {k} of the window {start:.3f}..{end:.3f} s")
+            raise InputError(f"no sample in period {k} of the window {start:.3f}..{end:.3f} s")
         out += [seg.max(), seg.min()]
     return np.array(out)
 
@@ -89,6 +91,6 @@ def eq67_error(measured, model) -> float:
     """The seed's Eq. 67: sum_i |f_hat_i - f_i|^2 over the peaks and lows (unit squared)."""
     measured, model = np.asarray(measured, float), np.asarray(model, float)
     if measured.shape != model.shape:
-        raise ValueError(f"peaks and lows differ in number: {measured.size} measured, "
+        raise InputError(f"peaks and lows differ in number: {measured.size} measured, "
                          f"{model.size} modelled")
     return float(np.sum((measured - model) ** 2))

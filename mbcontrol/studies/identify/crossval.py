@@ -16,6 +16,7 @@ import warnings
 import numpy as np
 
 from ...cache import progress_bar
+from ...errors import InputError
 
 TIE = 0.01           # scores within 1 % (relative) of the best: the smaller structure wins
 
@@ -30,10 +31,10 @@ def cross_validate(model: str, runs, candidates: dict, *, progress: bool = False
     from .setup import flume_identification, prediction
     groups = sorted({r.group for r in runs})
     if len(groups) < 2:
-        raise ValueError(f"cross-validation needs runs of at least two groups (series); got "
+        raise InputError(f"cross-validation needs runs of at least two groups (series); got "
                          f"{groups}")
     if not candidates:
-        raise ValueError("cross-validation: no candidate structures given")
+        raise InputError("cross-validation: no candidate structures given")
     bar = _bar(progress, len(candidates) * len(groups))
     out = {}
     for name, specs in candidates.items():

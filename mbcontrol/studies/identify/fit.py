@@ -34,6 +34,7 @@ import numpy as np
 
 from ... import defaults
 from ...cache import progress_bar
+from ...errors import InputError
 
 METHODS = ("gauss-newton", "nelder-mead")
 CORRELATION_LIMIT = 0.95
@@ -78,7 +79,7 @@ def fit(problem, method: str | None = None, *, starts: int = 1, seed: int = 0,
     method = defaults.resolve("identify.method", method)
     from scipy.optimize import least_squares, minimize
     if method not in METHODS:
-        raise ValueError(f"method {method!r}: expected one of {', '.join(METHODS)}")
+        raise InputError(f"method {method!r}: expected one of {', '.join(METHODS)}")
     lo, hi = problem.bounds()
     rng = np.random.default_rng(seed)
     first = problem.theta0() if theta0 is None else np.asarray(theta0, float)

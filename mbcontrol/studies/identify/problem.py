@@ -34,6 +34,7 @@ from ...scene import load_scene
 from ...sim.batch import batch_states
 from ...sim.integrators import outputs as evaluate_outputs
 from ...sim.sensitivity import sensitivity_name, sensitivity_plant
+from ...errors import InputError, UnknownName
 from .costs import harmonic, harmonic_weights, peak_low_indices, peaks_and_lows, whole_periods
 
 COSTS = ("harmonic", "peaks", "timeseries")
@@ -51,10 +52,10 @@ class FitParameter:
 
     def __post_init__(self):
         if not (self.lo < self.hi) or not (self.lo <= self.initial <= self.hi):
-            raise ValueError(f"fit parameter {self.name}: expected lo < hi and the initial value "
+            raise InputError(f"fit parameter {self.name}: expected lo < hi and the initial value "
                              f"{self.initial:g} within [{self.lo:g}, {self.hi:g}]")
         if self.log and self.lo <= 0:
-            raise ValueError(f"fit parameter {self.name}: a log transform needs lo > 0, got "
+            raise InputError(f"fit parameter {self.name}: a log transform needs lo > 0, got "
                              f"{self.lo:g} (give a positive lower bound or log=False)")
 
     def to_theta(self, value):
@@ -124,12 +125,12 @@ class Identification:
                  samples_per_period: int = 40, compiled: bool = True, batch: bool = False,
                  drop_absent: bool = False):
         if cost not in COSTS:
-            raise ValueError(f"cost {cost!r}: expected one of {', '.join(COSTS)}")
+            raise InputError(f"cost {cost!r}: expected one of {', '.join(COSTS)}")
         if not runs:
-            raise ValueError("identification: no runs given")
+            raise InputError("identification: no runs given")
         names = [p.name for p in fit]
         if len(set(names)) != len(names):
-            raise ValueError(f"identification: a parameter is listed twice in {names}")
+            raise InputError(f"identification: a parameter is listed twice in {names}")
         dt, settle = defaults.resolve("identify.dt", dt), defaults.resolve("identify.settle", settle)
         self.options = dict(cost=cost, phase=phase, weights=weights, params=params, dt=dt,
                             settle=settle, ramp_periods=ramp_periods, direction=direction,
@@ -146,7 +147,7 @@ class Identification:
         for run in self.runs:
             unknown = [c for c in run.channels if c not in self.outputs]
             if unknown:
-                raise ValueError(f"{run.source or run.name}: channel(s) {unknown} have no plant "
+                raise InputError(f"{run.source or run.name}: channel(s) {unknown} have no plant "
                                  f"output; expected some of {sorted(self.outputs)}")
         self.groups: dict = {}
         for i, run in enumerate(self.runs):
@@ -204,7 +205,7 @@ class Identification:
                               f"(their DOF is blocked in every run given)", stacklevel=3)
         unknown = [n for n in [p.name for p in self.fit] + list(self.params) if n not in known]
         if unknown:
-            raise KeyError(f"{self.scene}: unknown parameter(s) {unknown}; the plant has "
+            raise UnknownName(f"{self.scene}: unknown parameter(s) {unknown}; the plant has "
                            f"{', '.join(sorted(known))}")
 
     def _sensitivity_plant(self, key):
@@ -322,7 +323,7 @@ class Identification:
                     scale = self.scales[channel] / w
                     model, measured = y[idx], m["peaks"]
                     if model.size != measured.size:
-                        raise ValueError(f"{run.name} {channel}: {model.size} modelled and "
+                        raise InputError(f"{run.name} {channel}: {model.size} modelled and "
                                          f"{measured.size} measured peaks and lows")
                     rows.extend((model - measured) / scale)
                     if jacobian:

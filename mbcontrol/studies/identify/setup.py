@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 
+from ...errors import InputError
 from . import extrapolation
 from .problem import FitParameter, Identification
 
@@ -16,7 +17,7 @@ def fit_parameters(scene, plant_parameters: dict, specs=()) -> list[FitParameter
     chosen = {}
     if not specs:
         if not scene.identify:
-            raise ValueError(f"{scene.path}: no parameters to fit given and no [identify] "
+            raise InputError(f"{scene.path}: no parameters to fit given and no [identify] "
                              f"table in the scene")
         chosen = dict(scene.identify)
     for spec in specs:
@@ -26,18 +27,18 @@ def fit_parameters(scene, plant_parameters: dict, specs=()) -> list[FitParameter
             try:
                 lo, hi = (float(v) for v in bounds.split(":"))
             except ValueError:
-                raise ValueError(f"--fit {spec}: expected NAME=LO:HI with two numbers") from None
+                raise InputError(f"--fit {spec}: expected NAME=LO:HI with two numbers") from None
         elif name in scene.identify:
             lo, hi = scene.identify[name]
         else:
-            raise ValueError(f"--fit {name}: no bounds given and none in {scene.path}'s "
+            raise InputError(f"--fit {name}: no bounds given and none in {scene.path}'s "
                              f"[identify] table; write --fit {name}=LO:HI")
         chosen[name] = (lo, hi)
     out = []
     for name, (lo, hi) in chosen.items():
         _known(scene, plant_parameters, name)
         if not lo < hi:
-            raise ValueError(f"--fit {name}: bounds {lo:g}:{hi:g}; expected LO < HI")
+            raise InputError(f"--fit {name}: bounds {lo:g}:{hi:g}; expected LO < HI")
         log = lo > 0
         nominal = plant_parameters[name]
         initial = nominal if lo <= nominal <= hi and (nominal > 0 or not log) else (
@@ -48,7 +49,7 @@ def fit_parameters(scene, plant_parameters: dict, specs=()) -> list[FitParameter
 
 def _known(scene, plant_parameters, name) -> None:
     if name not in plant_parameters:
-        raise ValueError(f"--fit {name}: not a parameter of {scene.name}; it has "
+        raise InputError(f"--fit {name}: not a parameter of {scene.name}; it has "
                          f"{', '.join(sorted(plant_parameters))}")
 
 
@@ -58,7 +59,7 @@ def channel_outputs(plant, runs) -> dict:
     out = {}
     for channel in sorted({c for r in runs for c in r.channels}):
         if channel.lower() not in lower:
-            raise ValueError(f"channel {channel!r} has no plant output of that name in "
+            raise InputError(f"channel {channel!r} has no plant output of that name in "
                              f"{plant.name}; expected a joint named like it")
         out[channel] = lower[channel.lower()]
     return out

@@ -16,6 +16,7 @@ from ... import defaults
 # re-exported here so that `from mbcontrol.studies.sweep.cases import SeaState` keeps working.
 from ...waves.sites import WEIGHT_SUM_TOLERANCE, SeaState, grid, read_seas  # noqa: F401
 from ...waves.spectra import te_over_tp  # noqa: F401
+from ...errors import InputError
 
 
 WAVE_DIRECTION = "direction"    # --vary direction=0,45: NED headings in degrees, of the hydro data
@@ -121,10 +122,10 @@ def roles_for(names, scene, plant_parameters, controller_class=None) -> dict:
         if not kinds and name == WAVE_DIRECTION:
             kinds = ["wave"]
         if not kinds:
-            raise ValueError(f"--vary {name}: not a scene parameter ({', '.join(scene.parameters) or 'none'}), "
+            raise InputError(f"--vary {name}: not a scene parameter ({', '.join(scene.parameters) or 'none'}), "
                              f"plant parameter or controller setting of {scene.name}, nor `direction` "
                              "(wave headings, degrees)")
         if len(kinds) > 1:
-            raise ValueError(f"--vary {name}: ambiguous, it is a {' and a '.join(kinds)}")
+            raise InputError(f"--vary {name}: ambiguous, it is a {' and a '.join(kinds)}")
         roles[name] = kinds[0]
     return roles

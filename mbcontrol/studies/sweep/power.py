@@ -12,6 +12,7 @@ from ...waves.annual import HOURS_PER_YEAR, annual_energy_MWh  # noqa: F401
 from ...waves.flux import energy_flux  # noqa: F401
 from ...waves.sites import occurrence, read_ndbc_spectra  # noqa: F401
 from ...waves.spectra import spectral_hm0_te  # noqa: F401
+from ...errors import InputError
 
 
 def power_matrix(ds: xr.Dataset, variable: str = "mean_power_W", period: str = "tp",
@@ -20,7 +21,7 @@ def power_matrix(ds: xr.Dataset, variable: str = "mean_power_W", period: str = "
     over a list whose seas fall on one."""
     da = ds[variable].mean([d for d in reduce_dims if d in ds[variable].dims])
     if set(da.dims) - {"sea"}:
-        raise ValueError(f"power matrix: {variable} still varies over "
+        raise InputError(f"power matrix: {variable} still varies over "
                          f"{sorted(set(da.dims) - {'sea'})}; select one value of each first")
     hs, per = np.unique(ds["hs"].values), np.unique(np.round(ds[period].values, 9))
     table = np.full((hs.size, per.size), np.nan)

@@ -12,6 +12,7 @@ import numpy as np
 import xarray as xr
 
 from ...atomic import write_text
+from ...errors import InputError
 
 
 PROVENANCE_FILE = "provenance.json"
@@ -61,13 +62,13 @@ def _check_inputs(folder: Path, inputs: dict) -> None:
     try:
         stored = json.loads(path.read_text())
     except (OSError, ValueError) as exc:
-        raise ValueError(f"{path}: unreadable store provenance ({exc}); expected the JSON "
+        raise InputError(f"{path}: unreadable store provenance ({exc}); expected the JSON "
                          f"the sweep wrote") from None
     changed = [k for k in sorted(set(stored) | set(inputs)) if stored.get(k) != inputs.get(k)]
     if changed:
         detail = "; ".join(f"{k}: store {str(stored.get(k))[:16]}, now {str(inputs.get(k))[:16]}"
                            for k in changed)
-        raise ValueError(f"{folder}: this store was made from other inputs ({detail}). Its "
+        raise InputError(f"{folder}: this store was made from other inputs ({detail}). Its "
                          f"cases are not this model's: use a new --store, or delete {folder} "
                          f"to recompute")
 

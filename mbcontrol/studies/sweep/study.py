@@ -15,6 +15,7 @@ import xarray as xr
 from ... import defaults
 from ...plant import provenance
 from ...results import jsonable
+from ...errors import InputError
 from .cases import build_cases, roles_for
 from ...waves import annual_energy_MWh, site_energy_flux
 from .runner import execute, keep_plant
@@ -55,13 +56,13 @@ def sweep(model: str, seas, *, seeds: int = 1, vary: dict | None = None, params=
     vary = {k: list(v) for k, v in (vary or {}).items()}
     scene = load_scene(model, scene_params or None)
     if controller is not None and controller not in REGISTRY:
-        raise ValueError(f"--controller {controller}: expected one of {', '.join(REGISTRY)}")
+        raise InputError(f"--controller {controller}: expected one of {', '.join(REGISTRY)}")
     if robust and not design:
-        raise ValueError("--robust tunes within the robustness floors: it goes with --design")
+        raise InputError("--robust tunes within the robustness floors: it goes with --design")
     if design:
         from mbcontrol.controllers.sea_design import DESIGNABLE
         if controller not in DESIGNABLE:
-            raise ValueError(f"--design tunes a controller for each sea: give --controller, one "
+            raise InputError(f"--design tunes a controller for each sea: give --controller, one "
                              f"of {', '.join(DESIGNABLE)} (got {controller})")
     plant = build_plant(scene)
     keep_plant(model, tuple(sorted((scene_params or {}).items())), plant)   # serial path: reuse
@@ -72,7 +73,7 @@ def sweep(model: str, seas, *, seeds: int = 1, vary: dict | None = None, params=
         params = {**identified["values"], **dict(params or {})}
     unknown = [p for p in (params or {}) if p not in plant.parameters]
     if unknown:
-        raise ValueError(f"--param {unknown[0]}: not a parameter of {scene.name}; it has "
+        raise InputError(f"--param {unknown[0]}: not a parameter of {scene.name}; it has "
                          f"{', '.join(plant.parameters)}")
     inputs = {"model": scene.name, **provenance(plant)}
     cases = build_cases(model, seas, seeds=seeds, vary=vary, roles=roles, params=params,

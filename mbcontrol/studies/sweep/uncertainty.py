@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ...errors import InputError
 from . import budget as bud
 from .spectral import radiation_fit_effect, parameter_gradient, sea_components, sea_gains, \
     spectral_row
@@ -25,18 +26,18 @@ def read_identified(path, model: str, plant_parameters) -> dict:
     try:
         summary = json.loads(path.read_text())
     except (OSError, json.JSONDecodeError) as exc:
-        raise ValueError(f"{path}: cannot read an identification summary ({exc})") from None
+        raise InputError(f"{path}: cannot read an identification summary ({exc})") from None
     for field in ("model", "parameters", "correlation", "fit"):
         if field not in summary:
-            raise ValueError(f"{path}: field {field!r} missing (expected the JSON of "
+            raise InputError(f"{path}: field {field!r} missing (expected the JSON of "
                              f"`mbcontrol identify --json` or its summary.json)")
     if summary["model"] != model:
-        raise ValueError(f"{path}: field 'model' is {summary['model']!r}; this sweep runs "
+        raise InputError(f"{path}: field 'model' is {summary['model']!r}; this sweep runs "
                          f"{model!r} (an identification applies to the model it fitted)")
     names_all = list(summary["parameters"])
     unknown = [n for n in names_all if n not in plant_parameters]
     if unknown:
-        raise ValueError(f"{path}: field 'parameters' names {unknown[0]!r}, not a parameter "
+        raise InputError(f"{path}: field 'parameters' names {unknown[0]!r}, not a parameter "
                          f"of {model} ({', '.join(plant_parameters)})")
     values = {n: float(summary["parameters"][n]["value"]) for n in names_all}
     keep = [i for i, n in enumerate(names_all) if summary["parameters"][n].get("std")]
@@ -44,7 +45,7 @@ def read_identified(path, model: str, plant_parameters) -> dict:
     std = np.array([summary["parameters"][n]["std"] for n in names], float)
     corr = np.asarray(summary["correlation"], float)
     if corr.shape != (len(names_all), len(names_all)):
-        raise ValueError(f"{path}: field 'correlation' is {corr.shape}; expected "
+        raise InputError(f"{path}: field 'correlation' is {corr.shape}; expected "
                          f"{len(names_all)} x {len(names_all)} (one row per parameter)")
     cov = corr[np.ix_(keep, keep)] * np.outer(std, std)
     return {"values": values, "names": names, "covariance": cov, **_model_error(summary),
