@@ -25,12 +25,12 @@ def make(name: str, **settings) -> Controller:
     unknown = [k for k in settings if k not in accepted]
     if unknown:
         raise UnknownName(f"controller {name!r} has no setting {', '.join(map(repr, unknown))}; "
-                       f"its settings are {', '.join(accepted)}")
+                          f"its settings are {', '.join(accepted)}")
     try:
         return REGISTRY[name](**settings)
     except TypeError as exc:
         raise UnknownName(f"controller {name!r}: {exc}; its settings are "
-                       f"{', '.join(accepted)}") from None
+                          f"{', '.join(accepted)}") from None
 
 
 # Laws whose power comes from their damping alone: with none (their default, so that a law is

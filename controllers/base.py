@@ -36,7 +36,7 @@ def signal_indices(plant, names: list[str]) -> list[int]:
     missing = [n for n in names if n not in plant.outputs]
     if missing:
         raise UnknownName(f"{plant.name}: no output(s) {missing}; outputs are "
-                       f"{', '.join(plant.outputs)}")
+                          f"{', '.join(plant.outputs)}")
     return [plant.outputs.index(n) for n in names]
 
 

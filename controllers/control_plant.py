@@ -16,9 +16,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from mbcontrol.errors import ControllerError
 from mbcontrol.lti import frequency_response, zoh
 from mbcontrol.plant import controlled_params
-from mbcontrol.errors import ControllerError
 
 from .base import signal_indices
 
@@ -97,12 +97,12 @@ def build_control_plant(plant, dt: float, *, ptos=None, measured=None, order=Non
     A, B, C = (np.asarray(M, float) for M in (sys.A, sys.B, sys.C))
     if extra and np.any(np.asarray(sys.D)[-len(extra):] != 0):
         raise ControllerError(f"{plant.name}: outputs {extra} depend directly on the inputs; the "
-                         f"control plant predicts only outputs of its state")
+                              f"control plant predicts only outputs of its state")
     Ce = C[C.shape[0] - len(extra):] if extra else None
     C = C[:C.shape[0] - len(extra)]
     if np.any(np.asarray(sys.D)[:, :nu] != 0):
         raise ControllerError(f"{plant.name}: the PTO force feeds through to a position or velocity; "
-                         f"the control-plant model expects a strictly proper plant")
+                              f"the control-plant model expects a strictly proper plant")
     Bu_c, Bw = B[:, :nu], B[:, nu:]
     Bd_c, S = _disturbance_basis(Bw)
     Ad, Bud = zoh(A, np.hstack([Bu_c, Bd_c]), dt)

@@ -147,7 +147,7 @@ def design(plant, wave, name: str, *, pto: str | None = None, simulate_s: float 
     """
     if name not in REGISTRY:
         raise ControllerError(f"design: unknown controller {name!r}; expected one of "
-                         f"{', '.join(REGISTRY)}")
+                              f"{', '.join(REGISTRY)}")
     if wave is None:
         raise ControllerError(f"design {name!r}: needs a wave to tune for")
     pto_obj = _pto(plant, pto)
@@ -263,7 +263,7 @@ def _pto(plant, pto):
         return plant.scene.ptos[0]
     if pto not in ptos:
         raise ControllerError(f"design: {plant.name} has no PTO {pto!r}; PTOs are "
-                         f"{', '.join(ptos)}")
+                              f"{', '.join(ptos)}")
     return ptos[pto]
 
 

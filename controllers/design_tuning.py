@@ -101,7 +101,7 @@ def tune(plant, wave, name, pto_obj, limits, model_params, notes, robust: bool =
         from .latching import optimal_declutch, optimal_latch_time
         if model_params:
             raise ControllerError("model_params: latching and declutching tune by simulating the "
-                             "plant itself")
+                                  "plant itself")
         tuner, key = ((optimal_latch_time, "latch_time") if name == "latching"
                       else (optimal_declutch, "declutch_time"))
         kw = _limit_kwargs(tuner, finite, tuner.__name__, notes)
@@ -112,7 +112,7 @@ def tune(plant, wave, name, pto_obj, limits, model_params, notes, robust: bool =
     # mpc (or another registered controller): no tuner; its defaults and the PTO's limits
     if model_params:
         raise ControllerError("model_params: this controller is not tuned, so there is no model "
-                         "to get wrong")
+                              "to get wrong")
     if name in ("mpc", "nmpc"):
         # one wave period ahead in 40 steps: the horizon that reaches the constrained bound
         # on the sphere (tests/controllers/test_mpc.py) and a QP of real-time size

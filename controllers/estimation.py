@@ -22,8 +22,8 @@ from __future__ import annotations
 import numpy as np
 from scipy import linalg
 
-from mbcontrol.lti import frequency_response, zoh
 from mbcontrol.errors import ControllerError
+from mbcontrol.lti import frequency_response, zoh
 
 
 def wave_frequencies(wave=None, fallback: float | None = None, n: int = 3) -> np.ndarray:

@@ -8,8 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from mbcontrol.plant import controlled_params
 from mbcontrol.errors import ControllerError
+from mbcontrol.plant import controlled_params
 
 
 def base_params(plant, pto: str, params=None) -> dict:
@@ -80,7 +80,7 @@ def electrical_optimum(plant, wave, *, pto: str | None = None, params=None) -> d
     drive = next(p for p in plant.scene.ptos if p.name == name).drivetrain
     if drive is None:
         raise ControllerError(f"PTO {name!r} has no [pto.drivetrain]: its electrical optimum is "
-                         f"the complex-conjugate bound times its efficiency")
+                              f"the complex-conjugate bound times its efficiency")
     Z, F = intrinsic_impedance(plant, wave.omega, pto=name, params=params,
                                direction=wave.direction)
     g = drive.force_per_current

@@ -63,7 +63,7 @@ class PortModel:
         sys = joint_plant(plant, params=linear_params(plant, self.ptos, params))
         if np.any(np.asarray(sys.D) != 0):
             raise ControllerError(f"{plant.name}: a PTO's position or velocity depends directly "
-                             f"on a PTO force")
+                                  f"on a PTO force")
         self._A, self._B, self._C = (np.asarray(m) for m in (sys.A, sys.B, sys.C))
         self._n = n
 
@@ -132,8 +132,8 @@ def joint_tuning(plant, wave, *, passive: bool = False, params=None, force_max=N
     feasible = [v for (v, ok) in values if ok]
     if not feasible:
         raise ControllerError(f"{plant.name}: no common damping in {dampings[0]:.4g}.."
-                         f"{dampings[-1]:.4g} keeps every PTO's predicted peaks within its "
-                         f"limits")
+                              f"{dampings[-1]:.4g} keeps every PTO's predicted peaks within its "
+                              f"limits")
     best = int(np.argmax([v if ok else -np.inf for (v, ok) in values]))
     c_common = np.full(n, dampings[best])
     c_own = np.maximum(np.abs(Z_own.real), 1e-6 * scale)

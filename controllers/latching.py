@@ -60,7 +60,7 @@ class _Switching:
         self._c = per_pto(plant, self.damping, f"{self.name} damping")
         if np.any(self._c < 0) or self._hold_time < 0:
             raise ControllerError(f"{self.name}: damping and hold time must be >= 0, got "
-                             f"{self._c}, {self._hold_time}")
+                                  f"{self._c}, {self._hold_time}")
         self._names = names
         self._limits = force_limits(plant, self.force_max)
         self._velocity = signal_indices(plant, [f"{n}__velocity" for n in names])
@@ -190,7 +190,7 @@ def _port_inertia(plant, names) -> np.ndarray:
     gain = np.diag(np.asarray(sys.C) @ np.asarray(sys.B))
     if np.any(gain <= 0):
         raise ControllerError(f"{plant.name}: PTO force does not accelerate its own coordinate "
-                         f"(dv/dt per unit u = {gain}); cannot build a latching brake")
+                              f"(dv/dt per unit u = {gain}); cannot build a latching brake")
     return 1.0 / gain
 
 
@@ -215,7 +215,7 @@ def steady_mean_power(ds, pto: str, period: float, skip_periods: int = 5,
     n = int(np.floor((t[-1] - start) / period + 1e-9))
     if n < 1:
         raise ControllerError(f"record of {t[-1]:.4g} s too short to skip {skip_periods} periods of "
-                         f"{period:.4g} s and average over one")
+                              f"{period:.4g} s and average over one")
     return mean_power(ds, pto, start, start + n * period, key)
 
 
@@ -274,7 +274,7 @@ def _bracket_search(objective, lo, hi, step, xatol):
 def _regular(wave, what):
     if wave.omega.size != 1:
         raise ControllerError(f"{what} tunes for a regular wave; for a sea state tune on the "
-                         f"regular wave at its peak period (or simulate a grid)")
+                              f"regular wave at its peak period (or simulate a grid)")
     return wave.period
 
 
@@ -304,7 +304,7 @@ def optimal_latch_time(plant, wave, *, damping: float | None = None, pto: str | 
     T_n = natural_period(plant, pto=name)
     if T_n >= T:
         raise ControllerError(f"{plant.name}: latching helps for waves longer than the natural "
-                         f"period; T = {T:.4g} s <= T_n = {T_n:.4g} s (try declutching)")
+                              f"period; T = {T:.4g} s <= T_n = {T_n:.4g} s (try declutching)")
     if damping is None:
         damping = float(intrinsic_impedance(plant, [2 * np.pi / T_n], pto=name)[0][0].real)
 

@@ -114,8 +114,8 @@ def _gains(law, pto: str):
     if isinstance(law, (control.StateSpace, control.TransferFunction)):
         if law.ninputs != 2 or law.noutputs != 1:
             raise ControllerError(f"margins: an LTI law K(s) maps [x, v] (2 inputs) to the PTO "
-                             f"force (1 output); got {law.ninputs} inputs, {law.noutputs} "
-                             f"outputs")
+                                  f"force (1 output); got {law.ninputs} inputs, {law.noutputs} "
+                                  f"outputs")
         return "lti", law
     if isinstance(law, dict):
         label, settings = "reactive" if "stiffness" in law else "passive", law
@@ -123,8 +123,8 @@ def _gains(law, pto: str):
         label = getattr(law, "name", type(law).__name__)
         if label not in ("passive", "reactive"):
             raise ControllerError(f"margins: {label!r} is not a linear law (passive, reactive, a "
-                             f"dict of damping and stiffness, or an LTI K(s)); switching and "
-                             f"predictive controllers have no loop transfer")
+                                  f"dict of damping and stiffness, or an LTI K(s)); switching and "
+                                  f"predictive controllers have no loop transfer")
         settings = {"damping": law.damping, "stiffness": getattr(law, "stiffness", 0.0)}
 
     def one(value):                # a number for all PTOs, or a dict by PTO name
@@ -190,7 +190,7 @@ def pto_gains(plant, law, others: dict | None = None) -> dict:
         label, K = _gains(law, n)
         if label == "lti":
             raise ControllerError("margins: a sampled loop takes a static law (damping, stiffness); "
-                             "an LTI K(s) has no hold model here")
+                                  "an LTI K(s) has no hold model here")
         gains[n] = K
     unknown = set(others or {}) - set(names)
     if unknown:

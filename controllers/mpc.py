@@ -127,7 +127,7 @@ class Mpc:
             raise ControllerError(f"mpc: warm_up_s must be >= 0 s, got {warm_up_s}")
         if horizon_s < dt_s or dt_s <= 0:
             raise ControllerError(f"mpc: expected 0 < dt_s <= horizon_s, got dt_s={dt_s}, "
-                             f"horizon_s={horizon_s}")
+                                  f"horizon_s={horizon_s}")
         self.horizon_s, self.dt_s = float(horizon_s), float(dt_s)
         self.force_max, self.stroke_max, self.rate_max = force_max, stroke_max, rate_max
         self.wave, self.forecast, self.estimator, self.solver = wave, forecast, estimator, solver

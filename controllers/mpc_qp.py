@@ -55,7 +55,7 @@ class CondensedQp:
         lam = float(np.max(np.linalg.eigvalsh(Gs)))
         if lam <= 0:
             raise ControllerError("mpc: the control plant absorbs no energy from the PTO (energy "
-                             "Hessian not positive); check the PTO and the model")
+                                  "Hessian not positive); check the PTO and the model")
         self.passivity_defect = float(max(-np.min(np.linalg.eigvalsh(Gs)) / lam, 0.0))
         force, stroke, rate = limits["force"], limits["stroke"], limits["rate"]
         Ls = float(np.max(stroke)) if np.all(np.isfinite(stroke)) else 1.0

@@ -37,8 +37,8 @@ import time
 import casadi as ca
 import numpy as np
 
-from mbcontrol.sim.integrators import rk4_step
 from mbcontrol.errors import ControllerError, UnknownName
+from mbcontrol.sim.integrators import rk4_step
 
 from .base import signal_indices
 
@@ -87,7 +87,7 @@ class Nmpc:
         n = round(horizon_s / dt_s) if dt_s > 0 else 0
         if n < 1 or abs(n * dt_s - horizon_s) > 1e-9 * horizon_s:
             raise ControllerError(f"horizon_s ({horizon_s}) must be a whole number >= 1 of "
-                             f"dt_s ({dt_s})")
+                                  f"dt_s ({dt_s})")
         if substeps < 1 or stroke_penalty <= 0 or (force_penalty is not None
                                                    and force_penalty < 0):
             raise ControllerError("expected substeps >= 1, stroke_penalty > 0, force_penalty >= 0")
@@ -111,7 +111,7 @@ class Nmpc:
         if tuple(model.states) != tuple(plant.states) or \
                 tuple(model.inputs) != tuple(plant.inputs):
             raise ControllerError(f"nmpc: prediction model {model.name!r} must have the states and "
-                             f"inputs of the plant {plant.name!r}")
+                                  f"inputs of the plant {plant.name!r}")
         ptos = {p.name: p for p in plant.scene.ptos}
         name = self.pto or plant.scene.ptos[0].name
         if name not in ptos:
@@ -124,8 +124,8 @@ class Nmpc:
 
         if self.force_max is None and ptos[name].limited_force() == "hull":
             raise ControllerError(f"nmpc: PTO {name!r} limits the force on the hull (force_max_on = "
-                             f"'hull'); the NMPC limits the machine's command only: give it "
-                             f"force_max (a machine limit) explicitly")
+                                  f"'hull'); the NMPC limits the machine's command only: give it "
+                                  f"force_max (a machine limit) explicitly")
         fmax = ptos[name].force_max if self.force_max is None else self.force_max
         smax = ptos[name].stroke_max if self.stroke_max is None else self.stroke_max
         self._fmax, self._smax = float(fmax), float(smax)
@@ -233,7 +233,7 @@ class Nmpc:
             x, t0 = X[:, -1], t0 + self.horizon_s
         if not np.all(np.isfinite(peak)) or peak.max() > 1e12:
             raise ControllerError(f"nmpc: the prediction model diverges with {self.substeps} RK4 "
-                             f"substep(s) of {self.dt_s / self.substeps:.4g} s; raise substeps")
+                                  f"substep(s) of {self.dt_s / self.substeps:.4g} s; raise substeps")
         return np.where(peak > 1e-9 * max(peak.max(), 1e-300), peak, 1.0)
 
     def _excitation_scale(self, model) -> float:

@@ -180,7 +180,7 @@ def reactive_tuning(plant, wave, pto: str | None = None, *, params=None,
     stable, margin = closed_loop_stability(plant, c, k, pto=name, params=params)
     if not stable:
         raise ControllerError(f"{plant.name}: reactive tuning (damping {c:.4g}, stiffness {k:.4g}) "
-                         f"gives an unstable closed loop (margin {margin:.3g} 1/s)")
+                              f"gives an unstable closed loop (margin {margin:.3g} 1/s)")
     return c, k, power(c, k)
 
 

@@ -23,10 +23,10 @@ from typing import TYPE_CHECKING
 import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
+from mbcontrol.errors import ControllerError, UnknownName
 from mbcontrol.lti import zoh
 from mbcontrol.plant import controlled_params
 from mbcontrol.sim import sampled as zoh_loop
-from mbcontrol.errors import ControllerError, UnknownName
 
 if TYPE_CHECKING:       # python-control costs 2.5 s to import: only where it is used
     import control
@@ -82,7 +82,7 @@ def _complete(plant, gains: dict) -> dict:
     unknown = set(gains) - set(names)
     if unknown:
         raise UnknownName(f"{plant.name}: gains for unknown PTO(s) {sorted(unknown)}; PTOs are "
-                       f"{', '.join(names)}")
+                          f"{', '.join(names)}")
     return {n: tuple(map(float, gains.get(n, (0.0, 0.0)))) for n in names}
 
 
@@ -135,7 +135,7 @@ def discrete_loop(plant, gains: dict, period: float, pto: str, *, params=None):
     sys = joint_plant(plant, params=params)
     if np.any(np.asarray(sys.D)):
         raise ControllerError(f"{plant.name}: PTO positions and velocities should not depend on the "
-                         f"force directly (D != 0)")
+                              f"force directly (D != 0)")
     Phi, Gamma = zoh(sys.A, sys.B, float(period))
     G, C = gain_matrix(gains, names), np.asarray(sys.C)
     i = names.index(pto)

@@ -3,8 +3,8 @@ tuned as `design` tunes them (controllers.design_tuning.tune, the PTO's limits a
 model's envelope respected), and the bound the same envelope sets (analysis.envelope)."""
 from __future__ import annotations
 
-from mbcontrol.results import jsonable
 from mbcontrol.errors import ControllerError
+from mbcontrol.results import jsonable
 
 # what --design tunes: the controllers with a tuner or defaults fitted to the sea
 DESIGNABLE = ("passive", "reactive", "latching", "declutching", "mpc", "nmpc")
@@ -25,7 +25,7 @@ def design_for_sea(plant, wave, name: str, dt: float | None = None,
     from .design_tuning import tune
     if name not in DESIGNABLE:
         raise ControllerError(f"--design: {name!r} has no tuner; expected one of "
-                         f"{', '.join(DESIGNABLE)}")
+                              f"{', '.join(DESIGNABLE)}")
     ptos = plant.scene.ptos
     notes: list[str] = []
     parameters, predicted, tuner, _ = tune(plant, wave, name, ptos[0], True, None, notes,

@@ -202,7 +202,7 @@ def electrical_winding(plant, pto: str | None, objective: str) -> float | None:
     winding = None if objective == "mechanical" else winding_coefficient(plant, name)
     if objective == "electrical" and winding is None:
         raise ControllerError(f"objective 'electrical': PTO {name!r} has no [pto.drivetrain] "
-                         f"(give one, or an efficiency to the reactive tuner)")
+                              f"(give one, or an efficiency to the reactive tuner)")
     return winding
 
 

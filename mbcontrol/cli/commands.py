@@ -8,8 +8,8 @@ import sys
 
 import numpy as np
 
-from ..results import jsonable
 from ..errors import InputError
+from ..results import jsonable
 
 
 HYDRO_SCALES = ("__added_mass_scale", "__radiation_scale", "__excitation_scale")

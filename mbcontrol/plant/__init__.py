@@ -4,11 +4,11 @@
 symbolic parameters. Modules: `process` (ProcessPlant and its assembly), `loads` (PTO,
 friction, moorings, drag, end stops, gravity, hydrostatics), `catenary` and `catenary_line`
 (quasi-static mooring lines), `checks` (rest checks), `fidelity` (simplified models),
-`freeze` (DOFs removed: blocked by a rig, or not excited by the waves),
-`jacobians` (exact Jacobians, shared downstream), `workspace` (what is derived from a
-plant, kept with it and freed with it), `mechanical` (the linear mechanics at rest), `ownership` (which PTO parameters a
-controller owns: one rule for every stage), `provenance` (content hashes of what
-made a plant), `build` (the entry point).
+`freeze` (DOFs removed: blocked by a rig, or not excited by the waves), `jacobians` (exact
+Jacobians, shared downstream), `workspace` (what is derived from a plant, kept with it and
+freed with it), `mechanical` (the linear mechanics at rest), `ownership` (which PTO
+parameters a controller owns: one rule for every stage), `provenance` (content hashes of
+what made a plant), `build` (the entry point).
 """
 from .build import build_plant
 from .catenary import CatenarySolution, solve_catenary
@@ -24,4 +24,5 @@ from .workspace import derived, workspace_size
 __all__ = ["build_plant", "ProcessPlant", "active_hydro_dofs", "dof_selector", "jacobians",
            "Fidelity", "FidelityError", "plant_for", "CatenaryLine", "CatenarySolution",
            "catenary_line", "solve_catenary", "provenance", "MechanicalMatrices", "mechanical_matrices",
-           "device_around", "linear_params", "controlled_params", "response_error_of", "derived", "workspace_size"]
+           "device_around", "linear_params", "controlled_params", "response_error_of",
+           "derived", "workspace_size"]

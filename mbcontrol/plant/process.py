@@ -16,11 +16,11 @@ from dataclasses import dataclass, field
 import casadi as ca
 import numpy as np
 
+from ..errors import UnknownName
 from ..hydro import HydroModel, RadiationModel, load_hydro_model
 from ..hydro.fit.response_error import Device
 from ..multibody import Topology, build_topology
 from ..scene import DOF_NAMES, Scene, load_scene
-from ..errors import UnknownName
 from . import checks, loads
 from .mechanical import dof_selector, mechanical_matrices
 from .ownership import linear_params
@@ -75,7 +75,7 @@ class ProcessPlant:
         for key, value in overrides.items():
             if key not in self.parameters:
                 raise UnknownName(f"{self.name}: unknown parameter {key!r}; known: "
-                               f"{', '.join(self.parameters)}")
+                                  f"{', '.join(self.parameters)}")
             p[self.parameters.index(key)] = value
         return p
 

@@ -22,9 +22,9 @@ import hashlib
 import casadi as ca
 import numpy as np
 
+from ..errors import InputError
 from ..plant import derived
 from ..plant.pieces import f_by_parts
-from ..errors import InputError
 from .compiled import compile_function
 from .methods import METHODS, method, radiation_exponential, radiation_split
 

@@ -20,8 +20,8 @@ import time
 
 import numpy as np
 
-from ..plant import derived
 from ..errors import InputError
+from ..plant import derived
 from . import integrators
 from .simulate import _divergence_check, _parameters, _warn_stiff, energy_audit
 

@@ -13,8 +13,8 @@ import numpy as np
 import scipy.linalg
 from scipy.sparse.csgraph import connected_components
 
-from ..plant import derived
 from ..errors import InputError
+from ..plant import derived
 
 
 @dataclass(frozen=True)

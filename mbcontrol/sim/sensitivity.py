@@ -33,8 +33,8 @@ def sensitivity_plant(plant, names, outputs):
     missing = [o for o in outputs if o not in plant.outputs]
     if unknown or missing:
         raise UnknownName(f"{plant.name}: sensitivities of {missing or outputs} by {unknown or names}: "
-                       f"{'unknown parameter(s) ' + str(unknown) if unknown else ''}"
-                       f"{' unknown output(s) ' + str(missing) if missing else ''}")
+                          f"{'unknown parameter(s) ' + str(unknown) if unknown else ''}"
+                          f"{' unknown output(s) ' + str(missing) if missing else ''}")
     n_par = len(names)
     x, S = ca.SX.sym("x", plant.nx), ca.SX.sym("S", plant.nx, n_par)
     u, w = ca.SX.sym("u", len(plant.inputs)), ca.SX.sym("w", len(plant.disturbances))

@@ -89,7 +89,7 @@ def interpolate_complex(omega_data, values, omega) -> np.ndarray:
     if np.any(outside):
         bad = omega[outside]
         raise WaveError(f"wave components at {bad.min():.3g}..{bad.max():.3g} rad/s lie "
-                         f"outside the hydro data's band {lo:.3g}..{hi:.3g} rad/s")
+                        f"outside the hydro data's band {lo:.3g}..{hi:.3g} rad/s")
     flat = values.reshape(values.shape[0], -1)
     out = np.empty((omega.size, flat.shape[1]), dtype=complex)
     for j in range(flat.shape[1]):

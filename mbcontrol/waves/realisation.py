@@ -72,7 +72,7 @@ def regular(height: float, period: float, *, phase: float = 0.0, direction: floa
     """A regular wave of height H (m, crest to trough) and period T (s); ramp 2 T by default."""
     if height < 0 or period <= 0:
         raise WaveError(f"regular wave: expected height >= 0 and period > 0, got "
-                         f"H={height}, T={period}")
+                        f"H={height}, T={period}")
     ramp_time = 2 * period if ramp_time is None else ramp_time
     return Wave("regular", np.array([2 * np.pi / period]), np.array([height / 2]),
                 np.array([phase]), direction, ramp_time,
@@ -92,7 +92,7 @@ def band_limits(tp: float, data_band=None, band=DEFAULT_BAND, what: str = "a sea
     lo, hi = max(band[0], data_band[0] / wp), min(band[1], data_band[1] / wp)
     if not lo < hi:
         raise WaveError(f"{what} with Tp {tp:g} s lies outside the hydro data's band "
-                         f"{data_band[0]:.3g}..{data_band[1]:.3g} rad/s")
+                        f"{data_band[0]:.3g}..{data_band[1]:.3g} rad/s")
     return (float(lo), float(hi))
 
 
@@ -141,7 +141,7 @@ def irregular(hs: float, tp: float, *, gamma: float = 3.3, seed: int = 0,
     density = jonswap_spectrum(omega, hs, tp, gamma_used)
     if amplitudes not in ("deterministic", "random"):
         raise WaveError(f"{kind}: amplitudes must be 'deterministic' or 'random', got "
-                         f"{amplitudes!r}")
+                        f"{amplitudes!r}")
     amplitude = np.sqrt(2 * density * d_omega)
     rng = np.random.default_rng(seed)
     phase = rng.uniform(0, 2 * np.pi, omega.size)
@@ -229,9 +229,9 @@ def repeat_period(wave) -> tuple[float, np.ndarray]:
         return 2 * np.pi / float(omega[0]), np.array([1])
     if wave.d_omega is None:
         raise WaveError("a repeat period: an irregular wave needs a uniform frequency "
-                         "grid (Wave.d_omega) to be periodic")
+                        "grid (Wave.d_omega) to be periodic")
     k = omega / wave.d_omega
     if np.max(np.abs(k - np.rint(k))) > 1e-6 or np.any(np.rint(k) < 1):
         raise WaveError("a repeat period: the wave's frequencies are not positive "
-                         "multiples of its d_omega")
+                        "multiples of its d_omega")
     return 2 * np.pi / wave.d_omega, np.rint(k).astype(int)

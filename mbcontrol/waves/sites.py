@@ -89,12 +89,12 @@ def read_seas(path, gamma: float = 3.3) -> list[SeaState]:
         raise WaveError(f"{path}: cannot read the seas file ({exc.strerror})") from None
     if not rows:
         raise WaveError(f"{path}: no sea states (expected a header with Hm0 and Tp or Te, "
-                         f"then one row per sea)")
+                        f"then one row per sea)")
     columns = set(rows[0])
     period = "Tp" if "Tp" in columns else "Te" if "Te" in columns else None
     if "Hm0" not in columns or period is None:
         raise WaveError(f"{path}: expected columns Hm0 and Tp (or Te), found "
-                         f"{', '.join(sorted(c for c in columns if c))}")
+                        f"{', '.join(sorted(c for c in columns if c))}")
     ratio = te_over_tp(gamma)
     seas = []
     for i, row in enumerate(rows, start=2):              # row 1 is the header
@@ -107,14 +107,14 @@ def read_seas(path, gamma: float = 3.3) -> list[SeaState]:
                 values[name] = float(text)
             except ValueError:
                 raise WaveError(f"{path}: row {i}, column {name}: expected a number, got "
-                                 f"{text!r}") from None
+                                f"{text!r}") from None
         for name in ("Hm0", period) + (("J",) if "J" in values else ()):
             if not values[name] > 0 or not math.isfinite(values[name]):
                 raise WaveError(f"{path}: row {i}, column {name}: expected a positive "
-                                 f"number, got {values[name]:g}")
+                                f"number, got {values[name]:g}")
         if values.get("weights", 0.0) < 0:
             raise WaveError(f"{path}: row {i}, column weights: expected >= 0, got "
-                             f"{values['weights']:g}")
+                            f"{values['weights']:g}")
         _check_directional(path, i, values)
         tp = values[period] if period == "Tp" else values[period] / ratio
         seas.append(SeaState(values["Hm0"], tp, gamma, values.get("weights", math.nan),
@@ -129,7 +129,7 @@ def read_seas(path, gamma: float = 3.3) -> list[SeaState]:
         total = sum(weights)
         if abs(total - 1.0) > WEIGHT_SUM_TOLERANCE:
             raise WaveError(f"{path}: weights sum to {total:.4g}; expected 1 within "
-                             f"{WEIGHT_SUM_TOLERANCE} (shares of the year)")
+                            f"{WEIGHT_SUM_TOLERANCE} (shares of the year)")
         if abs(total - 1.0) > 1e-9:         # rounding in the file: shares of the year add to 1
             warnings.warn(f"{path}: weights sum to {total:.6g}; normalised to 1",
                           UserWarning, stacklevel=2)
@@ -145,12 +145,12 @@ def _check_directional(path, row: int, values: dict) -> None:
     """A seas file's direction (finite degrees) and spread (0 <= sigma < 81.03 degrees)."""
     if "direction" in values and not math.isfinite(values["direction"]):
         raise WaveError(f"{path}: row {row}, column direction: expected a finite angle "
-                         f"(degrees, NED: where the waves travel to), got {values['direction']:g}")
+                        f"(degrees, NED: where the waves travel to), got {values['direction']:g}")
     spread = values.get("spread", 0.0)
     if not 0 <= spread < SPREAD_MAX_DEG:
         raise WaveError(f"{path}: row {row}, column spread: expected a directional spread "
-                         f"sigma from 0 (long-crested) to below {SPREAD_MAX_DEG:.2f} degrees "
-                         f"(cos-2s, s > 0), got {spread:g}")
+                        f"sigma from 0 (long-crested) to below {SPREAD_MAX_DEG:.2f} degrees "
+                        f"(cos-2s, s > 0), got {spread:g}")
 
 
 def read_year_weights(path) -> dict[str, np.ndarray]:
@@ -171,19 +171,19 @@ def read_year_weights(path) -> dict[str, np.ndarray]:
                 value = float(text)
             except ValueError:
                 raise WaveError(f"{path}: row {i}, column {column}: expected a number (the "
-                                 f"sea's share of that year), got {text!r}") from None
+                                f"sea's share of that year), got {text!r}") from None
             if not value >= 0:
                 raise WaveError(f"{path}: row {i}, column {column}: expected >= 0, got "
-                                 f"{value:g}")
+                                f"{value:g}")
             values.append(value)
         total = sum(values)
         if abs(total - 1.0) > WEIGHT_SUM_TOLERANCE:
             raise WaveError(f"{path}: column {column} sums to {total:.4g}; expected 1 within "
-                             f"{WEIGHT_SUM_TOLERANCE} (shares of that year)")
+                            f"{WEIGHT_SUM_TOLERANCE} (shares of that year)")
         years[column[len("weights_"):]] = np.array(values) / total
     if len(years) == 1:
         raise WaveError(f"{path}: one weights_<year> column ({columns[0]}); interannual "
-                         f"variability needs two or more years")
+                        f"variability needs two or more years")
     return years
 
 
@@ -201,12 +201,12 @@ def read_ndbc_spectra(path) -> tuple[np.ndarray, np.ndarray, list]:
         f = np.array([float(h) for h in header[n_time:]])
     except ValueError:
         raise WaveError(f"{path}: header {' '.join(header[:8])}...: expected date columns "
-                         f"then frequencies in Hz") from None
+                        f"then frequencies in Hz") from None
     stamps, rows = [], []
     for k, parts in enumerate(lines[1:], start=2):
         if len(parts) != n_time + f.size:
             raise WaveError(f"{path}: line {k} has {len(parts)} values; expected "
-                             f"{n_time + f.size}")
+                            f"{n_time + f.size}")
         values = np.array([float(v) for v in parts[n_time:]])
         if np.any(values >= 999.0):
             continue

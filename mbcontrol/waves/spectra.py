@@ -79,7 +79,7 @@ def gamma_for_te_over_tp(ratio: float) -> float:
     lo, hi = te_over_tp(1.0), te_over_tp(20.0)
     if not lo - 1e-6 <= ratio <= hi:
         raise WaveError(f"Te/Tp = {ratio:.4g}: a JONSWAP spectrum with 1 <= gamma <= 20 has "
-                         f"{lo:.4f} to {hi:.4f}")
+                        f"{lo:.4f} to {hi:.4f}")
     if ratio <= lo:
         return 1.0
     return float(brentq(lambda g: _te_over_tp_uncached(g) - ratio, 1.0, 20.0, xtol=1e-10))

@@ -52,8 +52,8 @@ class Spreading:
             raise WaveError(f"spreading: kind must be one of {KINDS}, got {self.kind!r}")
         if not (math.isfinite(self.mean) and 0 < self.spread < SIGMA_MAX):
             raise WaveError(f"spreading: expected a finite mean direction (rad) and a spread "
-                             f"sigma in (0, {SIGMA_MAX:.4f}) rad (0 to 81 deg), got mean "
-                             f"{self.mean!r}, spread {self.spread!r}")
+                            f"sigma in (0, {SIGMA_MAX:.4f}) rad (0 to 81 deg), got mean "
+                            f"{self.mean!r}, spread {self.spread!r}")
         if not 0 < self.sector <= math.pi:
             raise WaveError(f"spreading: sector must lie in (0, pi] rad, got {self.sector!r}")
 

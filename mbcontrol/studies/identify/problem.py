@@ -29,12 +29,12 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ... import defaults, waves
+from ...errors import InputError, UnknownName
 from ...plant import Fidelity, build_plant
 from ...scene import load_scene
 from ...sim.batch import batch_states
 from ...sim.integrators import outputs as evaluate_outputs
 from ...sim.sensitivity import sensitivity_name, sensitivity_plant
-from ...errors import InputError, UnknownName
 from .costs import harmonic, harmonic_weights, peak_low_indices, peaks_and_lows, whole_periods
 
 COSTS = ("harmonic", "peaks", "timeseries")
@@ -206,7 +206,7 @@ class Identification:
         unknown = [n for n in [p.name for p in self.fit] + list(self.params) if n not in known]
         if unknown:
             raise UnknownName(f"{self.scene}: unknown parameter(s) {unknown}; the plant has "
-                           f"{', '.join(sorted(known))}")
+                              f"{', '.join(sorted(known))}")
 
     def _sensitivity_plant(self, key):
         if key not in self._sensitivity:

@@ -14,9 +14,9 @@ from ... import defaults
 
 # The seas themselves (SeaState, grids, the site CSV, Te/Tp) live in the waves package;
 # re-exported here so that `from mbcontrol.studies.sweep.cases import SeaState` keeps working.
+from ...errors import InputError
 from ...waves.sites import WEIGHT_SUM_TOLERANCE, SeaState, grid, read_seas  # noqa: F401
 from ...waves.spectra import te_over_tp  # noqa: F401
-from ...errors import InputError
 
 
 WAVE_DIRECTION = "direction"    # --vary direction=0,45: NED headings in degrees, of the hydro data

@@ -13,9 +13,9 @@ import numpy as np
 import xarray as xr
 
 from ... import defaults
+from ...errors import InputError
 from ...plant import provenance
 from ...results import jsonable
-from ...errors import InputError
 from .cases import build_cases, roles_for
 from ...waves import annual_energy_MWh, site_energy_flux
 from .runner import execute, keep_plant
