@@ -1,8 +1,10 @@
 """What a PTO sees in linear theory: its intrinsic impedance and equivalent excitation, the
 frequency-domain statistics of a damper-spring law, and the stability of its closed loop.
 
-Phasors exp(+i omega t), as in `mbcontrol.analysis` and python-control (see
-`controllers.reactive` for the conventions of Z_i and the PTO impedance).
+Phasors exp(+i omega t), as python-control and `analysis.frequency_domain_response` (see
+`controllers.reactive` for the conventions of Z_i and the PTO impedance); the Thevenin
+equivalent itself is computed once, by `analysis.pto_thevenin` in exp(-i omega t), and
+conjugated here.
 """
 from __future__ import annotations
 
@@ -26,32 +28,19 @@ def intrinsic_impedance(plant, omega, *, pto: str | None = None, params=None,
 
     Z_i (N s/m or N m s/rad): the impedance the PTO's controller sees (everything but the
     controller: inertia, added mass, radiation damping, restoring, the other PTOs and a law
-    on this PTO itself as set by params, base_params); F_eq (N per m
-    of wave amplitude): the force that drives it, so that with a PTO impedance Z_pto the PTO
-    velocity is F_eq / (Z_i + Z_pto). Read off two FD solutions (mbcontrol.analysis) with
-    different PTO damping c: V(c) = F_eq / (Z_i + c) is exact for a linear model, for any
-    number of bodies.
+    on this PTO itself as set by params, base_params); F_eq (N per m of wave amplitude): the
+    force that drives it, so that with a PTO impedance Z_pto the PTO velocity is
+    F_eq / (Z_i + Z_pto). The one computation is `mbcontrol.analysis.pto_thevenin` (exp(-i
+    omega t), the PTO's whole force): here its conjugate, converted at this edge, plus the
+    law params sets on the PTO itself (c - i k / omega beside the controller).
     """
-    from mbcontrol.analysis import frequency_domain_response
+    from mbcontrol.analysis import pto_thevenin
     name = pto or plant.scene.ptos[0].name
     omega = np.atleast_1d(np.asarray(omega, float))
     base = base_params(plant, name, params)
-    parallel = base[f"{name}__damping"]       # a damper params sets beside the controller
-
-    def velocity(c: float) -> np.ndarray:
-        return frequency_domain_response(plant, omega, direction=direction,
-                                         params={**base, f"{name}__damping": parallel + c},
-                                         outputs=[f"{name}__velocity"])[:, 0]
-
-    v0 = velocity(0.0)
-    # first pass with a unit damper (exact, but poorly conditioned if |Z_i| >> 1), then
-    # again with a damper of the size of Z_i, which keeps V0 - Vc well away from round-off
-    Z = None
-    for c in (1.0, None):
-        c = c if c is not None else float(np.median(np.abs(Z)))
-        vc = velocity(c)
-        Z = c * vc / (v0 - vc)
-    return Z, v0 * Z
+    th = pto_thevenin(plant, omega, name, direction, base, check_passive=False)
+    beside = base[f"{name}__damping"] - 1j * base[f"{name}__stiffness"] / omega
+    return np.conj(th.impedance) + beside, np.conj(th.excitation)
 
 
 def complex_conjugate_power(plant, wave, *, pto: str | None = None, params=None) -> float:
