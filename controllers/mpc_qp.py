@@ -6,7 +6,7 @@ import contextlib
 
 import numpy as np
 
-from mbcontrol.cache import flush_c_stdio
+from mbcontrol.console import flush_c_stdio
 from mbcontrol.errors import ControllerError
 
 from .mpc_active_set import ActiveSetQp

@@ -40,7 +40,8 @@ def test_bad_values_name_the_variable_or_key(monkeypatch):
 
 
 def test_cache_folder_and_quiet_keep_their_historical_variables(monkeypatch, tmp_path):
-    from mbcontrol.cache import cache_dir, progress_bar
+    from mbcontrol.cache import cache_dir
+    from mbcontrol.console import progress_bar
     monkeypatch.setenv("MBCONTROL_CACHE", str(tmp_path / "c"))
     assert cache_dir() == tmp_path / "c" and cache_dir().is_dir()
     monkeypatch.setenv("MBCONTROL_QUIET", "1")

@@ -130,7 +130,7 @@ def _loudness(args) -> None:
     """-v / -q: the "mbcontrol" logger's level, and progress bars off with -q."""
     import logging
 
-    from ..cache import set_verbosity
+    from ..console import set_verbosity
     if args.verbose or args.quiet:
         set_verbosity(logging.DEBUG if args.verbose else logging.WARNING)
     if args.quiet:
@@ -176,7 +176,7 @@ def _stdout_for_json_only():
         os.dup2(2, 1)
         yield
     finally:
-        from ..cache import flush_c_stdio
+        from ..console import flush_c_stdio
         flush_c_stdio()              # C's buffered writes go where they were meant to
         if swapped is not None:
             sys.stdout.flush()

@@ -28,7 +28,8 @@ from pathlib import Path
 import casadi as ca
 
 from ..atomic import write_text
-from ..cache import cache_dir, exclusive, status
+from ..cache import cache_dir, exclusive
+from ..console import status
 
 # -O3 for this CPU, and reassociation so that the radiation model's dense products vectorise;
 # NaN and Inf keep their IEEE meaning (no -ffinite-math-only), so divergence is still caught.

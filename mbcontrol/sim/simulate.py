@@ -21,7 +21,7 @@ import numpy as np
 import xarray as xr
 
 from .. import defaults
-from ..cache import progress_bar
+from ..console import progress_bar
 from ..errors import InputError, SimulationError
 from ..plant import controlled_params, provenance
 from ..results import jsonable

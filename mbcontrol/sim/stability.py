@@ -19,7 +19,7 @@ import warnings
 import casadi as ca
 import numpy as np
 
-from ..cache import progress_bar
+from ..console import progress_bar
 from ..errors import SimulationError
 from ..plant import derived
 from . import integrators

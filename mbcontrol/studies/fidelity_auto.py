@@ -22,7 +22,7 @@ import numpy as np
 import xarray as xr
 
 from .. import defaults
-from ..cache import progress_bar
+from ..console import progress_bar
 from ..plant import ProcessPlant
 from ..plant.fidelity import Fidelity, FidelityError, has_couplings, plant_for
 from ..plant.freeze import as_wave_list

@@ -21,7 +21,7 @@ import warnings
 import numpy as np
 import xarray as xr
 
-from ..cache import progress_bar
+from ..console import progress_bar
 from ..errors import InputError, SimulationError
 from ..sim import METHODS
 

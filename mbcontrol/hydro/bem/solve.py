@@ -23,7 +23,9 @@ import xarray as xr
 
 from mbcontrol.errors import HydroError
 
-from ...cache import exclusive, progress_bar
+from ...cache import exclusive
+
+from ...console import progress_bar
 from ..data import netcdf
 from ..data.dataset import BODY_FRAME_UNITS
 from ..data.frames import to_body_frames

@@ -16,7 +16,8 @@ import numpy as np
 import xarray as xr
 
 from ...atomic import atomic_path
-from ...cache import cache_dir, status
+from ...cache import cache_dir
+from ...console import status
 from ...errors import HydroError
 from . import (array_fit, array_passivity, fit_error, kernel, passive_order, passivity, radiation, response_error,
                sdp, vector_fit)

@@ -162,7 +162,7 @@ def _grid(grid, run, spec, roles, text, cache, workers, scheduler, progress) -> 
         done = set()
     bar = None
     if progress:
-        from ...cache import progress_bar
+        from ...console import progress_bar
         bar = progress_bar(total=len(grid), desc="codesign", unit="point", leave=False)
     for point in grid:
         record = run(point)

@@ -40,7 +40,7 @@ import warnings
 
 import numpy as np
 
-from ...cache import progress_bar
+from ...console import progress_bar
 from .conformal import cv_plus_guarantee, cv_plus_interval, quantile_index
 
 ALPHA = 0.05          # 95 % intervals

@@ -15,7 +15,7 @@ import warnings
 
 import numpy as np
 
-from ...cache import progress_bar
+from ...console import progress_bar
 from ...errors import InputError
 
 TIE = 0.01           # scores within 1 % (relative) of the best: the smaller structure wins

@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ... import defaults
-from ...cache import progress_bar
+from ...console import progress_bar
 from ...errors import InputError
 
 METHODS = ("gauss-newton", "nelder-mead")

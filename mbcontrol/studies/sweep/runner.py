@@ -22,7 +22,7 @@ import os
 import time
 from collections import defaultdict
 
-from ...cache import progress_bar
+from ...console import progress_bar
 
 # The plants this process built, most recent last: cases run a plant at a time (`groups`),
 # so a few suffice, and a sweep over scene parameters (each value a plant with its compiled
