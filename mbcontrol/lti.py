@@ -41,9 +41,10 @@ def frequency_response(A, B, C, D=None, omega=()) -> np.ndarray:
     B = np.asarray(B).reshape(A.shape[0], -1)
     C = np.asarray(C).reshape(-1, A.shape[0])
     omega = np.atleast_1d(np.asarray(omega, float))
+    eye = np.eye(A.shape[0])
     G = np.empty((omega.size, C.shape[0], B.shape[1]), complex)
     for k in frequency_chunks(omega.size, A.shape[0]):
-        G[k] = C @ state_response(A, B, omega[k])
+        G[k] = C @ np.linalg.solve(1j * omega[k, None, None] * eye - A, B)
     if D is not None:
         G += np.asarray(D).reshape(C.shape[0], B.shape[1])
     return G

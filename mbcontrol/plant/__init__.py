@@ -19,10 +19,10 @@ from .mechanical import MechanicalMatrices, dof_selector, mechanical_matrices
 from .ownership import controlled_params, linear_params
 from .process import ProcessPlant, active_hydro_dofs, device_around, response_error_of
 from .provenance import provenance
-from .workspace import derived, workspace_size
+from .workspace import derived
 
 __all__ = ["build_plant", "ProcessPlant", "active_hydro_dofs", "dof_selector", "jacobians",
            "Fidelity", "FidelityError", "plant_for", "CatenaryLine", "CatenarySolution",
            "catenary_line", "solve_catenary", "provenance", "MechanicalMatrices", "mechanical_matrices",
            "device_around", "linear_params", "controlled_params", "response_error_of",
-           "derived", "workspace_size"]
+           "derived"]

@@ -18,7 +18,3 @@ def derived(plant, key: tuple, build: Callable[[], Any]):
         space[key] = build()
     return space[key]
 
-
-def workspace_size(plant) -> int:
-    """How many derived values the plant holds (for tests and diagnostics)."""
-    return len(plant.workspace)
