@@ -36,7 +36,7 @@ BINDING = (2.5, 9.6664)                                # H m, T s
 def run_case(model, name, kind, steps, python_steps, folder):
 
     from mbcontrol.controllers import make
-    from mbcontrol.controllers.design_tuning import tune
+    from mbcontrol.studies.design import tune
     from mbcontrol.export import CController, export_controller
     from mbcontrol.export.checks import closed_loop_check, footprint, step_timing
     from mbcontrol.export.plant import export_plant

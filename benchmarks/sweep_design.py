@@ -29,7 +29,7 @@ def main(argv=None) -> dict:
     parser.add_argument("--duration", type=float, default=600.0, help="s per case")
     args = parser.parse_args(argv)
     from mbcontrol import build_plant, load_scene, waves
-    from mbcontrol.controllers.sea_design import design_for_sea
+    from mbcontrol.studies.design import design_for_sea
     from mbcontrol.studies.sweep import read_seas, sweep
 
     seas = read_seas(args.seas)

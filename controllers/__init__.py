@@ -1,16 +1,28 @@
 """PTO controllers. Each implements the Controller protocol of `controllers.base`.
 
 `make(name, **settings)` builds one by name (as the CLI's --controller NAME --set k=v does).
+Each law's tuner lives beside it (`optimal_damping` with passive, `reactive_tuning` with
+reactive, `optimal_latch_time` and `optimal_declutch` with latching, `joint_tuning` for
+several PTOs at once); the loop checks (`loop_margins`, `loop_robustness`) and the PTO limits
+they respect are here too. Tuning by name, bounding, simulating and scoring is a study:
+`mbcontrol.studies.design`.
 """
 from __future__ import annotations
 from mbcontrol.errors import UnknownName
 
 from .base import Controller
-from .latching import Declutching, Latching
+from .impedance import electrical_optimum
+from .joint import joint_tuning, other_laws
+from .latching import Declutching, Latching, mean_power, optimal_declutch, optimal_latch_time
+from .limits import command_limit, linear_range
+from .margins import loop_margins
 from .mpc import Mpc
 from .nmpc import Nmpc
-from .passive import Passive
-from .reactive import Reactive
+from .passive import Passive, optimal_damping
+from .reactive import Reactive, reactive_tuning
+from .robustness import robustness as loop_robustness
+from .robustness import share_explained
+from .tuning import OutsideEnvelope
 
 REGISTRY = {"passive": Passive, "reactive": Reactive, "latching": Latching,
             "declutching": Declutching, "mpc": Mpc, "nmpc": Nmpc}

@@ -50,7 +50,7 @@ class PortModel:
     """The device seen from all its PTOs in `wave`: FD responses and the joint linear loop."""
 
     def __init__(self, plant, wave, params=None):
-        from mbcontrol.analysis.ports import linear_params, port_responses
+        from mbcontrol.analysis import linear_params, port_responses
 
         from .sampled import joint_plant
         self.plant, self.wave = plant, wave
@@ -183,7 +183,7 @@ def _get(limits, name) -> float:
 def _closed_form(model):
     """(c, k) realising the multiport optimum of a regular wave, or None where a PTO would
     have to supply power (c_p < 0)."""
-    from mbcontrol.analysis.ports import multiport_bound
+    from mbcontrol.analysis import multiport_bound
     opt = multiport_bound(model.plant, model.wave, responses=(model.Y, model.H))
     F, V = opt.force[0], opt.velocity[0]
     if not np.all(np.isfinite(F)) or np.any(np.abs(V) == 0):

@@ -62,7 +62,7 @@ import warnings
 
 import numpy as np
 
-from mbcontrol.analysis.electrical import winding_coefficient
+from mbcontrol.analysis import winding_coefficient
 from mbcontrol.errors import ControllerError
 from mbcontrol.results import jsonable
 

@@ -23,8 +23,8 @@ class MpcEnvelope:
     probes: (wave seen at the body, item index) per relative heave."""
 
     def __init__(self, plant, wave, *, on: bool, forecast: str, dt: float):
-        from mbcontrol.analysis.envelope import PEAK_SHARE, envelope_items
-        from mbcontrol.analysis.validity import wave_at
+        from mbcontrol.analysis import PEAK_SHARE, envelope_items
+        from mbcontrol.analysis import wave_at
         self.items, self.probes = [], []
         if on and plant.hydro is not None:
             self.items = [i for i in envelope_items(plant) if not i.relative or wave is not None]

@@ -38,7 +38,7 @@ import casadi as ca
 import numpy as np
 
 from mbcontrol.errors import ControllerError, UnknownName
-from mbcontrol.sim.integrators import rk4_step
+from mbcontrol.sim import rk4_step
 
 from .base import signal_indices
 

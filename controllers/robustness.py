@@ -51,7 +51,7 @@ def share_explained(plant, wave, pto: str, predicted_W: float, name: str) -> dic
     theory: the bound with every force allowed, the bound inside the envelope, and the law's
     prediction; the gap between the last two is what a fixed damper (and spring) cannot do
     across the sea's frequencies, the gap between the first two what the envelope forbids."""
-    from mbcontrol.analysis.envelope import envelope_bound
+    from mbcontrol.analysis import envelope_bound
     b = envelope_bound(plant, wave, pto)
     cc, inside = b["unconstrained_W"], b["bound_W"]
     out = {"complex_conjugate_W": cc, "envelope_bound_W": inside, "predicted_W": predicted_W,

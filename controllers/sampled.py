@@ -26,7 +26,7 @@ from scipy.optimize import brentq, minimize_scalar
 from mbcontrol.errors import ControllerError, UnknownName
 from mbcontrol.lti import zoh
 from mbcontrol.plant import controlled_params
-from mbcontrol.sim import sampled as zoh_loop
+from mbcontrol.sim import closed_loop_map, sampled_verdict
 
 if TYPE_CHECKING:       # python-control costs 2.5 s to import: only where it is used
     import control
@@ -116,10 +116,10 @@ def sampled_closed_loop(plant, gains, period: float | None, *, params=None) -> S
         return SampledLoop(None, rate > 0, float("nan"), rate, poles, bad, gains,
                            f"the joint closed loop of PTOs {', '.join(names)} in continuous "
                            f"time is {state}: slowest pole at {-rate:.3g} 1/s (real part)")
-    z = np.linalg.eigvals(zoh_loop.closed_loop_map(A, B, C, D, -G, float(period)))
+    z = np.linalg.eigvals(closed_loop_map(A, B, C, D, -G, float(period)))
     # strict, as the continuous pole margin: a design check forgives no mode at the edge
-    v = zoh_loop.verdict(z, float(period), strict=True,
-                         what=f"the joint closed loop of PTOs {', '.join(names)}")
+    v = sampled_verdict(z, float(period), strict=True,
+                        what=f"the joint closed loop of PTOs {', '.join(names)}")
     return SampledLoop(float(period), v["stable"], v["spectral_radius"], v["decay_rate_1_s"],
                        z, z[np.abs(z) >= 1], gains, v["message"])
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from mbcontrol.analysis.envelope import ENVELOPE_SHARE, envelope_response
+from mbcontrol.analysis import ENVELOPE_SHARE, envelope_response
 from mbcontrol.errors import ControllerError
 
 from .impedance import (base_params, default_bounds, fd_statistics, hull_impedance,
@@ -195,7 +195,7 @@ def electrical_winding(plant, pto: str | None, objective: str) -> float | None:
     mechanical), "electrical" or "mechanical". Returns the drivetrain's winding coefficient for
     an electrical objective (analysis.electrical.winding_coefficient), None for a mechanical
     one."""
-    from mbcontrol.analysis.electrical import winding_coefficient
+    from mbcontrol.analysis import winding_coefficient
     if objective not in ("auto", "electrical", "mechanical"):
         raise ControllerError(f"objective {objective!r}: expected auto, electrical or mechanical")
     name = pto or plant.scene.ptos[0].name

@@ -61,7 +61,7 @@ def main(argv=None) -> int:
     report["validation"] = validate(plant, sys, out)
 
     step("4/6 passive and reactive PTO laws designed for a JONSWAP sea (Hs 3 cm, Tp 1.1 s)")
-    from mbcontrol.controllers.passive import Passive, optimal_damping
+    from mbcontrol.controllers import Passive, optimal_damping
     sea = waves.irregular(0.03, 1.1, gamma=3.3, seed=1, duration=args.duration)
     damping, p_design = optimal_damping(plant, sea)
     c_scene = float(plant.p0[plant.parameters.index("hinge_pto__damping")])
@@ -70,8 +70,8 @@ def main(argv=None) -> int:
     print(f"  optimal PTO damping {damping:.3g} N m s/rad (scene default {c_scene}); predicted "
           f"{p_design * 1e3:.3g} mW (linear, no Coulomb friction)")
 
-    from mbcontrol.controllers.mpc import Mpc
-    from mbcontrol.controllers.reactive import Reactive, reactive_tuning
+    from mbcontrol.controllers import Mpc
+    from mbcontrol.controllers import Reactive, reactive_tuning
     limit = plant.scene.ptos[0].force_max
     c_r, k_r, p_r = reactive_tuning(plant, sea, force_max=limit)
     from mbcontrol.analysis import complex_conjugate_bound

@@ -38,7 +38,7 @@ def bem_inputs(scene, panel_size: float | None = None) -> dict:
 
     from mbcontrol.hydro import BemBody
     from mbcontrol.hydro import geometry_dict
-    from mbcontrol.hydro.model import obstacle_bodies
+    from mbcontrol.hydro import obstacle_bodies
 
     h = scene.hydro
     bodies = [BemBody(name=b.name, geometry=geometry_dict(b.geometry), cog=b.cog, mass=b.mass,
@@ -88,7 +88,7 @@ def convert(scene, out: Path) -> None:
 
 def fit_report(path: Path, tol: float, omega_max: str | None) -> None:
     from mbcontrol.hydro import fit_radiation
-    from mbcontrol.hydro.data.netcdf import read_netcdf
+    from mbcontrol.hydro import read_netcdf
 
     ds = read_netcdf(path)
     wmax = None if omega_max is None else ds.attrs["omega_max_mesh"] if omega_max == "mesh" else float(omega_max)
@@ -114,17 +114,17 @@ def ship_fits(names=None) -> int:
     """Build the plants, copy the fits they used into models/radiation_fits (atomically)."""
     from mbcontrol.atomic import write_bytes
     from mbcontrol.cache import cache_dir
-    from mbcontrol.hydro import model as hydro_model
+    from mbcontrol.hydro import FITS_SERVED, shipped_fits_dir
     from mbcontrol.plant import Fidelity, build_plant
     from mbcontrol.scene import list_models
-    out = hydro_model.shipped_fits_dir()
+    out = shipped_fits_dir()
     out.mkdir(parents=True, exist_ok=True)
     wanted = set()
     for name in names or list_models():
         for freeze in [()] + SHIP_VARIANTS.get(name, []):
-            hydro_model.FITS_SERVED.clear()
+            FITS_SERVED.clear()
             build_plant(name, fidelity=Fidelity(freeze=freeze) if freeze else None)
-            wanted.update(hydro_model.FITS_SERVED)
+            wanted.update(FITS_SERVED)
     for fit in sorted(wanted):
         if (out / fit).exists():
             continue
@@ -157,7 +157,7 @@ def main(argv=None) -> int:
 
     import numpy as np
     from mbcontrol.hydro import compute, write_netcdf_atomic
-    from mbcontrol.hydro.bem.isolated import compute_isolated
+    from mbcontrol.hydro import compute_isolated
 
     for file, scene in catalogue(args.models).items():
         out = Path(file)

@@ -438,7 +438,7 @@ EXPORT = [
              "import numpy as np\nfrom fmpy import read_model_description\n"
              "from fmpy.validation import validate_fmu\n\n"
              "from mbcontrol.controllers import make\n"
-             "from mbcontrol.controllers.design_tuning import tune\n"
+             "from mbcontrol.studies.design import tune\n"
              "from mbcontrol.export import export_controller\n"
              "from mbcontrol.export.checks import footprint, step_timing\n"
              "from mbcontrol.export.cosim import closed_loop\n"

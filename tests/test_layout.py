@@ -179,7 +179,8 @@ def test_the_graph_sees_known_edges():
     graph = import_graph()
     assert "mbcontrol.plant.fidelity" in graph["mbcontrol.plant.build"]          # relative
     assert "mbcontrol.analysis" in graph["mbcontrol.controllers.impedance"]  # lazy, absolute
-    assert "mbcontrol.sim.stability" in graph["mbcontrol.studies.bench_report"]  # from X import sub
+    assert "mbcontrol.studies.identify.extrapolation" in graph[
+        "mbcontrol.studies.identify.setup"]                                       # from X import sub
     assert "mbcontrol.plant.process" in graph["mbcontrol.plant"]                  # a package face
 
 
@@ -250,3 +251,67 @@ def test_no_private_name_is_imported_across_packages():
                              if a.name.startswith("_") and not a.name.startswith("__")
                              and _package(target) != _package(module)]
     assert not crossing, crossing
+
+
+def _is_package(name: str) -> bool:
+    return name in MODULES and MODULES[name].name == "__init__.py"
+
+
+def _face(package: str) -> set[str]:
+    """The names a package's `__init__` binds at its top level."""
+    names = set()
+    for node in ast.parse(MODULES[package].read_text()).body:
+        if isinstance(node, (ast.Import, ast.ImportFrom)):
+            names |= {(a.asname or a.name).split(".")[0] for a in node.names}
+        elif isinstance(node, (ast.FunctionDef, ast.ClassDef)):
+            names.add(node.name)
+        elif isinstance(node, ast.Assign):
+            names |= {t.id for t in node.targets if isinstance(t, ast.Name)}
+    return names
+
+
+def _reached(module: str, path: Path, node) -> list[str]:
+    """The modules inside another package that an import statement reaches past its face."""
+    if isinstance(node, ast.Import):
+        targets = [a.name for a in node.names]
+    else:
+        base = _resolve(module, path, node)
+        if _is_package(base):   # from package import name: a module unless the face binds it
+            face = _face(base)
+            targets = [f"{base}.{a.name}" for a in node.names if a.name not in face]
+        else:
+            targets = [base]
+    return [t for t in targets if t.count(".") >= 2 and t in MODULES and not _is_package(t)
+            and _package(t) != _package(module)]
+
+
+def test_packages_are_entered_by_their_face():
+    """Another package is used through its `__init__` (its face: what it promises others),
+    never by reaching into one of its modules: `from mbcontrol.analysis import
+    envelope_bound`, not `from mbcontrol.analysis.envelope import envelope_bound`. A stage
+    made of sub-packages (hydro's readers, studies' sweep) may be entered at a sub-package's
+    face. Inside a package, modules import each other freely; a common module that is one
+    file (errors, lti) is its own face."""
+    reaching = [f"{module}:{node.lineno} imports {target}"
+                for module, path in MODULES.items()
+                for node in ast.walk(ast.parse(path.read_text(), str(path)))
+                if isinstance(node, (ast.Import, ast.ImportFrom))
+                for target in _reached(module, path, node)]
+    assert not reaching, "\n".join(reaching)
+
+
+@pytest.mark.parametrize("statement, reaches", [
+    ("from mbcontrol.analysis.envelope import envelope_bound", ["mbcontrol.analysis.envelope"]),
+    ("from mbcontrol.analysis import envelope_bound", []),
+    ("from mbcontrol.sim import integrators", ["mbcontrol.sim.integrators"]),
+    ("from mbcontrol.sim import simulate", []),           # the face binds the function
+    ("import mbcontrol.hydro.fit.ssforms", ["mbcontrol.hydro.fit.ssforms"]),
+    ("from ...errors import InputError", []),              # a one-file common module
+    ("from .process import ProcessPlant", []),             # inside its own package
+])
+def test_the_face_rule_sees_reaching_imports(statement, reaches):
+    module = "mbcontrol.studies.sweep.runner"
+    node = ast.parse(statement).body[0]
+    if statement.startswith("from ."):
+        module = "mbcontrol.plant.build"
+    assert _reached(module, MODULES[module], node) == reaches

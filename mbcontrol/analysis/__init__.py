@@ -8,16 +8,24 @@ passes), `summary` (a run's metrics, verdict and provenance: the simulate --json
 `metrics` (power, PAPR, peaks, limit violations), `reduce` (balanced truncation).
 """
 from .bounds import complex_conjugate_bound, pseudo_spectral_bound, pto_thevenin
+from .constrained import constrained_figure, window_share
+from .electrical import electrical_bound, winding_coefficient
+from .envelope import ENVELOPE_SHARE, PEAK_SHARE, envelope_bound, envelope_items, envelope_response
 from .frequency import (excitation_transfer, frequency_domain_response, mechanical_matrices,
                         regular_wave_amplitudes, statespace_response)
 from .linearize import linearize
 from .metrics import electrical_power, pto_metrics
-from .ports import multiport_bound
+from .ports import linear_params, multiport_bound, port_responses
+from .power_statistics import law_params, law_responses, record_power_statistics
 from .reduce import balanced_truncation
 from .summary import summary
-from .validity import assess, simulate_checked
+from .validity import ANGLE_MAX_RAD, DRAFT_FACTOR, assess, mean_draft, simulate_checked, wave_at
 
 __all__ = ["linearize", "frequency_domain_response", "statespace_response", "excitation_transfer",
            "regular_wave_amplitudes", "mechanical_matrices", "complex_conjugate_bound",
            "pseudo_spectral_bound", "pto_thevenin", "pto_metrics", "electrical_power", "summary",
-           "balanced_truncation", "multiport_bound", "assess", "simulate_checked"]
+           "balanced_truncation", "multiport_bound", "assess", "simulate_checked",
+           "constrained_figure", "window_share", "electrical_bound", "winding_coefficient",
+           "ENVELOPE_SHARE", "PEAK_SHARE", "envelope_bound", "envelope_items", "envelope_response",
+           "linear_params", "port_responses", "law_params", "law_responses",
+           "record_power_statistics", "ANGLE_MAX_RAD", "DRAFT_FACTOR", "mean_draft", "wave_at"]

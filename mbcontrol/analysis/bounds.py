@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError, MbcontrolError, UnknownName
-from ..waves.realisation import repeat_period
+from ..waves import repeat_period
 from .dense import OVERSAMPLE, dense_extremes
 
 # Re Z_i may be a tiny negative number where the radiation damping all but vanishes: BEM

@@ -69,7 +69,7 @@ def constrained_figure(plant, wave, pto, force_max: float, stroke_max: float, *,
     so the figure bounds them; else they are a window's and it is a reference. oversample:
     collocation density (default analysis.dense.OVERSAMPLE).
     """
-    from ..waves.realisation import repeat_period
+    from ..waves import repeat_period
     from .bounds import PseudoSpectralProblem, complex_conjugate_bound
     out: dict = {"constrained_W": None, "constrained_reason": None}
     period, _ = repeat_period(wave)

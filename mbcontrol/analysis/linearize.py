@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..errors import LinearizationError
-from ..plant.jacobians import jacobians
+from ..plant import jacobians
 
 if TYPE_CHECKING:       # python-control costs 2.5 s to import: only where it is used
     import control

@@ -26,7 +26,7 @@ import warnings
 
 from .. import defaults
 from ..errors import MbcontrolError
-from ..sim.methods import METHODS
+from ..sim import METHODS
 from .commands import (run_bench, run_fidelity, run_hydro, run_linearize, run_models,
                        run_simulate)
 from .describe import default_help, run_defaults, run_keys

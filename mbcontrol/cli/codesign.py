@@ -112,7 +112,7 @@ def run_codesign(args) -> int:
     from mbcontrol.controllers import REGISTRY
 
     from ..studies.codesign import Spec, codesign
-    from ..studies.codesign.objectives import UNLIKE
+    from ..studies.codesign import UNLIKE
     from .commands import _key_value, parse_settings
     wave = None
     if args.wave != "none" and args.objective != "annual_energy" and not args.seas:
@@ -140,14 +140,14 @@ def run_codesign(args) -> int:
     if args.against:
         import dataclasses
 
-        from ..studies.codesign.compare import compare_optima
+        from ..studies.codesign import compare_optima
         other = dataclasses.replace(spec, objective=args.against)
         kw = dict(vary=vary) if vary else dict(at=[p["params"] for p in result["points"]])
         result["against"] = codesign(other, store=args.store, workers=args.workers,
                                      scheduler=args.scheduler, progress=not args.json, **kw)
         result["comparison"] = compare_optima(result, result["against"])
     if args.plot:
-        from ..studies.codesign.plots import plot_codesign
+        from ..studies.codesign import plot_codesign
         plot_codesign(result, args.plot, unit + (f" per {args.per}" if args.per else ""))
     if args.json:
         print(json.dumps(result, indent=2, default=float))
@@ -167,6 +167,6 @@ def run_codesign(args) -> int:
     print(f"  best: {', '.join(f'{k} {v:.5g}' for k, v in best['params'].items())}: "
           f"{best['objective']:.6g} {unit}")
     if "comparison" in result:
-        from ..studies.codesign.compare import describe
-        print("  " + describe(result["comparison"], unit))
+        from ..studies.codesign import describe_comparison
+        print("  " + describe_comparison(result["comparison"], unit))
     return 0

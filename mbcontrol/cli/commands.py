@@ -148,7 +148,7 @@ INVALID_EXIT = 3        # `simulate`'s exit status for a result that failed its 
 
 
 def run_bench(args) -> int:
-    from ..studies.bench_report import bench
+    from ..studies import run_bench as bench
     plant = _plant(args)
     duration = args.duration or (30 * args.period if args.wave == "regular" and args.period
                                  else 600.0)
@@ -162,13 +162,13 @@ def run_bench(args) -> int:
 
 
 def run_fidelity(args) -> int:
-    from ..studies.fidelity_auto import auto
+    from ..studies import auto_fidelity
     plant = _plant(args)
     duration = args.duration
     wave = _wave(args, plant, duration or 600.0)
     if wave is None:
         raise InputError("fidelity needs a wave: --wave regular|jonswap|pm")
-    report = auto(plant.scene, wave, tol=args.tol, duration=duration, progress=True)
+    report = auto_fidelity(plant.scene, wave, tol=args.tol, duration=duration, progress=True)
     print(report)
     if args.out:
         from ..results import save_dataset

@@ -147,13 +147,13 @@ def run_keys(args) -> int:
     from pathlib import Path
 
     from ..atomic import write_text
-    from ..scene import reference
+    from ..scene import scene_keys_in_readme, scene_keys_markdown
     if args.readme:
         path = Path(args.readme)
-        write_text(path, reference.in_readme(path.read_text()))
+        write_text(path, scene_keys_in_readme(path.read_text()))
         print(f"wrote the scene keys into {path}")
     else:
-        print(reference.markdown(), end="")
+        print(scene_keys_markdown(), end="")
     return 0
 
 

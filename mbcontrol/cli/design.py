@@ -9,7 +9,7 @@ from .commands import _plant, _wave
 
 
 def run_design(args) -> int:
-    from mbcontrol.controllers.design import design
+    from mbcontrol.studies.design import design
     plant = _plant(args)
     if args.wave == "none":
         raise InputError("design needs a wave: --wave regular|jonswap|pm")

@@ -58,7 +58,7 @@ def add_parser(sub, model_options, wave_options) -> None:
 
 def _controller(args, plant, wave):
     from mbcontrol.controllers import REGISTRY, make
-    from mbcontrol.controllers.design_tuning import tune
+    from mbcontrol.studies.design import tune
 
     from .commands import _controller as from_settings
     if args.controller not in REGISTRY:
@@ -83,8 +83,8 @@ def _controller(args, plant, wave):
 
 def run_export(args) -> int:
     from mbcontrol.export import export_controller
-    from mbcontrol.export.checks import closed_loop_check, footprint, step_timing
-    from mbcontrol.export.plant import export_plant
+    from mbcontrol.export import closed_loop_check, footprint, step_timing
+    from mbcontrol.export import export_plant
     from mbcontrol.results import jsonable
     plant = _plant(args)
     if args.wave == "none":

@@ -116,22 +116,21 @@ def _candidates(args) -> dict:
 
 
 def _cross_validate(args, runs, common) -> int:
-    from ..studies.identify.crossval import cross_validate, table
+    from ..studies.identify import cross_validate, crossval_table
     cv = cross_validate(args.model, runs, _candidates(args), progress=not args.json, **common)
     if args.json:
         print(json.dumps({"model": args.model, "cross_validation": cv}, indent=2))
     else:
-        print(table(cv))
+        print(crossval_table(cv))
     return 0
 
 
 def run_identify(args) -> int:
-    from ..studies.identify import ExtrapolationWarning, fit
-    from ..studies.identify import report as rep
-    from ..studies.identify.calibration import calibrate, calibrated_rows
-    from ..studies.identify.intervals import coverage, prediction_intervals
-    from ..studies.identify.flume import load_runs
-    from ..studies.identify.setup import flume_identification, prediction
+    from ..studies.identify import (ExtrapolationWarning, amplitude_rows, calibrate,
+                                    calibrated_rows, coverage, error_table, errors_block, fit,
+                                    flume_identification, identification_summary, load_runs,
+                                    parameter_table, prediction, prediction_intervals,
+                                    repeatability)
     from .commands import _key_value
 
     params = dict(_key_value(s, "--param") for s in args.param)
@@ -150,31 +149,31 @@ def run_identify(args) -> int:
     if args.cross_validate:
         return _cross_validate(args, runs + validation, common)
     said = [str(w.message) for w in caught if issubclass(w.category, ExtrapolationWarning)]
-    before = rep.amplitude_rows(problem, {})      # the scene's own values: the model as built
+    before = amplitude_rows(problem, {})      # the scene's own values: the model as built
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         result = fit(problem, args.method, starts=args.starts, progress=not args.json)
-    after = rep.amplitude_rows(problem, result.values)
+    after = amplitude_rows(problem, result.values)
     v_before = v_after = None
     if validation:
         # fixed at the fitted values (those its plants have: a DOF may be blocked there)
-        v_before = rep.amplitude_rows(vproblem, {})
+        v_before = amplitude_rows(vproblem, {})
         # each with its interval: parameter uncertainty and the fitted runs' repeatability
-        v_after = prediction_intervals(vproblem, result, rep.amplitude_rows(vproblem, result.values),
-                                       rep.repeatability(after))
+        v_after = prediction_intervals(vproblem, result, amplitude_rows(vproblem, result.values),
+                                       repeatability(after))
         # calibrated on the fitted runs' held-out errors: one refit per fold
         cal = calibrate(args.model, runs, validation, fit=args.fit, method=args.method,
                         progress=not args.json, **common)
         v_after = calibrated_rows(v_after, cal["intervals"])
-    summary = rep.summary(problem.scene_name, problem, result, after, v_after)
+    summary = identification_summary(problem.scene_name, problem, result, after, v_after)
     summary["warnings"] = said + summary["warnings"]
     if validation:
         summary["predictions"] = [{k: r[k] for k in PREDICTION_KEYS} for r in v_after]
         summary["prediction_coverage"] = {
             **coverage(v_after), "parametric": coverage(v_after, "interval_95_parametric")}
         summary["calibration"] = cal["calibration"]
-    summary["fit_before"] = rep.errors_block(before)
-    summary["validation_before"] = rep.errors_block(v_before) if v_before else None
+    summary["fit_before"] = errors_block(before)
+    summary["validation_before"] = errors_block(v_before) if v_before else None
     if args.out:
         _write(Path(args.out), problem, result, summary, before, after, v_before, v_after)
     if args.json:
@@ -182,12 +181,12 @@ def run_identify(args) -> int:
         return 0
     for w in caught:
         print(f"mbcontrol: warning: {w.message}", file=sys.stderr)
-    print(rep.parameter_table(problem, result))
-    print(rep.error_table(before, "fit runs, scene values"))
-    print(rep.error_table(after, "fit runs, identified"))
+    print(parameter_table(problem, result))
+    print(error_table(before, "fit runs, scene values"))
+    print(error_table(after, "fit runs, identified"))
     if validation:
-        print(rep.error_table(v_before, "validation, scene values"))
-        print(rep.error_table(v_after, "validation, identified"))
+        print(error_table(v_before, "validation, scene values"))
+        print(error_table(v_after, "validation, identified"))
         c, b = summary["prediction_coverage"], summary["calibration"]
         p = c["parametric"]
         how = (f"calibrated: {b['method']}, {b['folds']}, {b['n_scores']} scores, nominal "
@@ -203,16 +202,16 @@ def run_identify(args) -> int:
 
 def _write(out: Path, problem, result, summary, before, after, v_before, v_after) -> None:
     from ..atomic import write_text
-    from ..studies.identify import report as rep
+    from ..studies.identify import parameter_table, plot_amplitudes, plot_time_series
     for name, text in (("summary.json", json.dumps(summary, indent=2)),
-                       ("parameters.txt", rep.parameter_table(problem, result) + "\n")):
+                       ("parameters.txt", parameter_table(problem, result) + "\n")):
         write_text(out / name, text)
-    rep.plot_amplitudes({"scene values": before, "identified": after}, out / "amplitudes.png")
+    plot_amplitudes({"scene values": before, "identified": after}, out / "amplitudes.png")
     if v_after:
-        rep.plot_amplitudes({"scene values": v_before, "identified": v_after},
+        plot_amplitudes({"scene values": v_before, "identified": v_after},
                             out / "amplitudes_validation.png")
     worst = max(after, key=lambda r: abs(r["relative_error"]))["run"]
-    rep.plot_time_series(problem, worst, {"scene values": {}, "identified": result.values},
+    plot_time_series(problem, worst, {"scene values": {}, "identified": result.values},
                          out / "time_series.png")
     import matplotlib.pyplot as plt
     plt.close("all")

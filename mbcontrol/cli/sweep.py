@@ -191,7 +191,7 @@ def spread_seas(seas, spread_deg: float | None, kind: str | None):
     import dataclasses
     import math
 
-    from ..waves.sites import SPREAD_MAX_DEG
+    from ..waves import SPREAD_MAX_DEG
     if spread_deg is not None:
         if not 0 <= spread_deg < SPREAD_MAX_DEG:
             raise InputError(f"--spread {spread_deg:g}: expected a directional spread sigma from "
@@ -255,7 +255,7 @@ def run_sweep(args) -> int:
         if args.design:
             raise InputError("--design with --isolated: not built (a farm's controllers are "
                              "tuned per device); tune one device with --design instead")
-        from ..studies.farm import farm_sweep
+        from ..studies import farm_sweep
         ds, summary = farm_sweep(args.model, seas, scene_params=scene_params,
                                  isolated=dict(_key_value(s, "--isolated") for s in args.isolated), **common)
     else:
@@ -265,7 +265,7 @@ def run_sweep(args) -> int:
                             robust=args.robust, identified=args.identified, years=years,
                             **common)
     if args.plot:
-        from ..studies.sweep.plots import plot_sweep
+        from ..studies.sweep import plot_sweep
         plot_sweep(ds, summary, args.plot)
     if args.json:
         print(json.dumps(summary, indent=2))
@@ -303,10 +303,10 @@ def run_sweep(args) -> int:
               + ("" if share == 1 else f" (valid seas only: {100 * share:.3g} % of the year; a "
                                        f"lower bound)"))
     if summary.get("annual_energy_ci95_MWh"):
-        from ..studies.sweep.budget import table
+        from ..studies.sweep import budget_table
         lo, hi = summary["annual_energy_ci95_MWh"]
         print(f"  annual energy 95 % interval [{lo:.4g}, {hi:.4g}] MWh; its budget:")
-        print("\n".join("    " + line for line in table(summary["annual_energy_budget"])
+        print("\n".join("    " + line for line in budget_table(summary["annual_energy_budget"])
                         .splitlines()))
     if farm and farm["q_annual"] is not None:
         print(f"  farm of {farm['devices']} devices: annual energy {summary['annual_energy_MWh']:.4g} MWh "

@@ -165,7 +165,7 @@ def makefile(ident: str, sources: list[str]) -> str:
 
 
 def compile_library(sources: list[Path], target: Path, extra_flags=()) -> None:
-    from mbcontrol.sim.compiled import compiler
+    from mbcontrol.sim import compiler
     cc = compiler()
     if cc is None:
         raise RuntimeError("export: no C compiler found ($CC, gcc or cc); the sources are "

@@ -18,7 +18,7 @@ def closed_loop_check(plant, wave, controller, exported, *, duration: float, dt:
     Python run's peak force and |mean power|; beside them the round-off floor (the Python
     run against itself from a start moved by 1e-12). Returns the check and the Python record
     (the timing replays its measurements)."""
-    from mbcontrol.controllers.latching import mean_power
+    from mbcontrol.controllers import mean_power
     from mbcontrol.sim import simulate
     period = getattr(controller, "period", None)
     reference = simulate(plant, wave, duration=duration, dt=dt, controller=controller,

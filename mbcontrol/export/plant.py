@@ -29,7 +29,7 @@ def plant_parameters(plant) -> np.ndarray:
 
 def export_plant(plant, wave, out_dir, *, dt: float, model: str | None = None) -> Path:
     """Write out_dir/<model>_plant.fmu: the plant in `wave` (None: still water), RK4 at dt s."""
-    from mbcontrol.sim.integrators import rk4_step, wave_terms
+    from mbcontrol.sim import rk4_step, wave_terms
     ident = identifier(model or plant.name, "plant")
     out_dir = Path(out_dir).resolve()
     out_dir.mkdir(parents=True, exist_ok=True)

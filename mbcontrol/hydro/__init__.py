@@ -34,6 +34,12 @@ from .fit.passivity import PassivityReport, absorbed_energy, enforce_passivity, 
 from .fit.array_fit import fit_radiation_columns
 from .fit.kernel import convolution_force, impulse_response, kernel_data
 from .fit.radiation import RadiationModel, fit_radiation
+from .bem.isolated import compute_isolated
+from .data.headings import SECTOR_SIGMAS
+from .fit.response_error import Device, response_error_on
+from .fit.ssforms import state_blocks
+from .mesh.large_angle import buoyancy
+from .model import FITS_SERVED, obstacle_bodies, shipped_fits_dir
 
 __all__ = [
     "read_netcdf", "write_netcdf_atomic",
@@ -44,4 +50,6 @@ __all__ = [
     "headings_for_spread", "headings_line", "covering_headings", "covers_circle",
     "heading_matrix", "axisymmetric_headings",
     "HydroModel", "load_hydro_model", "load_hydro_data", "fit_hydro_model", "fit_method", "geometry_dict",
+    "compute_isolated", "SECTOR_SIGMAS", "Device", "response_error_on", "state_blocks", "buoyancy",
+    "FITS_SERVED", "obstacle_bodies", "shipped_fits_dir",
 ]

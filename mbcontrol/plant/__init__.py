@@ -13,10 +13,12 @@ what made a plant), `build` (the entry point).
 from .build import build_plant
 from .catenary import CatenarySolution, solve_catenary
 from .catenary_line import CatenaryLine, catenary_line
-from .fidelity import Fidelity, FidelityError, plant_for
+from .fidelity import Fidelity, FidelityError, has_couplings, plant_for
+from .freeze import as_wave_list
 from .jacobians import jacobians
 from .mechanical import MechanicalMatrices, dof_selector, mechanical_matrices
 from .ownership import controlled_params, linear_params
+from .pieces import f_by_parts
 from .process import ProcessPlant, active_hydro_dofs, device_around, response_error_of
 from .provenance import provenance
 from .workspace import derived
@@ -25,4 +27,4 @@ __all__ = ["build_plant", "ProcessPlant", "active_hydro_dofs", "dof_selector", "
            "Fidelity", "FidelityError", "plant_for", "CatenaryLine", "CatenarySolution",
            "catenary_line", "solve_catenary", "provenance", "MechanicalMatrices", "mechanical_matrices",
            "device_around", "linear_params", "controlled_params", "response_error_of",
-           "derived"]
+           "derived", "has_couplings", "as_wave_list", "f_by_parts"]

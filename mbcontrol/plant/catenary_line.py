@@ -14,7 +14,7 @@ import casadi as ca
 import numpy as np
 
 from ..scene import Mooring
-from ..scene.checks import catenary_geometry
+from ..scene import catenary_geometry
 from .catenary import SYMBOLIC_OPS, CatenarySolution, shape_terms, solve_catenary
 
 

@@ -223,7 +223,7 @@ def large_angle_hydrostatics(scene: Scene, topo: Topology, q):
     loads. Returns (generalised force, potential energy relative to rest, J).
     """
     from ..hydro import geometry_dict
-    from ..hydro.mesh.large_angle import buoyancy
+    from ..hydro import buoyancy
 
     tree, tau, energy = topo.tree, ca.SX.zeros(topo.tree.n_s), 0
     rho, g = scene.water.rho, scene.water.g

@@ -35,7 +35,7 @@ import hashlib
 import casadi as ca
 import numpy as np
 
-from ..hydro.fit.ssforms import state_blocks
+from ..hydro import state_blocks
 
 PIECES_MASS_NONZEROS = 100
 PIECES_RADIATION_NONZEROS = 5000

@@ -18,7 +18,7 @@ import numpy as np
 
 from ..errors import UnknownName
 from ..hydro import HydroModel, RadiationModel, load_hydro_model
-from ..hydro.fit.response_error import Device
+from ..hydro import Device
 from ..multibody import Topology, build_topology
 from ..scene import DOF_NAMES, Scene, load_scene
 from . import checks, loads
@@ -379,7 +379,7 @@ def response_error_of(plant) -> dict | None:
     judged it: {"error", "omega", "weight", "what"} at the worst fitted frequency, on the data the
     fit saw (its band, BEM reciprocity as it applied it), the device at rest with its PTOs free.
     None for a plant without radiation states."""
-    from ..hydro.fit.response_error import response_error_on
+    from ..hydro import response_error_on
     hydro = plant.hydro
     if hydro is None or hydro.radiation.order == 0:
         return None

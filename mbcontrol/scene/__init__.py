@@ -9,10 +9,15 @@ repeat), `units` ("60 mm" -> 0.06), `shapes` (revolution profiles, immersed volu
 from .load import catalogue_dir, list_models, load_scene, resolve
 from .model import (DOF_NAMES, JOINT_TYPES, Body, Drag, Drivetrain, EndStop, Friction, Geometry, HydroSettings,
                     Joint, Mooring, Obstacle, Pto, Scene, Water)
+from .checks import catenary_geometry
 from .parse import parse_scene
+from .reference import in_readme as scene_keys_in_readme
+from .reference import markdown as scene_keys_markdown
 from .shapes import immersed_profile, immersed_volume, profile_problem
+from .template import evaluate as evaluate_expression
 
 __all__ = ["load_scene", "list_models", "catalogue_dir", "resolve", "parse_scene",
            "DOF_NAMES", "JOINT_TYPES", "Scene", "Water", "Geometry", "Body", "Joint", "Pto",
            "Friction", "Mooring", "EndStop", "Drag", "Drivetrain", "HydroSettings", "Obstacle",
-           "immersed_profile", "immersed_volume", "profile_problem"]
+           "immersed_profile", "immersed_volume", "profile_problem", "catenary_geometry",
+           "evaluate_expression", "scene_keys_markdown", "scene_keys_in_readme"]

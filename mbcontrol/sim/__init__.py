@@ -6,11 +6,21 @@ registry), `integrators` (compiled stepping), `compiled` (the compiled-code cach
 (many cases through one compiled function), `reference` (direct-convolution reference),
 `stability` (largest stable steps).
 """
-from .batch import simulate_batch
+from .batch import batch_states, simulate_batch
+from .compiled import compiler
+from .integrators import outputs as plant_outputs
+from .integrators import prepare, rk4_step, wave_terms
+from .light import can_run as can_run_light
+from .light import simulate_arrays
 from .methods import METHODS, method
 from .reference import simulate_convolution
+from .sampled import closed_loop_map, verdict as sampled_verdict
+from .sensitivity import sensitivity_name, sensitivity_plant
 from .simulate import energy_audit, simulate
 from .stability import linear_stability_limit, stability_limit, stability_table
 
 __all__ = ["simulate", "simulate_batch", "simulate_convolution", "energy_audit", "METHODS",
-           "method", "stability_limit", "linear_stability_limit", "stability_table"]
+           "method", "stability_limit", "linear_stability_limit", "stability_table",
+           "batch_states", "compiler", "plant_outputs", "prepare", "rk4_step", "wave_terms",
+           "can_run_light", "simulate_arrays", "closed_loop_map", "sampled_verdict",
+           "sensitivity_name", "sensitivity_plant"]

@@ -41,7 +41,7 @@ def law_loop(plant, law, p, x=None):
     """(A, B_u, C, D_u, K): the plant's exact Jacobians at x (default: rest, no command,
     still water) and K = d law / d y there (u = K y), for the continuous loop here and the
     sampled one (sim.sampled)."""
-    from ..plant.jacobians import jacobians
+    from ..plant import jacobians
     x = plant.x0() if x is None else np.asarray(x, float)
     nu, nw = len(plant.inputs), len(plant.disturbances)
     u0, w0 = np.zeros(nu), np.zeros(nw)

@@ -24,7 +24,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..plant import derived
-from ..plant.pieces import f_by_parts
+from ..plant import f_by_parts
 from .compiled import compile_function
 from .methods import METHODS, method, radiation_exponential, radiation_split
 

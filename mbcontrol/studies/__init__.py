@@ -4,7 +4,10 @@ Modules: `workprecision` (accuracy against cost of every method and radiation or
 `bench_report` (the `mbcontrol bench` command's study), `fidelity_auto` (the cheapest model
 within a tolerance in the user's waves).
 """
+from .bench_report import bench as run_bench
+from .farm import farm_sweep
 from .fidelity_auto import FidelityReport
+from .fidelity_auto import auto as auto_fidelity
 from .workprecision import work_precision
 
-__all__ = ["FidelityReport", "work_precision"]
+__all__ = ["FidelityReport", "work_precision", "run_bench", "farm_sweep", "auto_fidelity"]

@@ -10,7 +10,7 @@ from pathlib import Path
 
 from ..atomic import atomic_path
 from ..results import write_dataset
-from ..sim import stability as stab
+from ..sim import stability_table
 from . import workprecision as wp
 
 
@@ -50,7 +50,7 @@ def bench(scene, wave, *, duration: float, methods, radiation_tols=(), stability
 
 
 def _stability(scene, wave, methods):
-    from mbcontrol.controllers.latching import Latching
+    from mbcontrol.controllers import Latching
     fixed = [m for m in methods if m in ("rk3", "rk4", "dopri5", "exp-rk4")]
     stop, latching = None, None
     if scene.ptos:
@@ -61,7 +61,7 @@ def _stability(scene, wave, methods):
             travel = max(wave.settings.get("height", wave.settings.get("hs", 1.0)) / 5, 1e-3)
             stop = (pto.joint, travel, _stop_stiffness(scene, pto, wave))
         latching = Latching(damping=pto.damping or 1.0, latch_time=wave.period / 8)
-    return stab.stability_table(scene, wave, methods=fixed, duration=min(60.0, 10 * wave.period),
+    return stability_table(scene, wave, methods=fixed, duration=min(60.0, 10 * wave.period),
                                 end_stop=stop, latching=latching,
                                 tight_radiation_tol=scene.hydro.radiation_tol / 5,
                                 progress=True)

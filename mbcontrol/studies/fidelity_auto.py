@@ -24,8 +24,8 @@ import xarray as xr
 from .. import defaults
 from ..console import progress_bar
 from ..plant import ProcessPlant
-from ..plant.fidelity import Fidelity, FidelityError, has_couplings, plant_for
-from ..plant.freeze import as_wave_list
+from ..plant import Fidelity, FidelityError, has_couplings, plant_for
+from ..plant import as_wave_list
 from ..scene import Scene, load_scene
 from ..sim import simulate
 

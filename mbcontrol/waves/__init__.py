@@ -13,23 +13,24 @@ from .excitation import (coefficient_offsets, coefficient_series, excitation_at_
                          excitation_series, interpolate_complex)
 from .flux import deep_water_flux, energy_flux, spectrum_energy_flux
 from .realisation import (DEFAULT_BAND, Wave, band_limits, from_args, from_elevation,
-                          irregular, regular, variance_outside)
-from .sites import (SeaState, grid, occurrence, read_ndbc_spectra, read_seas,
-                    read_year_weights, site_energy_flux)
+                          irregular, regular, repeat_period, variance_outside)
+from .sites import (SPREAD_MAX_DEG, WEIGHT_SUM_TOLERANCE, SeaState, grid, occurrence,
+                    read_ndbc_spectra, read_seas, read_year_weights, site_energy_flux)
 from .spreading import Spreading, component_directions, spread_from_s
+from .spreading import from_settings as spreading_from_settings
 from .spectra import gamma_for_te_over_tp, jonswap_spectrum, moment, spectral_hm0_te, te_over_tp
 from .synthesis import ramp
 
 __all__ = [
     "Wave", "regular", "irregular", "from_args", "from_elevation", "band_limits",
-    "variance_outside", "DEFAULT_BAND", "ramp",
+    "variance_outside", "DEFAULT_BAND", "ramp", "repeat_period",
     "jonswap_spectrum", "moment", "spectral_hm0_te", "te_over_tp", "gamma_for_te_over_tp",
     "wavenumber", "group_velocity", "group_velocities",
     "excitation_series", "excitation_at_offsets", "excitation_impulse_response",
     "interpolate_complex", "coefficient_series", "coefficient_offsets",
     "energy_flux", "spectrum_energy_flux", "deep_water_flux",
     "SeaState", "grid", "read_seas", "read_year_weights", "site_energy_flux",
-    "read_ndbc_spectra", "occurrence",
-    "Spreading", "component_directions", "spread_from_s",
+    "read_ndbc_spectra", "occurrence", "SPREAD_MAX_DEG", "WEIGHT_SUM_TOLERANCE",
+    "Spreading", "component_directions", "spread_from_s", "spreading_from_settings",
     "HOURS_PER_YEAR", "annual_energy_MWh", "bin_seas",
 ]

@@ -142,7 +142,8 @@ def test_a_sea_no_setting_can_serve_is_flagged_with_the_closest(sphere, monkeypa
     Hs 2 m: the sea alone moves the surface by 1 m) no damping keeps it inside: the tuner
     raises OutsideEnvelope with the damper that comes closest, which is the least-ratio point
     of the same scan, and `design` flags the sea instead of stopping."""
-    from mbcontrol.controllers import design_tuning, tuning
+    from mbcontrol.controllers import tuning
+    from mbcontrol.studies.design import tune
     monkeypatch.setattr(tuning, "ENVELOPE_SHARE", 0.01)
     wave = _sea(sphere, 2.0, 9.0, duration=600.0)
     with pytest.raises(OutsideEnvelope, match="linear model's range") as caught:
@@ -154,8 +155,8 @@ def test_a_sea_no_setting_can_serve_is_flagged_with_the_closest(sphere, monkeypa
     ratios = [env.ratio(_damper_force(sphere, wave, x)) for x in scan]
     assert caught.value.ratio <= min(ratios) * (1 + 0.02)      # the closest, to the grid step
     notes = []
-    parameters, _, info, _ = design_tuning.tune(sphere, wave, "passive", sphere.scene.ptos[0],
-                                                True, None, notes)
+    parameters, _, info, _ = tune(sphere, wave, "passive", sphere.scene.ptos[0],
+                                  True, None, notes)
     assert info["envelope"]["inside"] is False and parameters["damping"] > 0
     assert any("OUTSIDE ITS ENVELOPE" in n for n in notes)
 

@@ -133,7 +133,7 @@ def test_design_tunes_every_sea_and_reports_its_bound(capsys, tmp_path):
     same envelope (+1 %), the share is reported, and a bare reactive law no longer warns.
     A rerun from the store computes nothing and reports the same settings."""
     from mbcontrol import build_plant, load_scene, waves
-    from mbcontrol.controllers.sea_design import design_for_sea
+    from mbcontrol.studies.design import design_for_sea
     argv = ("sweep", "rm3", "--hs", "1.5", "3.5", "--tp", "9", "--duration", "300", "--dt", "0.1",
             "--workers", "0", "--controller", "reactive", "--design", "--store",
             str(tmp_path / "store"), "--json")

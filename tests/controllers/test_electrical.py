@@ -87,7 +87,7 @@ DEVICES = {   # model: (drivetrain, regular wave (H, T), sea (Hs, Tp))
 @pytest.mark.parametrize("model", DEVICES)
 @pytest.mark.parametrize("sea", ["regular", "jonswap"])
 def test_designs_stay_below_the_electrical_bound(model, sea, tmp_path):
-    from mbcontrol.controllers.design import design
+    from mbcontrol.studies.design import design
     drive, (h, t), (hs, tp) = DEVICES[model]
     plant = build_plant(with_drivetrain(tmp_path, model, **drive))
     wave = waves.regular(h, t) if sea == "regular" else \

@@ -5,8 +5,8 @@ code: two frequency-domain solutions with different PTO damping, V(c) = F_eq / (
 import numpy as np
 import pytest
 
-from controllers.impedance import base_params, intrinsic_impedance
 from mbcontrol.analysis import frequency_domain_response
+from mbcontrol.controllers.impedance import base_params, intrinsic_impedance
 from mbcontrol.plant import build_plant
 
 

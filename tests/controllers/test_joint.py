@@ -12,12 +12,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from controllers.design import design
-from controllers.joint import joint_tuning, other_laws
 from mbcontrol.analysis import frequency_domain_response, pto_thevenin
 from mbcontrol.analysis.ports import multiport_bound
+from mbcontrol.controllers.joint import joint_tuning, other_laws
 from mbcontrol.plant import build_plant
 from mbcontrol.scene import load_scene
+from mbcontrol.studies.design import design
 from mbcontrol.waves import regular
 
 # simulated / linear theory: the nonlinear plant, its radiation fit and the step size
@@ -140,7 +140,7 @@ def test_predictive_control_of_several_ptos_is_bounded_in_total(array4):
 def test_cli_sets_one_ptos_value():
     import inspect
 
-    from controllers.reactive import Reactive
+    from mbcontrol.controllers.reactive import Reactive
     from mbcontrol.cli.commands import parse_settings
     signature = inspect.signature(Reactive).parameters
     out = parse_settings(["damping.pto1=2", "damping.pto2=3", "stiffness=-1"], signature)

@@ -9,9 +9,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from controllers import make
-from controllers.passive import optimal_damping
 from mbcontrol.analysis import complex_conjugate_bound
+from mbcontrol.controllers import make
+from mbcontrol.controllers.passive import optimal_damping
 from mbcontrol.export.plant import plant_parameters
 from mbcontrol.plant import build_plant, controlled_params, linear_params
 from mbcontrol.sim import simulate

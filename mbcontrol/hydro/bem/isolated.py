@@ -22,7 +22,7 @@ import json
 import numpy as np
 import xarray as xr
 
-from ...waves.dispersion import wavenumber
+from ...waves import wavenumber
 from .solve import _geometry_for_key, compute
 from ..mesh.geometry import BemBody
 

@@ -14,7 +14,7 @@ costs nothing) and one of:
 - mechanical_bound: the same for absorbed power (`analysis.pseudo_spectral_bound`);
 - controller: the mean power (electrical with a drivetrain, else mechanical; W) of a causal
   controller designed for the wave as `sweep --design` designs it
-  (`controllers.sea_design`), simulated on the nonlinear plant and checked;
+  (`studies.design`), simulated on the nonlinear plant and checked;
 - annual_energy: the site's annual absorbed energy (MWh: the PTOs' mechanical power, as
   `sweep` weighs it) with the controller designed per sea (`studies.sweep`, --design), its
   95 % interval the error bar; mechanical_bound is its ceiling, not electrical_bound.
@@ -126,7 +126,7 @@ def _bound(objective: str, plant, wave, params, omega_max: float | None = None) 
     carry force. The dense interior point ("IPM", analysis.box_qp) solves it: the same optimum
     as Clarabel to 1e-8, 4-25x faster on a sea's hundreds of harmonics."""
     from ...analysis import pseudo_spectral_bound
-    from ...analysis.electrical import electrical_bound
+    from ...analysis import electrical_bound
     pto = plant.scene.ptos[0]
     kw = dict(pto=pto.name, force_max=pto.force_max, stroke_max=pto.stroke_max,
               params=params or None, solver="IPM",
@@ -152,7 +152,7 @@ def _site_bound(spec: Spec, plant, params) -> dict:
     bound in the wave `sweep` runs it in (runner.sea_wave: its JONSWAP with deterministic
     amplitudes, repeating every spec.duration s), weighted by its share of the year. Expected
     amplitudes have no phase scatter, so the figure has no error bar."""
-    from ...waves.annual import annual_energy_MWh
+    from ...waves import annual_energy_MWh
     from ..sweep import read_seas
     from ..sweep.runner import sea_wave
     seas = read_seas(spec.seas)
@@ -174,10 +174,10 @@ def _controller(spec: Spec, plant, wave, params, settings) -> dict:
     import inspect
 
     from mbcontrol.controllers import REGISTRY, make
-    from mbcontrol.controllers.sea_design import design_for_sea
+    from mbcontrol.studies.design import design_for_sea
 
     from ...analysis import pto_metrics
-    from ...analysis.validity import assess
+    from ...analysis import assess
     from ...sim import simulate
     designed = design_for_sea(plant, wave, spec.controller, dt=spec.dt)
     chosen = {**designed["settings"], **settings}
@@ -219,8 +219,8 @@ def cost_proxy(per: str, scene, values: dict) -> float:
     immersed volume where its geometry gives it in closed form, else its mass / rho),
     "rated_force" (kN: the PTOs' force_max summed) or an arithmetic expression of `values`
     and the scene's parameters. Must be > 0."""
-    from ...scene.shapes import immersed_volume
-    from ...scene.template import evaluate as arithmetic
+    from ...scene import immersed_volume
+    from ...scene import evaluate_expression
     if per == "volume":
         total = 0.0
         for body in scene.bodies:
@@ -233,7 +233,7 @@ def cost_proxy(per: str, scene, values: dict) -> float:
     elif per == "rated_force":
         value = sum(p.force_max for p in scene.ptos) / 1e3
     else:
-        value = arithmetic(per, {**scene.parameters, **values}, str(scene.path), "--per")
+        value = evaluate_expression(per, {**scene.parameters, **values}, str(scene.path), "--per")
     if not (value > 0 and math.isfinite(value)):
         raise InputError(f"--per {per}: the cost proxy is {value!r}; expected a finite number > 0")
     return float(value)

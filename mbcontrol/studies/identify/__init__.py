@@ -8,11 +8,24 @@ and lows), `problem` (runs + plant + parameters -> residuals and their exact Jac
 (Nelder-Mead and Gauss-Newton, uncertainty), `extrapolation` (runs where the model was not
 fitted), `report` (tables, JSON, figures).
 """
+from .calibration import calibrate, calibrated_rows
+from .crossval import cross_validate
+from .crossval import table as crossval_table
 from .extrapolation import ExtrapolationWarning
 from .fit import FitResult, IdentifiabilityWarning, fit
 from .problem import FitParameter, Identification, Run
+from .flume import load_runs
+from .intervals import coverage, prediction_intervals
 from .records import Record, RecordError, read_csv, read_netcdf
+from .report import (amplitude_rows, error_table, errors_block, parameter_table, plot_amplitudes,
+                     plot_time_series, repeatability)
+from .report import summary as identification_summary
+from .setup import flume_identification, prediction
 
 __all__ = ["Identification", "FitParameter", "Run", "fit", "FitResult", "IdentifiabilityWarning",
            "ExtrapolationWarning",
-           "Record", "RecordError", "read_csv", "read_netcdf"]
+           "Record", "RecordError", "read_csv", "read_netcdf", "calibrate", "calibrated_rows",
+           "cross_validate", "crossval_table", "load_runs", "coverage", "prediction_intervals",
+           "amplitude_rows", "error_table", "errors_block", "parameter_table", "plot_amplitudes",
+           "plot_time_series", "repeatability", "identification_summary",
+           "flume_identification", "prediction"]

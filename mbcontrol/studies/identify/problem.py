@@ -32,9 +32,7 @@ from ... import defaults, waves
 from ...errors import InputError, UnknownName
 from ...plant import Fidelity, build_plant
 from ...scene import load_scene
-from ...sim.batch import batch_states
-from ...sim.integrators import outputs as evaluate_outputs
-from ...sim.sensitivity import sensitivity_name, sensitivity_plant
+from ...sim import batch_states, plant_outputs, sensitivity_name, sensitivity_plant
 from .costs import harmonic, harmonic_weights, peak_low_indices, peaks_and_lows, whole_periods
 
 COSTS = ("harmonic", "peaks", "timeseries")
@@ -277,7 +275,7 @@ class Identification:
                 tw = t[keep]
                 W = plant.excitation(self._wave(run), tw)
                 U = np.zeros((tw.size, len(plant.inputs)))
-                Y = evaluate_outputs(plant, Xc[keep], U, W, p, compiled=self.compiled)
+                Y = plant_outputs(plant, Xc[keep], U, W, p, compiled=self.compiled)
                 out = {}
                 for channel in run.channels:
                     name = self.outputs[channel]

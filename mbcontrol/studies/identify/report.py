@@ -97,7 +97,7 @@ def forward_validity(problem, values: dict, rows: list[dict]) -> dict:
     hydrodynamics hold and a heave within the body's mean draft
     (`mbcontrol.analysis.validity`); and no fitted hydro correction that makes the model
     create energy (a negative radiation or damping scale). {"valid", "invalid_reasons"}."""
-    from ...analysis.validity import ANGLE_MAX_RAD, DRAFT_FACTOR, mean_draft
+    from ...analysis import ANGLE_MAX_RAD, DRAFT_FACTOR, mean_draft
     reasons = []
     for name, value in values.items():
         dissipative = name.endswith(("__radiation_scale", "__damping")) or "viscous" in name

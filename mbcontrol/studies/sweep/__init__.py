@@ -9,8 +9,10 @@ tables are `mbcontrol.waves`' (re-exported here).
 """
 from ...waves import (SeaState, annual_energy_MWh, energy_flux, grid, occurrence, read_seas,
                      site_energy_flux)
+from .budget import table as budget_table
+from .plots import plot_sweep
 from .power import power_matrix
 from .study import sweep
 
 __all__ = ["sweep", "SeaState", "grid", "read_seas", "energy_flux", "annual_energy_MWh",
-           "power_matrix", "occurrence", "site_energy_flux"]
+           "power_matrix", "occurrence", "site_energy_flux", "budget_table", "plot_sweep"]

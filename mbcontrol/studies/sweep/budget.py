@@ -26,7 +26,7 @@ import math
 
 import numpy as np
 
-from ...waves.annual import HOURS_PER_YEAR
+from ...waves import HOURS_PER_YEAR
 
 MWH_PER_W = HOURS_PER_YEAR / 1e6
 

@@ -15,8 +15,8 @@ from ... import defaults
 # The seas themselves (SeaState, grids, the site CSV, Te/Tp) live in the waves package;
 # re-exported here so that `from mbcontrol.studies.sweep.cases import SeaState` keeps working.
 from ...errors import InputError
-from ...waves.sites import WEIGHT_SUM_TOLERANCE, SeaState, grid, read_seas  # noqa: F401
-from ...waves.spectra import te_over_tp  # noqa: F401
+from ...waves import (WEIGHT_SUM_TOLERANCE, SeaState, grid, read_seas,  # noqa: F401
+                      te_over_tp)
 
 
 WAVE_DIRECTION = "direction"    # --vary direction=0,45: NED headings in degrees, of the hydro data
@@ -88,7 +88,7 @@ def build_cases(model: str, seas, *, seeds: int = 1, vary: dict | None = None, r
     """Every sea x seed x combination of the varied values. roles: varied name -> "param",
     "scene" or "setting" (see `roles_for`); inputs: the plant's provenance (content hashes),
     part of every case's key. duration, dt and method left out: the "sweep.*" defaults.
-    design: each case's controller is tuned for its sea (controllers.sea_design); robust:
+    design: each case's controller is tuned for its sea (studies.design.sea); robust:
     within the robustness floors; amplitudes: the seas' ("deterministic" or "random",
     waves.irregular)."""
     duration = defaults.resolve("sweep.duration", duration)

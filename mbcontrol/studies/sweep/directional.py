@@ -25,7 +25,7 @@ def spread_sector(headings, spread: float) -> float:
     the whole circle (pi) where the hydro data's headings (rad) cover it, else 3 sigma (at
     most pi); the share of D cut off is recorded in the wave's settings."""
     from ...hydro import covers_circle
-    from ...hydro.data.headings import SECTOR_SIGMAS
+    from ...hydro import SECTOR_SIGMAS
     if covers_circle(headings):
         return math.pi
     return min(math.pi, SECTOR_SIGMAS * spread)
@@ -47,8 +47,8 @@ def spread_power(plant, wave, velocities, damping) -> float:
     spreading): velocities(direction) gives (n_omega, n_pto) velocities per unit amplitude
     for one direction (rad) per frequency."""
     from ...hydro import heading_matrix
-    from ...waves.spreading import from_settings
-    spreading = from_settings(wave.settings)
+    from ...waves import spreading_from_settings
+    spreading = spreading_from_settings(wave.settings)
     omega = np.asarray(wave.omega, float)
     omega_p = 2 * math.pi / wave.settings["tp"]
     n = max(2, math.ceil(2 * spreading.sector / QUADRATURE_STEP))

@@ -9,10 +9,8 @@ import numpy as np
 import xarray as xr
 
 from ...errors import InputError
-from ...waves.annual import HOURS_PER_YEAR, annual_energy_MWh  # noqa: F401
-from ...waves.flux import energy_flux  # noqa: F401
-from ...waves.sites import occurrence, read_ndbc_spectra  # noqa: F401
-from ...waves.spectra import spectral_hm0_te  # noqa: F401
+from ...waves import (HOURS_PER_YEAR, annual_energy_MWh, energy_flux,  # noqa: F401
+                      occurrence, read_ndbc_spectra, spectral_hm0_te)
 
 
 def power_matrix(ds: xr.Dataset, variable: str = "mean_power_W", period: str = "tp",

@@ -69,7 +69,7 @@ def run_case(case) -> dict:
 
     from mbcontrol.controllers import REGISTRY, make
 
-    from ...sim import light, simulate
+    from ...sim import can_run_light, simulate, simulate_arrays
     params, scene_params, settings = case.resolved()
     plant = _plant(case.model, tuple(sorted(scene_params.items())))
     direction = None if case.direction_deg is None else math.radians(case.direction_deg)
@@ -78,7 +78,7 @@ def run_case(case) -> dict:
     controller, designed = None, None
     start = time.perf_counter()
     if case.design:      # tuned for this sea; settings given with --set take precedence
-        from mbcontrol.controllers.sea_design import design_for_sea
+        from mbcontrol.studies.design import design_for_sea
         try:
             designed = design_for_sea(plant, wave, case.controller, dt=case.dt,
                                       robust=case.robust)
@@ -91,9 +91,9 @@ def run_case(case) -> dict:
             settings.setdefault("wave", wave)
         controller = make(case.controller, **settings)
     try:
-        if light.can_run(plant, controller, case.method):
-            run = light.simulate_arrays(plant, wave, duration=case.duration, dt=case.dt,
-                                        method=case.method, params=params or None)
+        if can_run_light(plant, controller, case.method):
+            run = simulate_arrays(plant, wave, duration=case.duration, dt=case.dt,
+                                  method=case.method, params=params or None)
             _LAST_RUN[:] = [run]     # the previous run is let go only now (see _LAST_RUN)
         else:
             run = simulate(plant, wave, duration=case.duration, dt=case.dt,
@@ -143,8 +143,8 @@ def case_record(case, plant, wave, run, start: float) -> dict:
     perf_counter at the start of its simulation. The one place a record is made: metrics
     (every numeric entry of `pto_metrics` per PTO, `<pto>__<key>`, and the totals), the
     validity verdict (`mbcontrol.analysis.validity.assess` on the run and its wave)."""
-    from ...analysis.metrics import pto_metrics
-    from ...analysis.validity import assess
+    from ...analysis import pto_metrics
+    from ...analysis import assess
     from ...results import jsonable
     ptos = {pto.name: jsonable(pto_metrics(run, pto)) for pto in plant.scene.ptos}
     metrics = {}
@@ -368,15 +368,15 @@ def _warm(model: str, scene_params: tuple, n_steps: int, method: str) -> None:
 
     import mbcontrol.controllers  # noqa: F401
 
-    from ...analysis import metrics, validity  # noqa: F401
-    from ...sim import integrators
+    import mbcontrol.analysis  # noqa: F401   (its metrics and validity checks)
+    from ...sim import method as method_of
+    from ...sim import plant_outputs, prepare
     plant = _plant(model, scene_params)
-    if integrators.method(method).fixed_step:
-        integrators.prepare(plant, n_steps, method)
+    if method_of(method).fixed_step:
+        prepare(plant, n_steps, method)
         rows = n_steps + 1
-        integrators.outputs(plant, np.zeros((rows, plant.nx)),
-                            np.zeros((rows, len(plant.inputs))),
-                            np.zeros((rows, len(plant.disturbances))), plant.p0)
+        plant_outputs(plant, np.zeros((rows, plant.nx)), np.zeros((rows, len(plant.inputs))),
+                      np.zeros((rows, len(plant.disturbances))), plant.p0)
 
 
 def _on_dask(queue: list, save, client, per_task) -> None:

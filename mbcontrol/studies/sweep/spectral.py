@@ -40,7 +40,7 @@ def sea_components(plant, sea, duration: float, direction: float | None = None):
     """(wave, rms amplitudes): the sea as the sweep draws it (`runner.sea_wave`, seed 0; its
     grid, deterministic amplitudes and ramp) and each component's rms amplitude sqrt(2 S dw) (m),
     what random amplitudes scatter about."""
-    from ...waves.spectra import jonswap_spectrum
+    from ...waves import jonswap_spectrum
     from .runner import sea_wave
     wave = sea_wave(plant, sea, duration, seed=0, direction=direction)
     gamma = wave.settings.get("gamma", sea.gamma)
@@ -64,7 +64,7 @@ def spectral_row(plant, wave, rms, gains, duration: float, amplitudes: str, n_va
     mean power / sqrt(n)), "bandwidth_hz" (Bendat & Piersol's B_s of the power density),
     "expected_power_W" (linear theory's expected power: for a spread sea weighted over
     directions, `expected_power`)."""
-    from ...analysis.power_statistics import record_power_statistics
+    from ...analysis import record_power_statistics
     amplitude = rms if amplitudes == "random" else wave.amplitude
     stats = record_power_statistics(plant, wave.omega, amplitude, gains,
                                     (wave.ramp_time, duration), amplitudes=amplitudes,
@@ -88,7 +88,7 @@ def expected_power(plant, wave, gains, *, params=None, statespace: bool = False)
     sea's (settings with a spreading): the expected power, weighted over directions
     (`directional.spread_power`), not its realisation's one direction per component."""
     from ...analysis import linearize, statespace_response
-    from ...analysis.power_statistics import law_params, law_responses
+    from ...analysis import law_params, law_responses
     a2 = np.asarray(wave.amplitude, float) ** 2
     if wave.directional and "spreading" in wave.settings:   # a spread sea: over directions
         from ...analysis import excitation_transfer

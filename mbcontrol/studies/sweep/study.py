@@ -36,7 +36,7 @@ def sweep(model: str, seas, *, seeds: int = 1, vary: dict | None = None, params=
     worker per core, N workers; scheduler: a Dask scheduler address; store: a folder (resume:
     finished cases are not run again; `<store>/sweep.nc` holds the Dataset); width: the
     characteristic width (m) for the capture width ratio. design: the controller is tuned for
-    each sea (controllers.sea_design; per sea "settings", "bound_W", "percent_of_bound" in the
+    each sea (studies.design.sea; per sea "settings", "bound_W", "percent_of_bound" in the
     summary); robust: a reactive law tuned within the robustness floors; amplitudes:
     "deterministic" (the expected power) or "random" (Rayleigh: a record's statistics;
     waves.irregular). With several seeds each sea gets its standard error and 95 % interval
@@ -60,7 +60,7 @@ def sweep(model: str, seas, *, seeds: int = 1, vary: dict | None = None, params=
     if robust and not design:
         raise InputError("--robust tunes within the robustness floors: it goes with --design")
     if design:
-        from mbcontrol.controllers.sea_design import DESIGNABLE
+        from mbcontrol.studies.design import DESIGNABLE
         if controller not in DESIGNABLE:
             raise InputError(f"--design tunes a controller for each sea: give --controller, one "
                              f"of {', '.join(DESIGNABLE)} (got {controller})")

@@ -1,4 +1,4 @@
-"""controllers.design and controllers.margins on the 10 m heaving hemisphere (`sphere`).
+"""studies.design and controllers.margins on the 10 m heaving hemisphere (`sphere`).
 
 References that do not come from the code under test: the complex-conjugate bound and the
 intrinsic impedance written out here from the hydro data, Z_i = B + i (omega (m + A) - K /
@@ -22,10 +22,10 @@ from mbcontrol import waves
 from mbcontrol.analysis import pto_metrics
 from mbcontrol.cli import main
 from mbcontrol.controllers import make
-from mbcontrol.controllers.design import design
 from mbcontrol.controllers.impedance import intrinsic_impedance
 from mbcontrol.controllers.margins import loop_margins
 from mbcontrol.plant import build_plant
+from mbcontrol.studies.design import design
 from sphere_reference import heave_impedance
 
 H, T = 2.5, 9.6664     # m, s: the regular wave of the brief; the sphere's T_n is 4.36 s

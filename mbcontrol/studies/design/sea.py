@@ -1,5 +1,5 @@
 """A controller designed for one sea of a sweep (`mbcontrol sweep --design`): its settings
-tuned as `design` tunes them (controllers.design_tuning.tune, the PTO's limits and the linear
+tuned as `design` tunes them (studies.design.tuning.tune, the PTO's limits and the linear
 model's envelope respected), and the bound the same envelope sets (analysis.envelope)."""
 from __future__ import annotations
 
@@ -20,9 +20,9 @@ def design_for_sea(plant, wave, name: str, dt: float | None = None,
     made, "envelope": the tuner's verdict (inside, ratio, reason), "robustness": the linear
     laws' margins against controllers.robustness' floors (None for the others), "notes"}.
     JSON-ready. robust: a reactive law tuned within those floors."""
-    from mbcontrol.analysis.envelope import envelope_bound
+    from ...analysis import envelope_bound
 
-    from .design_tuning import tune
+    from .tuning import tune
     if name not in DESIGNABLE:
         raise ControllerError(f"--design: {name!r} has no tuner; expected one of "
                               f"{', '.join(DESIGNABLE)}")
@@ -38,17 +38,16 @@ def design_for_sea(plant, wave, name: str, dt: float | None = None,
         bound = envelope_bound(plant, wave, ptos[0].name)
         bound["kind"] = "complex-conjugate bound within the envelope (analysis.envelope)"
     else:
-        from mbcontrol.analysis.ports import multiport_bound
+        from mbcontrol.analysis import multiport_bound
         bound = {"bound_W": multiport_bound(plant, wave).power,
                  "kind": "multiport complex-conjugate bound (no envelope: several PTOs)"}
     envelope = tuner.get("envelope") or {"inside": None,
                                          "reason": f"{name}'s tuner does not take the envelope"}
     robust = None
     if name in ("passive", "reactive") and len(ptos) == 1:   # the floors of `design`
-        from .margins import loop_margins
-        from .robustness import robustness
+        from ...controllers import loop_margins, loop_robustness
         gains = {k: parameters[k] for k in ("damping", "stiffness") if k in parameters}
-        robust = robustness(loop_margins(plant, gains, pto=ptos[0].name))
+        robust = loop_robustness(loop_margins(plant, gains, pto=ptos[0].name))
     return jsonable({"settings": parameters, "predicted_W": predicted,
                      "bound_W": bound["bound_W"], "bound": bound, "envelope": envelope,
                      "robustness": robust, "notes": notes})

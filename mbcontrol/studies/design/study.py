@@ -54,8 +54,8 @@ import numpy as np
 from mbcontrol.errors import ControllerError, SimulationError
 from mbcontrol.results import jsonable
 
-from . import REGISTRY, make
-from .design_tuning import CONTRACT, tune
+from ...controllers import REGISTRY, make
+from .tuning import CONTRACT, tune
 
 MAX_HARMONICS = 25            # the constrained bound's QP stays < 0.1 s (0.07 s at 15)
 SETTLE_TIME_CONSTANTS = 12      # e^-12 = 6e-6: the start-up transient left in the window
@@ -171,7 +171,7 @@ def design(plant, wave, name: str, *, pto: str | None = None, simulate_s: float 
     # the other PTOs as the controller closes them: the same plant for margins and bounds
     others = None
     if linear and many:
-        from .joint import other_laws
+        from ...controllers import other_laws
         others = other_laws(plant, parameters, pto_obj.name)
         tuner["other_ptos"] = (f"{len(plant.scene.ptos)} PTOs tuned jointly for their total "
                                f"power; the prediction, bound, margins and simulation of "
@@ -182,14 +182,14 @@ def design(plant, wave, name: str, *, pto: str | None = None, simulate_s: float 
 
     margins = None
     if linear:
-        from .margins import loop_margins
+        from ...controllers import loop_margins
         gains = {k: parameters[k] for k in CONTRACT[name]}
         margins = loop_margins(plant, gains, pto=pto_obj.name, params=others)
         if not margins.stable:
             notes.append(f"{name}: the closed loop is unstable on the plant, so it was not "
                          f"simulated. {margins.message}")
-        from .robustness import robustness, share_explained
-        tuner["robustness"] = robustness(margins)
+        from ...controllers import loop_robustness, share_explained
+        tuner["robustness"] = loop_robustness(margins)
         if margins.stable and not tuner["robustness"]["meets"]:
             notes.append(f"{name}: below the robustness floors: "
                          f"{tuner['robustness']['why']}")
@@ -206,7 +206,7 @@ def design(plant, wave, name: str, *, pto: str | None = None, simulate_s: float 
         bound.update(complex_conjugate_W=None, constrained_W=None,
                      constrained_reason=tuner["other_ptos"])
     if many and bounds:
-        from mbcontrol.analysis.ports import multiport_bound
+        from mbcontrol.analysis import multiport_bound
         bound["total_complex_conjugate_W"] = multiport_bound(plant, wave).power
 
     metrics = simulation = ds = None
@@ -301,7 +301,7 @@ def _bounds(plant, wave, pto, limit_values, mode, params=None, whole=False) -> d
         out["constrained_reason"] = "bounds not requested"
         return out
     from mbcontrol.analysis import complex_conjugate_bound
-    from mbcontrol.analysis.constrained import constrained_figure, window_share
+    from ...analysis import constrained_figure, window_share
     try:
         cc = complex_conjugate_bound(plant, wave, pto, params)
     except ValueError as exc:          # NotPassiveError, a wave outside the data, ...
@@ -310,11 +310,11 @@ def _bounds(plant, wave, pto, limit_values, mode, params=None, whole=False) -> d
     out["complex_conjugate_W"] = cc.power
     force_max, stroke_max = limit_values["force_max"], limit_values["stroke_max"]
     if next(p for p in plant.scene.ptos if p.name == pto).drivetrain is not None:
-        from .impedance import electrical_optimum     # limits only lower it: still a bound
+        from ...controllers import electrical_optimum     # limits only lower it: still a bound
         out["electrical_W"] = electrical_optimum(plant, wave, pto=pto, params=params)["power_W"]
         out["electrical_within_limits"] = False
         if wave.omega.size == 1 and (math.isfinite(force_max) or math.isfinite(stroke_max)):
-            from mbcontrol.analysis.electrical import electrical_bound   # within the limits
+            from mbcontrol.analysis import electrical_bound   # within the limits
             out["electrical_W"] = electrical_bound(
                 plant, wave, pto=pto, force_max=force_max, stroke_max=stroke_max, params=params,
                 omega_max=float(plant.hydro.omega[-1])).electrical_W

@@ -1,19 +1,15 @@
-"""Tuning by controller name for `controllers.design`: each controller's tuner, the PTO's
-limits handed to the tuners that take them, and the parameters that rebuild the controller
-(`make(name, **parameters)`). See controllers.design for what the limits mean."""
+"""Tuning by controller name for `design`: each controller's tuner, the PTO's limits handed to
+the tuners that take them, and the parameters that rebuild the controller
+(`make(name, **parameters)`). See `studies.design.study` for what the limits mean."""
 from __future__ import annotations
 
 import inspect
 import math
 
-from mbcontrol.results import jsonable
-
-from mbcontrol.analysis.envelope import ENVELOPE_SHARE
-from mbcontrol.errors import ControllerError
-
-from . import REGISTRY, make
-from .limits import command_limit
-from .tuning import OutsideEnvelope
+from ...analysis import ENVELOPE_SHARE
+from ...controllers import REGISTRY, OutsideEnvelope, command_limit, make
+from ...errors import ControllerError
+from ...results import jsonable
 
 # the tuned parameters of each controller (the contract of make(name, **parameters))
 CONTRACT = {"passive": ("damping",), "reactive": ("damping", "stiffness"),
@@ -67,8 +63,7 @@ def tune(plant, wave, name, pto_obj, limits, model_params, notes, robust: bool =
                          "are reported)")
         return _tune_jointly(plant, wave, name, limits, model_params, own, extra)
     if name in ("passive", "reactive"):
-        from .passive import optimal_damping
-        from .reactive import reactive_tuning
+        from ...controllers import optimal_damping, reactive_tuning
         tuner = optimal_damping if name == "passive" else reactive_tuning
         kw = _limit_kwargs(tuner, finite, tuner.__name__, notes)
         if pto_obj.efficiency != 1 and _accepts(tuner, "efficiency"):
@@ -98,7 +93,7 @@ def tune(plant, wave, name, pto_obj, limits, model_params, notes, robust: bool =
             tuned["stiffness"] = stiffness
         return {**tuned, **own}, predicted, info, extra
     if name in ("latching", "declutching"):
-        from .latching import optimal_declutch, optimal_latch_time
+        from ...controllers import optimal_declutch, optimal_latch_time
         if model_params:
             raise ControllerError("model_params: latching and declutching tune by simulating the "
                                   "plant itself")
@@ -133,8 +128,7 @@ def tune(plant, wave, name, pto_obj, limits, model_params, notes, robust: bool =
 def _tune_jointly(plant, wave, name, limits, model_params, own, extra):
     """Every PTO tuned together for their total power (controllers.joint), each with its
     own law and, with limits, its own force and stroke limits."""
-    from .joint import joint_tuning
-    from .limits import linear_range
+    from ...controllers import joint_tuning, linear_range
     ptos = plant.scene.ptos
     kw = {}
     if limits:       # a stroke the scene leaves free: within the linear model's range
