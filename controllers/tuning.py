@@ -57,8 +57,6 @@ def constrained_tuning(plant, wave, *, pto: str | None = None, params=None,
     carries the damper that comes closest (`fallback`, `ratio`), for a caller that flags the
     sea rather than stops.
     """
-    from scipy.optimize import minimize_scalar
-
     name = pto or plant.scene.ptos[0].name
     Z, F = intrinsic_impedance(plant, wave.omega, pto=name, params=params,
                                direction=wave.direction)
@@ -95,7 +93,23 @@ def constrained_tuning(plant, wave, *, pto: str | None = None, params=None,
         bounds = default_bounds(plant, wave, name, base_params(plant, name, params))
     x = np.linspace(np.log(bounds[0]), np.log(bounds[1]), 400)
     objective, feasible, st = evaluate(np.exp(x), 0.0)
-    if env is not None and not feasible.any():
+    if not feasible.any():
+        _no_feasible_damper(plant, x, st, bounds=bounds, env=env, Z=Z, F=F, wave=wave,
+                            f_max=f_max, s_max=s_max, rated_power=rated_power, key=key)
+    best_x = _best_on_grid(evaluate, x, objective, feasible)
+    c_passive = float(np.exp(best_x))
+    if passive:
+        return c_passive, 0.0, float(evaluate(c_passive, 0.0)[2]["power_W"])
+    c, k = _best_spring_damper(plant, name, params, evaluate, bounds=bounds, best_x=best_x,
+                               Z=Z, F=F, wave=wave, min_margin=min_margin)
+    return c, k, float(evaluate(c, k)[2]["power_W"])
+
+
+def _no_feasible_damper(plant, x, st, *, bounds, env, Z, F, wave, f_max, s_max, rated_power,
+                        key):
+    """Raise why no damper on the log grid `x` is feasible: OutsideEnvelope, with the closest
+    damper, when the limits can be met but the envelope cannot; else ControllerError."""
+    if env is not None:
         limited = (st["force_peak"] <= f_max) & (st["stroke_peak"] <= s_max)
         if rated_power is not None:
             limited = limited & (st[key] <= rated_power)
@@ -110,11 +124,16 @@ def constrained_tuning(plant, wave, *, pto: str | None = None, params=None,
                             f"{r['limit']:.3g}, {r['source']})" for r in worst),
                 fallback=(c, 0.0, float(st["power_W"][j])),
                 ratio=float(st["envelope_ratio"][j]))
-    if not feasible.any():
-        raise ControllerError(
-            f"{plant.name}: no damping in {bounds[0]:.4g}..{bounds[1]:.4g} keeps the predicted "
-            f"peaks within force_max {f_max:.4g} and stroke_max {s_max:.4g} (least force peak "
-            f"{st['force_peak'].min():.4g}, least stroke peak {st['stroke_peak'].min():.4g})")
+    raise ControllerError(
+        f"{plant.name}: no damping in {bounds[0]:.4g}..{bounds[1]:.4g} keeps the predicted "
+        f"peaks within force_max {f_max:.4g} and stroke_max {s_max:.4g} (least force peak "
+        f"{st['force_peak'].min():.4g}, least stroke peak {st['stroke_peak'].min():.4g})")
+
+
+def _best_on_grid(evaluate, x, objective, feasible) -> float:
+    """The best feasible log damping, refined: Brent's method between its neighbours when both
+    are feasible, else bisection towards the infeasible one (the optimum is on the edge)."""
+    from scipy.optimize import minimize_scalar
     j = int(np.argmax(np.where(feasible, objective, -np.inf)))
     best_x = x[j]
     inside = 0 < j < x.size - 1
@@ -132,10 +151,14 @@ def constrained_tuning(plant, wave, *, pto: str | None = None, params=None,
                 lo, hi = (mid, hi) if evaluate(np.exp(mid), 0.0)[1] else (lo, mid)
             if evaluate(np.exp(lo), 0.0)[0] >= objective[j]:
                 best_x = lo
-    c_passive = float(np.exp(best_x))
-    if passive:
-        return c_passive, 0.0, float(evaluate(c_passive, 0.0)[2]["power_W"])
+    return best_x
 
+
+def _best_spring_damper(plant, name, params, evaluate, *, bounds, best_x, Z, F, wave,
+                        min_margin) -> tuple[float, float]:
+    """(damping, stiffness): a damping-stiffness grid's best stable feasible point and the
+    passive optimum (log damping `best_x`) start a Nelder-Mead search in (log c, k / k_s)."""
+    w = np.asarray(wave.omega, float)
     margin = margin_function(plant, name, params)
     j = int(np.argmax(np.abs(F * wave.amplitude)))
     k_scale = max(abs(float(w[j] * Z[j].imag)), float(np.median(np.abs(w * Z))))
@@ -163,7 +186,7 @@ def constrained_tuning(plant, wave, *, pto: str | None = None, params=None,
     c, k = float(np.exp(best.x[0])), float(best.x[1] * k_scale)
     if not np.isfinite(best.fun):
         raise ControllerError(f"{plant.name}: no stable spring-damper meets the limits")
-    return c, k, float(evaluate(c, k)[2]["power_W"])
+    return c, k
 
 
 def _loop_distance(plant, name: str, params, wave, n: int = 300):

@@ -17,6 +17,7 @@ import numpy as np  # noqa: E402
 
 from .atomic import atomic_path
 from .lti import frequency_response
+from .results import record
 
 
 def save(fig, path) -> Path:
@@ -113,21 +114,18 @@ INVALID_FACE = "#fde4e4"        # axes of a result that failed its physics check
 def result_label(ds) -> str:
     """What a reader must know about a result beside its numbers: INVALID (failed its physics
     checks) and oracle (a controller that saw the future wave), or ''."""
-    import json
     notes = []
     if ds.attrs.get("valid", 1) == 0:
-        notes.append("INVALID: " + "; ".join(json.loads(ds.attrs.get("invalid_reasons", "[]"))))
-    controller = json.loads(ds.attrs.get("controller", "null") or "null") or {}
-    if controller.get("oracle"):
+        notes.append("INVALID: " + "; ".join(record(ds.attrs, "invalid_reasons", [])))
+    if (record(ds.attrs, "controller") or {}).get("oracle"):
         notes.append("oracle forecast: a non-causal upper bound")
     return " | ".join(notes)
 
 
 def _window_start(ds) -> float:
     """Where the statistics start (s): after the wave's ramp and the controller's warm-up."""
-    import json
-    wave = json.loads(ds.attrs.get("wave", "{}") or "{}")
-    controller = json.loads(ds.attrs.get("controller", "null") or "null") or {}
+    wave = record(ds.attrs, "wave", {})
+    controller = record(ds.attrs, "controller") or {}
     return max(float(wave.get("ramp_s", 0.0) or 0.0),
                float(controller.get("warm_up_s", 0.0) or 0.0))
 
@@ -135,9 +133,8 @@ def _window_start(ds) -> float:
 def mark_result(ds, axes, title_ax) -> None:
     """Shade what the statistics leave out (the wave's ramp, the controller's warm-up) and
     mark an invalid or oracle result on its axes (red faces, a note under the title)."""
-    import json
     import textwrap
-    wave = json.loads(ds.attrs.get("wave", "{}") or "{}")
+    wave = record(ds.attrs, "wave", {})
     start = _window_start(ds)
     first = float(ds["time"].values[0])
     for ax in np.ravel(axes):

@@ -1,6 +1,12 @@
-"""Results on disk: one netCDF codec for every file mbcontrol writes (hydrodynamic caches,
-`simulate --out`, sweeps, benchmarks), each written to a temporary file and renamed, so
-nothing half-written; and `jsonable`, the one conversion of results to strict JSON.
+"""Results: the run record that travels with a run (`RunInfo`, read by `run_info`); one netCDF
+codec for every file mbcontrol writes (hydrodynamic caches, `simulate --out`, sweeps,
+benchmarks), each written to a temporary file and renamed, so nothing half-written; and
+`jsonable`, the one conversion of results to strict JSON.
+
+A run's record lives in its Dataset's attrs as Python values (dicts, lists), never as JSON
+strings inside a process: JSON appears only in files, where `write_dataset` encodes it and
+`read_dataset` decodes it. Save a run with `write_dataset` (or `mbcontrol simulate --out`);
+xarray's own `to_netcdf` cannot store dict attributes.
 
 netCDF cannot hold complex numbers, booleans, dictionaries or (portably) infinite
 attributes. They are encoded on write and decoded on read, so that
@@ -8,13 +14,14 @@ attributes. They are encoded on write and decoded on read, so that
 
 - a complex variable gets a leading dimension ``complex = ["re", "im"]`` (Capytaine's own
   convention, so ``capytaine.io.xarray.merge_complex_values`` reads it too);
-- attributes that are bool, dict, list, tuple or non-finite float are stored as strings,
+- attributes that are bool, None, dict, list, tuple or non-finite float are stored as strings,
   and their original type is recorded in the attribute ``mbc_encoded_attrs`` (JSON).
 """
 from __future__ import annotations
 
 import json
 import math
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -28,6 +35,52 @@ ENCODED_ATTRS = "mbc_encoded_attrs"
 
 class DataFileError(MbcontrolError, ValueError):
     """A results file cannot be read: names the file and what was expected."""
+
+
+@dataclass(frozen=True)
+class RunInfo:
+    """What made a run and how it is scored: model (its name); wave (Wave.describe(); type
+    "none" without one); parameters (the plant's values the run used, by name, SI);
+    controller (its describe(), None when the scene's own PTO laws ran); estimator (its
+    accuracy report, or None); sampled_loop (mbcontrol.sim.sampled's verdict on the held
+    loop, or None); statistics_from_s and statistics_note (where the metrics' window starts
+    and why, when a caller chose it; None: the default window)."""
+    model: str
+    wave: dict
+    parameters: dict
+    controller: dict | None = None
+    estimator: dict | None = None
+    sampled_loop: dict | None = None
+    statistics_from_s: float | None = None
+    statistics_note: str | None = None
+
+    @property
+    def warm_up_s(self) -> float:
+        """The controller's warm-up (s): the metrics' window starts after it."""
+        return float((self.controller or {}).get("warm_up_s") or 0.0)
+
+
+def run_info(ds) -> RunInfo:
+    """The run record of a Dataset made by `simulate` (or a sweep's light run), as it is in a
+    process or as read from a file (a file opened by plain xarray holds JSON strings)."""
+    attrs = ds.attrs
+    start = attrs.get("statistics_from_s")
+    return RunInfo(model=str(attrs.get("model", "")),
+                   wave=record(attrs, "wave", {"type": "none"}),
+                   parameters=record(attrs, "parameters", {}),
+                   controller=record(attrs, "controller"), estimator=record(attrs, "estimator"),
+                   sampled_loop=record(attrs, "sampled_loop"),
+                   statistics_from_s=None if start is None else float(start),
+                   statistics_note=attrs.get("statistics_note"))
+
+
+def record(attrs: dict, key: str, default=None):
+    """attrs[key] as a Python value: a dict or list as stored in a process, a JSON string as
+    plain xarray reads it from a file; `default` when absent or null."""
+    value = attrs.get(key)
+    if isinstance(value, str):
+        value = json.loads(value)
+    return default if value is None else value
 
 
 def jsonable(obj):
@@ -138,7 +191,7 @@ def _encode_attrs(attrs: dict) -> dict:
     for k, v in attrs.items():
         if isinstance(v, (bool, np.bool_)):
             out[k], kinds[k] = int(bool(v)), "bool"
-        elif isinstance(v, (dict, list, tuple)):
+        elif v is None or isinstance(v, (dict, list, tuple)):
             out[k], kinds[k] = json.dumps(v), "json"
         elif isinstance(v, (float, np.floating)) and not math.isfinite(float(v)):
             out[k], kinds[k] = repr(float(v)), "float"  # 'inf', '-inf', 'nan'

@@ -15,12 +15,12 @@ continuously (the scene's own PTO law, no controller) is integrated by the trape
 """
 from __future__ import annotations
 
-import json
 import math
 
 import numpy as np
 
 from ..errors import InputError
+from ..results import record, run_info
 
 
 _BODY_KEYS = {"Surge": "surge_amplitude_m", "Sway": "sway_amplitude_m",
@@ -43,22 +43,23 @@ def analysis_window(ds) -> np.ndarray:
 def statistics_window(ds) -> dict:
     """{"start_s", "note"}: where the statistics start (s) and why. Regular wave: the last 10
     periods; a sea: after the ramp; either way not before the controller's warm-up ends
-    (its describe()["warm_up_s"] in ds.attrs["controller"]). A caller may set the start in
-    ds.attrs["statistics_from_s"] with its reason in ds.attrs["statistics_note"] (design
-    scores a sea over its last whole repeat period, as the bounds it is compared with)."""
+    (the run record's controller, mbcontrol.results.RunInfo). A caller may set the start in
+    the record, ds.attrs["statistics_from_s"] with its reason in ds.attrs["statistics_note"]
+    (design scores a sea over its last whole repeat period, as the bounds it is compared
+    with)."""
     t = ds["time"].values
-    wave = json.loads(ds.attrs.get("wave", "{}"))
-    if "statistics_from_s" in ds.attrs:
-        start = float(ds.attrs["statistics_from_s"])
-        note = str(ds.attrs.get("statistics_note", "set by the caller"))
+    run = run_info(ds)
+    wave = record(ds.attrs, "wave", {})
+    if run.statistics_from_s is not None:
+        start = run.statistics_from_s
+        note = str(run.statistics_note or "set by the caller")
     elif wave.get("type") == "regular":
         start = float(t[-1] - 10 * wave["period"])
         note = "the last 10 wave periods"
     else:
         start = float(wave.get("ramp_s", 0.0) or 0.0)
         note = f"after the wave's ramp ({start:.4g} s)" if start > 0 else "the whole record"
-    controller = json.loads(ds.attrs.get("controller", "null") or "null")
-    warm_up = controller.get("warm_up_s") if isinstance(controller, dict) else None
+    warm_up = run.warm_up_s
     if warm_up:
         note += f", and after the controller's warm-up ({float(warm_up):.4g} s)"
         if float(warm_up) > start:
@@ -81,7 +82,7 @@ def step_power(ds, pto: str) -> tuple[np.ndarray, np.ndarray]:
     """
     t = ds["time"].values
     force, x = ds[f"{pto}__force"].values, ds[f"{pto}__position"].values
-    held = json.loads(ds.attrs.get("controller", "null")) is not None
+    held = record(ds.attrs, "controller") is not None
     f = force[:-1] if held else 0.5 * (force[:-1] + force[1:])
     return t[:-1], -f * np.diff(x) / np.diff(t)
 
@@ -168,7 +169,7 @@ def pto_metrics(ds, pto, start: float | None = None, end: float | None = None) -
         "violation_fraction": float(outside.mean()),
         # the run's physics verdict when it has one (mbcontrol.analysis.validity.assess)
         **({"valid": bool(ds.attrs["valid"]),
-            "invalid_reasons": json.loads(ds.attrs.get("invalid_reasons", "[]"))}
+            "invalid_reasons": record(ds.attrs, "invalid_reasons", [])}
            if "valid" in ds.attrs else {}),
     }
 

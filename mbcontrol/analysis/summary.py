@@ -2,11 +2,11 @@
 provenance, in one dict (`summary`)."""
 from __future__ import annotations
 
-import json
+import copy
 
 import numpy as np
 
-from ..results import jsonable
+from ..results import jsonable, record, run_info
 from .metrics import _BODY_KEYS, analysis_window, pto_metrics, signal_stats, statistics_window
 from .validity import assess
 
@@ -22,17 +22,17 @@ def summary(ds, plant) -> dict:
         bodies[body] = {key: 0.5 * float(np.ptp(ds[f"{body}__{dof}"].values[mask]))
                         for dof, key in _BODY_KEYS.items()}
     verdict = _verdict(ds, plant)
+    run = copy.deepcopy(run_info(ds))      # the summary is the caller's to change
     ptos = {pto.name: jsonable({**pto_metrics(ds, pto), "valid": verdict["valid"],
                                 "invalid_reasons": verdict["invalid_reasons"]})
             for pto in plant.scene.ptos}
     return {"model": ds.attrs["model"], "valid": verdict["valid"],
             "invalid_reasons": verdict["invalid_reasons"],
-            "validity_warnings": verdict["warnings"], "wave": json.loads(ds.attrs["wave"]),
+            "validity_warnings": verdict["warnings"], "wave": run.wave,
             "duration_s": float(ds.attrs["duration_s"]), "dt_s": float(ds.attrs["dt_s"]),
             "wall_time_s": float(ds.attrs["wall_time_s"]), "method": ds.attrs["method"],
             "window_start_s": stats_window["start_s"], "window": stats_window["note"],
-            "controller": json.loads(ds.attrs.get("controller", "null")),
-            "estimator": json.loads(ds.attrs.get("estimator", "null")),
+            "controller": run.controller, "estimator": run.estimator,
             "provenance": {k: ds.attrs.get(k) for k in ("scene_sha256", "hydro_sha256",
                                                         "radiation_sha256")},
             "dofs": dofs, "bodies": bodies, "ptos": ptos,
@@ -43,7 +43,7 @@ def _verdict(ds, plant) -> dict:
     """The Dataset's validity verdict: the one in its attrs, else assessed now."""
     if "valid" in ds.attrs:
         return {"valid": bool(ds.attrs["valid"]),
-                "invalid_reasons": json.loads(ds.attrs["invalid_reasons"]),
-                "warnings": json.loads(ds.attrs.get("validity_warnings", "[]")),
-                "checks": json.loads(ds.attrs.get("validity", "{}"))}
+                "invalid_reasons": list(record(ds.attrs, "invalid_reasons", [])),
+                "warnings": list(record(ds.attrs, "validity_warnings", [])),
+                "checks": copy.deepcopy(record(ds.attrs, "validity", {}))}
     return assess(ds, plant)

@@ -35,12 +35,12 @@ attrs; `assess_values` works on plain numbers, for callers that keep no Dataset;
 from __future__ import annotations
 
 import dataclasses
-import json
 import math
 
 import numpy as np
 
 from ..plant import derived
+from ..results import jsonable, record
 
 POWER_ALLOWANCE = 0.10            # share above the bound a reported mean power may reach
 ENERGY_TOLERANCE = 0.05           # of the excitation's absolute work over the record
@@ -56,7 +56,7 @@ def wave_of(ds):
     from ..waves import Wave
     if "wave_omega" not in ds:
         return None
-    desc = json.loads(ds.attrs.get("wave", "{}"))
+    desc = record(ds.attrs, "wave", {})
     return Wave(desc.get("type", "components"), ds["wave_omega"].values,
                 ds["wave_amplitude"].values, ds["wave_phase"].values,
                 direction=float(desc.get("direction_rad", 0.0)),
@@ -239,7 +239,7 @@ def energy_record(plant, ds):
 
 def assess(ds, plant, wave=None, *, mean_power_W: float | None = None) -> dict:
     """Check a simulated Dataset (see the module doc); the verdict goes into ds.attrs
-    ("valid": 1/0, "invalid_reasons" and "validity" as JSON) and is returned. mean_power_W:
+    ("valid": 1/0, "invalid_reasons", "validity_warnings" and "validity") and is returned. mean_power_W:
     the PTOs' total over the metrics window when the caller has it already (W)."""
     from .metrics import analysis_window, pto_metrics
     wave = wave if wave is not None else wave_of(ds)
@@ -247,11 +247,12 @@ def assess(ds, plant, wave=None, *, mean_power_W: float | None = None) -> dict:
     t = ds["time"].values[mask]
     power = mean_power_W if mean_power_W is not None else sum(
         pto_metrics(ds, pto)["mean_power_W"] for pto in plant.scene.ptos)
-    params = np.array([json.loads(ds.attrs["parameters"])[name] for name in plant.parameters])
+    ran_with = record(ds.attrs, "parameters")
+    params = np.array([ran_with[name] for name in plant.parameters])
     verdict = assess_values(plant, wave, params, window=(float(t[0]), float(ds["time"][-1])),
                             mean_power_W=power, energy=energy_record(plant, ds),
                             excursions=excursions(plant, ds, wave, mask))
-    loop = json.loads(ds.attrs.get("sampled_loop", "null"))
+    loop = record(ds.attrs, "sampled_loop")
     if loop is not None and not loop["stable"]:       # sim.sampled, checked before the run
         verdict["valid"] = False
         verdict["invalid_reasons"].append(f"sampled control loop: {loop['message']}")
@@ -277,12 +278,12 @@ def simulate_checked(plant, wave=None, **options):
 
 
 def mark(ds, verdict: dict) -> None:
-    """Write a verdict into a Dataset's attrs."""
-    from ..results import jsonable
+    """Write a verdict into a Dataset's attrs (Python values: mbcontrol.results encodes them in
+    a file)."""
     ds.attrs["valid"] = int(verdict["valid"])
-    ds.attrs["invalid_reasons"] = json.dumps(verdict["invalid_reasons"])
-    ds.attrs["validity_warnings"] = json.dumps(verdict.get("warnings", []))
-    ds.attrs["validity"] = json.dumps(jsonable(verdict["checks"]))
+    ds.attrs["invalid_reasons"] = list(verdict["invalid_reasons"])
+    ds.attrs["validity_warnings"] = list(verdict.get("warnings", []))
+    ds.attrs["validity"] = jsonable(verdict["checks"])
 
 
 def _watts(value: float) -> str:

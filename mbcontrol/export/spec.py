@@ -140,7 +140,8 @@ def _switching_spec(c, plant) -> ControllerSpec:
         settings=c.describe())
 
 
-def _mpc_spec(c, plant) -> ControllerSpec:
+def _check_exportable_mpc(c) -> None:
+    """Refuse an MPC the C engine cannot run as a device would."""
     if c.forecast == "known" or c.uses_state:
         raise InputError("export: this MPC is an oracle (forecast 'known' or estimator "
                          "'state'): it needs the future wave or the whole plant state, which a "
@@ -151,6 +152,10 @@ def _mpc_spec(c, plant) -> ControllerSpec:
                          "yet; export one without it (--set envelope=false, "
                          "make('mpc', ..., envelope=False)) and keep the device in range "
                          "another way")
+
+
+def _mpc_spec(c, plant) -> ControllerSpec:
+    _check_exportable_mpc(c)
     cp, qp, kal = c.cp, c.qp, c.kalman
     outputs = list(plant.outputs)
     names = list(cp.ptos)
@@ -162,7 +167,6 @@ def _mpc_spec(c, plant) -> ControllerSpec:
     ar = c.ar
     ar_order = ar.order if ar is not None else 1
     window = ar.window if ar is not None else 1
-    nv = N * nu
     forms = qp.forms
     arrays = {
         "MBC_KALMAN_INDEX": ("int", [inputs.index(n) for n in kalman_inputs]),
@@ -175,17 +179,7 @@ def _mpc_spec(c, plant) -> ControllerSpec:
         "MBC_STROKE": ("double", qp.stroke), "MBC_RATE": ("double", qp.rate),
         "MBC_FORCE_MAX": ("double", c.limits["force"]),
     }
-    form_rows = []
-    for i, form in enumerate(forms):
-        start, col, val = sparse_rows(form.A)
-        arrays.update({f"MBC_F{i}_H": ("double", form.H), f"MBC_F{i}_ASTART": ("int", start),
-                       f"MBC_F{i}_ACOL": ("int", col), f"MBC_F{i}_AVAL": ("double", val)})
-        for part in ("lbx", "ubx", "g_slack"):
-            arrays[f"MBC_F{i}_{part.upper()}"] = ("double", getattr(form, part))
-        form_rows.append(f"{{{form.n_var}, {form.A.shape[0]}, {int(form.soft)}, "
-                         + ", ".join(f"MBC_F{i}_{p}" for p in
-                                     ("H", "ASTART", "ACOL", "AVAL", "LBX", "UBX", "G_SLACK"))
-                         + "}")
+    form_rows = _qp_form_arrays(forms, arrays)
     nv_max = max(f.n_var for f in forms)
     na_max = max(max(f.A.shape[0] for f in forms), 1)
     warm = [float(v) for v in c.warm_up_damping]
@@ -209,20 +203,46 @@ def _mpc_spec(c, plant) -> ControllerSpec:
         "MBC_NFORMS": str(len(forms)),
         "MBC_QP_ITER_PER_VARIABLE": str(QP_MAX_ITER_PER_VARIABLE),
     }
-    context = "\n    ".join([
-        f"double params[{len(params)}];",
-        f"double s[{kal.Phi.shape[0]}], u_prev[{nu}], first_t, next_t, warm_up_end;",
+    context = _mpc_context(n_params=len(params), n_kalman=kal.Phi.shape[0], nu=nu, nd=nd, N=N,
+                           ar_order=ar_order, window_max=window_max, nv_max=nv_max,
+                           na_max=na_max, n_forms=len(forms))
+    return ControllerSpec("mpc", "mpc", inputs, [f"u__{n}" for n in names], params,
+                          defines=defines, arrays=arrays, engine=["mbc_mpc.c", "mbc_qp.c"],
+                          context=context, settings={**c.describe(), "forms": form_rows})
+
+
+def _qp_form_arrays(forms, arrays: dict) -> list:
+    """Each QP form's matrices into `arrays` (constraint rows in compressed sparse rows); the C
+    initialisers of the forms' table."""
+    form_rows = []
+    for i, form in enumerate(forms):
+        start, col, val = sparse_rows(form.A)
+        arrays.update({f"MBC_F{i}_H": ("double", form.H), f"MBC_F{i}_ASTART": ("int", start),
+                       f"MBC_F{i}_ACOL": ("int", col), f"MBC_F{i}_AVAL": ("double", val)})
+        for part in ("lbx", "ubx", "g_slack"):
+            arrays[f"MBC_F{i}_{part.upper()}"] = ("double", getattr(form, part))
+        form_rows.append(f"{{{form.n_var}, {form.A.shape[0]}, {int(form.soft)}, "
+                         + ", ".join(f"MBC_F{i}_{p}" for p in
+                                     ("H", "ASTART", "ACOL", "AVAL", "LBX", "UBX", "G_SLACK"))
+                         + "}")
+    return form_rows
+
+
+def _mpc_context(*, n_params, n_kalman, nu, nd, N, ar_order, window_max, nv_max, na_max,
+                 n_forms) -> str:
+    """The C engine's per-instance state, sized for this MPC."""
+    nv = N * nu
+    return "\n    ".join([
+        f"double params[{n_params}];",
+        f"double s[{n_kalman}], u_prev[{nu}], first_t, next_t, warm_up_end;",
         "int has_last, warm_done, has_plan, has_coef, last_form;",
         f"double hist[{window_max * max(nd, 1)}];",
         "int hist_len, hist_start, since_fit, min_samples, window;",
         f"double coef[{max(nd, 1) * ar_order}], maps[{max(nd, 1) * (N + 1) * ar_order}];",
         f"double D[{max(N * nd, 1)}], plan[{nv}], q[{nv}], freep[{nv}];",
         f"double g[{nv_max}], x[{nv_max}], lba[{na_max}], uba[{na_max}];",
-        f"mbc_qp qp[{len(forms)}];",
-        f"double J0[{len(forms)}][{nv_max * nv_max}];",
+        f"mbc_qp qp[{n_forms}];",
+        f"double J0[{n_forms}][{nv_max * nv_max}];",
         f"double qp_work[MBC_QP_WORK({nv_max}, {na_max})];",
         f"int qp_iwork[MBC_QP_IWORK({nv_max}, {na_max})];",
         "long solves, failures, soft_solves, ar_fits, ar_unstable_fits;"])
-    return ControllerSpec("mpc", "mpc", inputs, [f"u__{n}" for n in names], params,
-                          defines=defines, arrays=arrays, engine=["mbc_mpc.c", "mbc_qp.c"],
-                          context=context, settings={**c.describe(), "forms": form_rows})

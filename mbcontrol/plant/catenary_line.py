@@ -13,8 +13,7 @@ from dataclasses import dataclass
 import casadi as ca
 import numpy as np
 
-from ..scene import Mooring
-from ..scene import catenary_geometry
+from ..scene import Mooring, catenary_geometry
 from .catenary import SYMBOLIC_OPS, CatenarySolution, shape_terms, solve_catenary
 
 

@@ -17,8 +17,7 @@ import casadi as ca
 import numpy as np
 
 from ..errors import UnknownName
-from ..hydro import HydroModel, RadiationModel, load_hydro_model
-from ..hydro import Device
+from ..hydro import Device, HydroModel, RadiationModel, load_hydro_model
 from ..multibody import Topology, build_topology
 from ..scene import DOF_NAMES, Scene, load_scene
 from . import checks, loads
@@ -122,50 +121,12 @@ def assemble_plant(scene: Scene | str, hydro: HydroModel | None = None, *,
     P = tree.P(q)
     select = dof_selector(topo, hydro_dofs)                  # 6N -> hydro DOFs
     scale = _hydro_scales(params, hydro_dofs) if hydro and hydro_corrections else None
-    added_mass = None
-    if hydro and scale is None:
-        added_mass = select.T @ hydro.added_mass_inf @ select
-    elif hydro:
-        A_inf = ca.mtimes([scale["added_mass"], ca.DM(hydro.added_mass_inf), scale["added_mass"]])
-        added_mass = ca.mtimes([ca.DM(select.T), A_inf, ca.DM(select)])
-    nu_h = ca.mtimes(select, ca.mtimes(P.T, s))
-    w_h = w if scale is None else ca.mtimes(scale["excitation"], w)
-
+    added_mass, hydro_force, chi_dot, power, radiation_apart = _hydro_loads(
+        hydro, radiation, scale, select, P, s, w, chi)
     tau = -tree.bias(q, s, added_mass)
-    chi_dot, power = ca.SX(0, 1), {"radiated_power": 0, "excitation_power": 0}
-    radiation_apart = None             # what plant.pieces needs to compile the radiation apart
-    if hydro and not radiation:
-        tau += ca.mtimes(P, ca.mtimes(select.T, w_h))
-        power = {"radiated_power": 0, "excitation_power": ca.dot(nu_h, w_h)}
-    elif hydro:
-        A_r, B_r, C_r, D_r = hydro.radiation_matrices()
-        if scale is None:
-            radiation_apart = (chi, ca.mtimes(P, select.T), nu_h, (A_r, B_r, C_r, D_r))
-        R = scale["radiation"] if scale is not None else ca.DM.eye(len(hydro_dofs))
-        nu_r = ca.mtimes(R, nu_h)           # the kernel S^1/2 K S^1/2 as a state-space model
-        mu_h = ca.mtimes(R, ca.mtimes(C_r, chi) + ca.mtimes(D_r, nu_r))
-        chi_dot = ca.mtimes(A_r, chi) + ca.mtimes(B_r, nu_r)
-        tau += ca.mtimes(P, ca.mtimes(select.T, w_h - mu_h))
-        power = {"radiated_power": ca.dot(nu_h, mu_h), "excitation_power": ca.dot(nu_h, w_h)}
-    if scene.hydro.hydrostatics == "large_angle":
-        restoring, potential = loads.large_angle_hydrostatics(scene, topo, q)
-    else:
-        restoring, potential = loads.restoring_forces(topo, q, hydro.stiffness_by_body() if hydro
-                                                      else {})
-    tau += restoring
-    tau_pto, pto_signals = loads.pto_forces(scene, topo, q, s, u, params)
-    tau += tau_pto + loads.friction_forces(scene, topo, s, params)
-    potential += loads.drivetrain_spring_energy(scene, pto_signals)
-    tau += loads.drag_forces(scene, topo, q, s, params)
-    tau_moor, mooring_energy, tensions = loads.mooring_forces(scene, topo, q, s, params)
-    tau += tau_moor
-    potential += mooring_energy
-    for conservative in (loads.end_stop_forces(scene, topo, q, s, params),
-                         loads.gravity_forces(scene, topo, q)):
-        tau += conservative[0]
-        potential += conservative[1]
-    if scene.hydro.hydrostatics == "linear":
-        tau += loads.static_loads(scene, topo, q, hydro.buoyancy(scene.water) if hydro else {})
+    if hydro_force is not None:
+        tau += hydro_force
+    tau, potential, pto_signals, tensions = _body_loads(tau, scene, topo, hydro, q, s, u, params)
     tau += _preloads(scene, topo, q, s, u, w, chi, tau, pto_signals, params)
 
     M = tree.mass_matrix(q, added_mass)
@@ -188,6 +149,57 @@ def assemble_plant(scene: Scene | str, hydro: HydroModel | None = None, *,
                         tuple(output_names), tuple(params.names), np.array(params.values),
                         f, h, notes, plant_parts([x, u, w, p], M, tau, x_dot[:tree.n_q], chi_dot,
                                                  radiation_apart))
+
+
+def _hydro_loads(hydro, radiation, scale, select, P, s, w, chi):
+    """Added mass A(inf) on the coordinates, the wave-minus-radiation force (or None), chi',
+    the radiated and excitation powers (W), what plant.pieces compiles apart."""
+    chi_dot, power = ca.SX(0, 1), {"radiated_power": 0, "excitation_power": 0}
+    if not hydro:
+        return None, None, chi_dot, power, None
+    if scale is None:
+        added_mass = select.T @ hydro.added_mass_inf @ select
+    else:
+        A_inf = ca.mtimes([scale["added_mass"], ca.DM(hydro.added_mass_inf), scale["added_mass"]])
+        added_mass = ca.mtimes([ca.DM(select.T), A_inf, ca.DM(select)])
+    nu_h = ca.mtimes(select, ca.mtimes(P.T, s))
+    w_h = w if scale is None else ca.mtimes(scale["excitation"], w)
+    if not radiation:
+        return (added_mass, ca.mtimes(P, ca.mtimes(select.T, w_h)), chi_dot,
+                {"radiated_power": 0, "excitation_power": ca.dot(nu_h, w_h)}, None)
+    A_r, B_r, C_r, D_r = hydro.radiation_matrices()
+    apart = (chi, ca.mtimes(P, select.T), nu_h, (A_r, B_r, C_r, D_r)) if scale is None else None
+    R = scale["radiation"] if scale is not None else ca.DM.eye(select.shape[0])
+    nu_r = ca.mtimes(R, nu_h)           # the kernel S^1/2 K S^1/2 as a state-space model
+    mu_h = ca.mtimes(R, ca.mtimes(C_r, chi) + ca.mtimes(D_r, nu_r))
+    chi_dot = ca.mtimes(A_r, chi) + ca.mtimes(B_r, nu_r)
+    return (added_mass, ca.mtimes(P, ca.mtimes(select.T, w_h - mu_h)), chi_dot,
+            {"radiated_power": ca.dot(nu_h, mu_h), "excitation_power": ca.dot(nu_h, w_h)}, apart)
+
+
+def _body_loads(tau, scene, topo, hydro, q, s, u, params):
+    """tau plus hydrostatics, PTOs, friction, drag, moorings, end stops, gravity (in this order:
+    the compiled code stays the same); the potential (J), PTO signals, mooring tensions."""
+    if scene.hydro.hydrostatics == "large_angle":
+        restoring, potential = loads.large_angle_hydrostatics(scene, topo, q)
+    else:
+        restoring, potential = loads.restoring_forces(topo, q, hydro.stiffness_by_body() if hydro
+                                                      else {})
+    tau += restoring
+    tau_pto, pto_signals = loads.pto_forces(scene, topo, q, s, u, params)
+    tau += tau_pto + loads.friction_forces(scene, topo, s, params)
+    potential += loads.drivetrain_spring_energy(scene, pto_signals)
+    tau += loads.drag_forces(scene, topo, q, s, params)
+    tau_moor, mooring_energy, tensions = loads.mooring_forces(scene, topo, q, s, params)
+    tau += tau_moor
+    potential += mooring_energy
+    for conservative in (loads.end_stop_forces(scene, topo, q, s, params),
+                         loads.gravity_forces(scene, topo, q)):
+        tau += conservative[0]
+        potential += conservative[1]
+    if scene.hydro.hydrostatics == "linear":
+        tau += loads.static_loads(scene, topo, q, hydro.buoyancy(scene.water) if hydro else {})
+    return tau, potential, pto_signals, tensions
 
 
 def _preloads(scene, topo, q, s, u, w, chi, tau, pto_signals, params):

@@ -23,8 +23,7 @@ import casadi as ca
 import numpy as np
 
 from ..errors import InputError
-from ..plant import derived
-from ..plant import f_by_parts
+from ..plant import derived, f_by_parts
 from .compiled import compile_function
 from .methods import METHODS, method, radiation_exponential, radiation_split
 

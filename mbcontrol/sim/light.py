@@ -15,7 +15,7 @@ here across the seeds of a sea.
 """
 from __future__ import annotations
 
-import json
+import copy
 import time
 
 import numpy as np
@@ -100,9 +100,9 @@ def simulate_arrays(plant, wave=None, *, duration: float, dt: float, method: str
     if audit:
         energy_audit(plant, t, Y, method, dt)
     attrs = {"model": plant.name, "method": method, "dt_s": dt, "duration_s": float(t[-1]),
-             "wall_time_s": wall, "controller": "null",
-             "wave": json.dumps(wave.describe() if wave is not None else {"type": "none"}),
-             "parameters": json.dumps(dict(zip(plant.parameters, map(float, p))))}
+             "wall_time_s": wall, "controller": None,
+             "wave": copy.deepcopy(wave.describe()) if wave is not None else {"type": "none"},
+             "parameters": dict(zip(plant.parameters, map(float, p)))}
     return Run(t, plant.outputs, Y, attrs)
 
 

@@ -17,7 +17,7 @@ so a positive stiffness removes damping and, with h long enough, destabilises a 
 continuous version is stable.
 
 `check` is what simulate calls for a controller with a period and a CasADi law: the verdict
-goes into the Dataset's attrs["sampled_loop"] (JSON) and analysis.validity marks the result
+goes into the Dataset's attrs["sampled_loop"] (the run record) and analysis.validity marks the result
 invalid when the loop is unstable.
 """
 from __future__ import annotations

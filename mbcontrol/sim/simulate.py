@@ -11,7 +11,7 @@ raises SimulationError naming the time, the step and a remedy.
 """
 from __future__ import annotations
 
-import json
+import copy
 import platform
 import time
 import warnings
@@ -79,8 +79,9 @@ def simulate(plant, wave=None, *, duration: float, dt: float | None = None, cont
     if spec.fixed_step:
         W_nodes = integrators.excitation_at_nodes(plant, wave, n, dt, spec.nodes)
         p_run = np.concatenate([p, gains]) if embedded and gains is not None else p
-        X, U = _run_fixed(plant, method, controller, law if embedded else None, embedded, x0,
-                          W_nodes, p_run, dt, n, compiled, check)
+        X, U = _run_fixed(plant, method, controller, x0, W_nodes, p_run, dt=dt, n=n,
+                          law=law if embedded else None, embedded=embedded, compiled=compiled,
+                          check=check)
     else:
         X, U = _run_cvodes(plant, wave, controller, x0, p, dt, n, rtol, check, method)
     wall = time.perf_counter() - start
@@ -100,16 +101,17 @@ def simulate(plant, wave=None, *, duration: float, dt: float | None = None, cont
     if audit:
         energy_audit(plant, t, Y, method, dt, why)
     eta = wave.elevation(t) if wave is not None else np.zeros_like(t)
-    ds = _dataset(plant, t, X, U_full, W, Y, eta, wave, controller, method, dt, p, wall)
+    ds = _dataset(plant, t, X, U_full, W, Y, eta, wave=wave, controller=controller,
+                  method=method, dt=dt, p=p, wall=wall)
     ds.attrs["output_time_s"] = output_wall
     if not spec.fixed_step:
         ds.attrs["rtol"] = rtol
-    ds.attrs["moorings"] = json.dumps(mooring_report(plant, ds))
+    ds.attrs["moorings"] = mooring_report(plant, ds)
     report = getattr(controller, "estimation_report", None)    # an estimator's accuracy
     if report is not None:
-        ds.attrs["estimator"] = json.dumps(jsonable(report(t, W)))
+        ds.attrs["estimator"] = jsonable(report(t, W))
     if loop is not None:                 # analysis.validity reads it
-        ds.attrs["sampled_loop"] = json.dumps(loop)
+        ds.attrs["sampled_loop"] = copy.deepcopy(loop)
     return ds
 
 
@@ -207,7 +209,7 @@ def _parameters(plant, params, controller) -> np.ndarray:
     return plant.params(**controlled_params(plant, params))
 
 
-def _run_fixed(plant, method, controller, law, embedded, x0, W_nodes, p, dt, n, compiled,
+def _run_fixed(plant, method, controller, x0, W_nodes, p, *, dt, n, law, embedded, compiled,
                check):
     nu = len(plant.inputs)
     if embedded:
@@ -342,7 +344,7 @@ def _progress_bar(progress: bool, n: int):
     return progress_bar(total=n, unit="step", desc="simulate", leave=False)
 
 
-def _dataset(plant, t, X, U, W, Y, eta, wave, controller, method, dt, p, wall):
+def _dataset(plant, t, X, U, W, Y, eta, *, wave, controller, method, dt, p, wall):
     data = {}
     for names, values in ((plant.outputs, Y), (plant.inputs, U), (plant.disturbances, W)):
         data.update({name: ("time", values[:, i], {"units": plant.units(name)})
@@ -364,14 +366,17 @@ def _dataset(plant, t, X, U, W, Y, eta, wave, controller, method, dt, p, wall):
         "radiation_sha256": made_by["radiation_sha256"] or "none",
         "method": method, "dt_s": dt,
         "duration_s": float(t[-1]), "wall_time_s": wall,
-        "wave": json.dumps(wave.describe() if wave is not None else {"type": "none"}),
-        "controller": json.dumps(controller.describe() if controller is not None else None),
-        "parameters": json.dumps(dict(zip(plant.parameters, map(float, p)))),
+        # the run record (mbcontrol.results.RunInfo): Python values here, JSON only in files
+        # (copies: the describe() dicts may share a controller's own lists, which its next
+        # reset changes)
+        "wave": copy.deepcopy(wave.describe()) if wave is not None else {"type": "none"},
+        "controller": copy.deepcopy(controller.describe()) if controller is not None else None,
+        "parameters": dict(zip(plant.parameters, map(float, p))),
         "hydro_source": plant.hydro.source if plant.hydro else "none",
         "radiation_states": int(plant.hydro.radiation.A.shape[0]) if plant.hydro else 0,
         "conventions": "NED n-frame (z down); body DOFs are CoG displacements (m) and ZYX "
                        "Euler angles (rad); absorbed power positive",
-        "versions": json.dumps(_versions()),
+        "versions": _versions(),
     })
     return ds
 

@@ -23,9 +23,8 @@ import xarray as xr
 
 from .. import defaults
 from ..console import progress_bar
-from ..plant import ProcessPlant
-from ..plant import Fidelity, FidelityError, has_couplings, plant_for
-from ..plant import as_wave_list
+from ..plant import (Fidelity, FidelityError, ProcessPlant, as_wave_list, has_couplings,
+                     plant_for)
 from ..scene import Scene, load_scene
 from ..sim import simulate
 

@@ -82,7 +82,7 @@ def test_reactive_saturates_alike_compiled_and_in_python(plant, wave, matched):
     np.testing.assert_allclose(python.pto__position.values, compiled.pto__position.values,
                                atol=1e-9)
     assert compiled.attrs["controller"] == python.attrs["controller"]
-    assert '"force_max": [2000000.0]' in compiled.attrs["controller"]
+    assert list(compiled.attrs["controller"]["force_max"]) == [2000000.0]
     # without the limit the same law reaches 5.4 MN in 3 periods (6.5 MN in steady state)
     free = run(plant, wave, Reactive(c, k, force_max=np.inf), periods=3)
     assert np.abs(free.pto__force.values).max() > 2 * LIMIT

@@ -3,7 +3,6 @@ labelled a bound), a passive warm-up until the predictor's first fit, AR models 
 statistics after the warm-up; MPC power against the complex-conjugate bound (linear theory
 straight from the BEM data, mbcontrol.analysis.complex_conjugate_bound) on rm3, the sphere
 and the OSWEC in three seas each."""
-import json
 
 import numpy as np
 import pytest
@@ -108,7 +107,7 @@ def test_rm3_issue_case_is_valid_and_physical():
     assert 0 < power <= bound
     assert 0.5 < stroke < 5.0
     assert s["valid"], s["invalid_reasons"]
-    described = json.loads(ds.attrs["controller"])
+    described = ds.attrs["controller"]
     assert described["warm_up_s"] == pytest.approx(45.0, abs=1e-9)
     assert s["window_start_s"] == pytest.approx(45.0) and "warm-up" in s["window"]
     # during the warm-up the command is the tuned damper on the measured velocity

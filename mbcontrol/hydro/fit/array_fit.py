@@ -127,8 +127,9 @@ def fit_radiation_columns(ds, dofs=None, *, tol: float = 0.02, omega_max=None, r
                          "raise [hydro] radiation_tol or max_order")
     entry = np.sqrt(np.sum(np.abs(fit - Ks) ** 2, axis=0)
                     / np.maximum(np.sum(np.abs(Ks) ** 2, axis=0), 1e-300))
-    report = _report(model, fit, Ks, w, dofs, classes, fits, passivity, history, tol, err, rms, band,
-                     given, (lo, hi), asym, time.perf_counter() - t_start)
+    report = _report(model, fit, Ks, w, dofs, classes=classes, fits=fits, passivity=passivity,
+                     history=history, tol=tol, err=err, rms=rms, band=band, given=given,
+                     band_lims=(lo, hi), asym=asym, seconds=time.perf_counter() - t_start)
     return RadiationModel(A=model.A, B=model.B, C=model.C, D=np.zeros((n, n)), dofs=tuple(dofs),
                           order=model.order, fit_error=err, entry_errors=entry, report=report)
 
@@ -198,8 +199,8 @@ def worst_entries(fit, K, w, dofs, count=20):
     return rows
 
 
-def _report(model, fit, K, w, dofs, classes, fits, passivity, history, tol, err, rms, band, given,
-            band_lims, asym, seconds):
+def _report(model, fit, K, w, dofs, *, classes, fits, passivity, history, tol, err, rms, band,
+            given, band_lims, asym, seconds):
     worst = worst_entries(fit, K, w, dofs)
     w0 = worst[0]
     ev = np.linalg.eigvals(model.A)

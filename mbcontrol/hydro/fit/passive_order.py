@@ -14,8 +14,8 @@ LAWSON_STEPS = 3   # reweighted enforcements after the first, while the gate is 
 LAWSON_REACH = 3.0  # tried only within this factor of the target (farther, it did not get there)
 
 
-def make_passive(trial, error, abc, err, target, n_max, max_states, omega, H, weights, dc_zero, markov,
-                 profile=None):
+def make_passive(trial, error, abc, err, *, target, n_max, max_states, omega, H, weights, dc_zero,
+                 markov, profile=None):
     """Order selection around :func:`enforce_passivity`, used by ``fit_radiation`` per DOF group.
 
     abc = (A, B, C) is the selected model and err its error; trial(r) -> (error, (A, B, C)) refits

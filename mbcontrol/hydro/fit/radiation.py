@@ -60,7 +60,8 @@ from ..data.dataset import matrix
 from .kernel import RECIPROCITY, _cos_transform, _with_tail, kernel_data, reciprocal
 from .passivity import _response, passivity_test_groups
 from .fit_error import FLOOR, _group_errors, _nerr, _worst, miss_message
-from .vector_fit import SLOW_POLE, _best_scaled_fit, group_error, same_group_fit
+from .group_fit import _best_scaled_fit, group_error, same_group_fit
+from .vector_fit import SLOW_POLE
 
 ZERO_COUPLING = 1e-6  # |K_ij| <= this * sqrt(max|K_ii| max|K_jj|): treated as an exact zero
 DENSE_STEP = 0.02  # fit on a grid refined (by interpolation) to Δω <= 2 % of ω
@@ -219,38 +220,19 @@ def fit_radiation(ds, dofs=None, *, tol: float = 0.02, max_order: int = 30, omeg
         inband = (w >= lo) & (w <= hi)
     # the groups are fitted on the refined grid; their gate takes the BEM frequencies at full weight
     # (interpolated ones at INTERP_WEIGHT), so it is the error reported here
-    parts, pre, info = [], [], []  # pre: the unconstrained fits (what passive=False returns)
-    done = []                      # groups fitted so far: an identical one reuses its fit
-    for gidx in groups:
-        common = (wf, Kf[:, gidx][:, :, gidx], link[np.ix_(gidx, gidx)], np.isin(wf, w), ainf[gidx],
-                  (wf >= lo) & (wf <= hi) & given & (device is None))
-        markov_g, judge = group_markov(gidx), None if device is None else gate_f.on(gidx)
-        rest = (tol, max_order, n_iter, dc_zero, refit, markov_g, p_tail,
-                passive_max_states if passive else 0)
-        reused = same_group_fit(done, common, markov_g, judge, tol)
-        abc, rep, before = reused or _best_scaled_fit(common, rest, [dofs[i] for i in gidx],
-                                                      passive, judge)
-        if reused is None:
-            done.append((common, markov_g, abc, rep, before, group_error(abc, common, judge)))
-        parts.append((gidx, *abc))
-        pre.append((gidx, *before))
-        info.append({"dofs": [dofs[i] for i in gidx], **rep})
+    settings = {"tol": tol, "max_order": max_order, "n_iter": n_iter, "dc_zero": dc_zero, "refit": refit,
+                "p_tail": p_tail, "passive_states": passive_max_states if passive else 0}
+    parts, pre, info = _fit_groups(groups, dofs, wf, Kf, link, np.isin(wf, w), ainf,
+                                   (wf >= lo) & (wf <= hi) & given & (device is None),
+                                   gate=gate_f if device is not None else None, markov_of=group_markov,
+                                   settings=settings, passive=passive)
     model, entry, err = _assemble(parts, w, Ks, dofs, groups, ainf, inband)
     if device is not None:
         err = float(np.max(gate_w.errors(model.frequency_response(w))))
     A, B, C, order = model.A, model.B, model.C, model.order
     k0_data = _cos_transform(*_with_tail(w, K.real, None)[:2], np.zeros(1))[0]
-    pas = {"enforce": bool(passive), "enforced": any(g.get("passivity", {}).get("enforced") for g in info),
-           **passivity_test_groups(parts).as_dict()}
-    if pas["enforced"]:  # the unconstrained fit's numbers, for comparison
-        m0, _, e0 = _assemble(pre, w, Ks, dofs, groups, ainf, inband)
-        if device is not None:
-            e0 = float(np.max(gate_w.errors(m0.frequency_response(w))))
-        t0 = passivity_test_groups(pre).as_dict()
-        pas.update(before={"fit_error": e0, "n_states": m0.order, **{k: t0[k] for k in (
-            "passive", "margin", "min_eig", "omega_at_min", "max_eig", "bands", "grid_min_eig")}},
-            fit_error_growth=err / e0 if e0 > 0 else 1.0,
-            enforcement_seconds=sum(g["passivity"]["seconds"] for g in info if "passivity" in g))
+    pas = _passivity_summary(parts, pre, info, passive, err, (w, Ks, dofs, groups, ainf, inband),
+                             gate_w if device is not None else None)
     fit = model.frequency_response(w)
     shown = inband if given or device is not None else np.ones(w.size, bool)  # the worst shown, not gated
     worst = _worst(fit, Ks, w, dofs, groups, ainf, shown) if shown.any() else None
@@ -289,6 +271,43 @@ def fit_radiation(ds, dofs=None, *, tol: float = 0.02, max_order: int = 30, omeg
         warnings.warn(RadiationFitWarning(miss_message(report)), stacklevel=2)
     return RadiationModel(A=A, B=B, C=C, D=np.zeros((n, n)), dofs=tuple(dofs), order=order,
                           fit_error=err, entry_errors=entry, report=report)
+
+
+def _fit_groups(groups, dofs, wf, Kf, link, bem, ainf, band, *, gate, markov_of, settings, passive):
+    """Each coupled DOF group fitted (an identical group reuses an earlier fit): its (gidx, A, B, C),
+    the unconstrained fit before passivity enforcement (what passive=False returns) and its report."""
+    parts, pre, info = [], [], []
+    done = []                      # groups fitted so far: an identical one reuses its fit
+    for gidx in groups:
+        common = (wf, Kf[:, gidx][:, :, gidx], link[np.ix_(gidx, gidx)], bem, ainf[gidx], band)
+        markov_g, judge = markov_of(gidx), None if gate is None else gate.on(gidx)
+        reused = same_group_fit(done, common, markov_g, judge, settings["tol"])
+        abc, rep, before = reused or _best_scaled_fit(common, {**settings, "M1": markov_g},
+                                                      [dofs[i] for i in gidx], passive, judge)
+        if reused is None:
+            done.append((common, markov_g, abc, rep, before, group_error(abc, common, judge)))
+        parts.append((gidx, *abc))
+        pre.append((gidx, *before))
+        info.append({"dofs": [dofs[i] for i in gidx], **rep})
+    return parts, pre, info
+
+
+def _passivity_summary(parts, pre, info, passive, err, data, gate) -> dict:
+    """The report's passivity block: the exact test of the returned model and, where enforcement
+    changed it, the unconstrained fit's numbers for comparison. data: (w, K, dofs, groups, ainf,
+    inband) as _assemble takes them; gate: the device response's error (or None)."""
+    pas = {"enforce": bool(passive), "enforced": any(g.get("passivity", {}).get("enforced") for g in info),
+           **passivity_test_groups(parts).as_dict()}
+    if pas["enforced"]:
+        m0, _, e0 = _assemble(pre, *data)
+        if gate is not None:
+            e0 = float(np.max(gate.errors(m0.frequency_response(data[0]))))
+        t0 = passivity_test_groups(pre).as_dict()
+        pas.update(before={"fit_error": e0, "n_states": m0.order, **{k: t0[k] for k in (
+            "passive", "margin", "min_eig", "omega_at_min", "max_eig", "bands", "grid_min_eig")}},
+            fit_error_growth=err / e0 if e0 > 0 else 1.0,
+            enforcement_seconds=sum(g["passivity"]["seconds"] for g in info if "passivity" in g))
+    return pas
 
 
 def _assemble(parts, w, K, dofs, groups, ainf, inband):

@@ -19,8 +19,8 @@ from ...atomic import atomic_path
 from ...cache import cache_dir
 from ...console import status
 from ...errors import HydroError
-from . import (array_fit, array_passivity, fit_error, kernel, passive_order, passivity, radiation, response_error,
-               sdp, vector_fit)
+from . import (array_fit, array_passivity, fit_error, group_fit, kernel, passive_order, passivity, radiation,
+               response_error, sdp, vector_fit)
 from .radiation import RadiationModel, fit_radiation
 from .response_error import Device
 
@@ -52,7 +52,8 @@ def cached_fit(data: xr.Dataset, dofs, tol, source: str, omega_max: float = np.i
     for var in ("added_mass", "radiation_damping", "added_mass_inf"):
         digest.update(np.ascontiguousarray(data[var].values).tobytes())
     # the fitting code is part of the key: a changed algorithm never serves an old fit
-    for module in (radiation, kernel, fit_error, vector_fit, passive_order, passivity, sdp, response_error):
+    for module in (radiation, kernel, fit_error, vector_fit, group_fit, passive_order, passivity, sdp,
+                   response_error):
         digest.update(Path(module.__file__).read_bytes())
     band = fit_band_limit(data, omega_max)
     response_band = None if response_band is None else [float(x) for x in response_band]

@@ -131,7 +131,7 @@ def _balanced(A, B, C):
     return Ti @ A @ T, Ti @ B, C @ T, hsv
 
 
-def _vector_fit(w, H, Wr, Wi, nd, err_fn, tol, max_order, n_iter, dc_zero, markov=None):
+def _vector_fit(w, H, Wr, Wi, nd, err_fn, *, tol, max_order, n_iter, dc_zero, markov=None):
     """Common poles for all columns of H (nω, n_entries), N = 2, 4, … poles until the error is met.
     Each order starts from pairs spread log-uniformly over the data band with damping ratio ~0.1
     (well-damped starts avoid spurious sharp resonances). Rows from nd on are the weighted
@@ -206,8 +206,8 @@ def _unit_class(dof: str) -> str:
     return {"Surge": "m", "Sway": "m", "Heave": "m", "Roll": "rad", "Pitch": "rad", "Yaw": "rad"}.get(kind, dof)
 
 
-def _fit_group(w, Kg, pattern, bem, ainf, inband, unit_class, tol, max_order, n_iter, dc_zero, refit, M1=None, p_tail=3.0,
-               passive_states=0, vf_frac=0.7, judge=None):
+def _fit_group(w, Kg, pattern, bem, ainf, inband, unit_class, *, tol, max_order, n_iter, dc_zero, refit, M1=None,
+               p_tail=3.0, passive_states=0, vf_frac=0.7, judge=None):
     """VF of one coupled group (scaled) to vf_frac·tol, column realisation, balanced truncation to tol.
 
     judge (a :class:`mbcontrol.hydro.fit.response_error.GroupJudge`, or None): the error that gates is
@@ -219,30 +219,9 @@ def _fit_group(w, Kg, pattern, bem, ainf, inband, unit_class, tol, max_order, n_
     ent = [(i, j) for i in range(m) for j in range(m) if pattern[i, j]]
     M1s = None if M1 is None else M1 * sc[:, None] * sc[None, :]  # scaled like G
     nd = w.size
-    # Above the band the data say nothing. Lightly weighted points of an extrapolation keep the
-    # model from inventing a large out-of-band response (which spoils K(t) near t = 0):
-    # Re K = B_N (ω_N/ω)^p, and Im K = ω(A - A∞) = -[M1 + (c_N - M1)(ω_N/ω)²]/ω, the two-term
-    # asymptotic form (K(0+)/ω, then K''(0+)/ω³) that is continuous with the data (c_N = -ω_N Im K_N)
-    # and tends to the first Markov parameter M1 = K(0+).
-    we, Ge, tw = w, G, np.ones(nd)
-    if M1s is not None:
-        wn = w.max()
-        wx = np.geomspace(1.02 * wn, 10 * wn, TAIL_POINTS)[:, None, None]
-        cn = -wn * G[-1].imag
-        ext = G[-1].real[None] * (wn / wx) ** p_tail - 1j * (M1s[None] + (cn - M1s)[None] * (wn / wx) ** 2) / wx
-        wx = wx[:, 0, 0]
-        we = np.concatenate([w, wx])
-        Ge = np.concatenate([G, np.where(pattern[None], ext, 0.0)])
-        tw = np.concatenate([np.ones(nd), np.full(wx.size, TAIL_WEIGHT)])
-    # relative least squares (the error measure's): each part at each ω weighted by 1/its size
+    we, Ge, tw = _extended(w, G, pattern, M1s, p_tail)
     ainf_s = ainf * sc**2  # A∞ scaled like G
-    re, im = part_sizes(np.where(pattern[None], Ge, 0.0), we, ainf_s,
-                        np.concatenate([inband, np.zeros(we.size - nd, bool)]))  # the tail: absolute
-    wr, wi = tw / re, tw / im
-    if judge is not None:      # where the response feels the kernel (relative; LS_FLOOR elsewhere)
-        feel = judge.sensitivity(sc)
-        feel = np.maximum(feel / max(feel.max(), 1e-300), LS_FLOOR)
-        wr = wi = tw * np.concatenate([feel, np.full(we.size - nd, feel[-1])])
+    wr, wi = _ls_weights(we, Ge, tw, nd, pattern, ainf_s, inband, judge, sc)
     Wr = np.broadcast_to(wr[:, None, None], Ge.shape)
     Wi = np.broadcast_to(wi[:, None, None], Ge.shape)
     wt = wr   # passivity enforcement: one weight per ω, as the LS fit
@@ -265,16 +244,10 @@ def _fit_group(w, Kg, pattern, bem, ainf, inband, unit_class, tol, max_order, n_
         fit[pick] = rows
         return gate(fit)
     # most of the error budget for the fit, the rest for the truncation (errors add ~ in quadrature)
-    poles, Cr, history = _vector_fit(we, He, Wr[pick], Wi[pick], nd, err_fn, vf_frac * tol, max_order,
-                                     n_iter, dc_zero, None if M1s is None else np.array([M1s[i, j] for i, j in ent]))
-    Lam, bvec = _poles_real_form(poles)
-    N = Lam.shape[0]
-    A = np.kron(np.eye(m), Lam)
-    B = np.kron(np.eye(m), bvec[:, None])
-    C = np.zeros((m, m * N))
-    for e, (i, j) in enumerate(ent):
-        C[i, j * N:(j + 1) * N] = Cr[:, e]
-    Ab, Bb, Cb, hsv = _balanced(A, B, C)
+    poles, Cr, history = _vector_fit(we, He, Wr[pick], Wi[pick], nd, err_fn, tol=vf_frac * tol,
+                                     max_order=max_order, n_iter=n_iter, dc_zero=dc_zero,
+                                     markov=None if M1s is None else np.array([M1s[i, j] for i, j in ent]))
+    Ab, Bb, Cb, hsv = _balanced(*_column_realisation(poles, Cr, ent, m))
 
     def error(Ar, Br, Cr_):
         fit = _response(Ar, Br, Cr_, None, w, 1e10)
@@ -294,10 +267,71 @@ def _fit_group(w, Kg, pattern, bem, ainf, inband, unit_class, tol, max_order, n_
         Cr_ = _refit_output(Ar, Br, 1j * we, Ge, Wr, Wi, pattern, dc_zero, M1s) if refit else Cb[:, :r]
         return error(Ar, Br, Cr_), (Ar, Br, Cr_)
 
-    # smallest r meeting tol (or, if the fit itself misses it, within 5 % of the full-order error);
-    # the error is close to monotone in r, so bisect
+    # smallest r meeting tol (or, if the fit itself misses it, within 5 % of the full-order error)
     target = max(tol, 1.05 * trial(hsv.size)[0])
-    lo, hi = 1, hsv.size
+    lo, err, (Ar, Br, Cr_) = _smallest_order(trial, hsv.size, target)
+    info = {"poles": [[float(p.real), float(p.imag)] for p in poles], "history": history, "hsv": hsv.tolist(),
+            "order": int(lo), "error_gate": float(err)}
+    before = (Ar, Br / sc[None, :], Cr_ / sc[:, None])
+    if passive_states:
+        Ar, Br, Cr_, err, info["passivity"] = make_passive(
+            trial, error, (Ar, Br, Cr_), err, target=target, n_max=hsv.size, max_states=passive_states, omega=we,
+            H=np.where(pattern[None], Ge, 0.0), weights=wt, dc_zero=dc_zero, markov=M1s, profile=profile)
+        info["order"] = int(Ar.shape[0])
+    return Ar, Br / sc[None, :], Cr_ / sc[:, None], info, before
+
+
+def _extended(w, G, pattern, M1s, p_tail):
+    """(ω, G, weight) of the data and, with a first Markov parameter M1s, its asymptotic tail.
+
+    Above the band the data say nothing. Lightly weighted points of an extrapolation keep the
+    model from inventing a large out-of-band response (which spoils K(t) near t = 0):
+    Re K = B_N (ω_N/ω)^p, and Im K = ω(A - A∞) = -[M1 + (c_N - M1)(ω_N/ω)²]/ω, the two-term
+    asymptotic form (K(0+)/ω, then K''(0+)/ω³) that is continuous with the data (c_N = -ω_N Im K_N)
+    and tends to the first Markov parameter M1 = K(0+)."""
+    nd = w.size
+    if M1s is None:
+        return w, G, np.ones(nd)
+    wn = w.max()
+    wx = np.geomspace(1.02 * wn, 10 * wn, TAIL_POINTS)[:, None, None]
+    cn = -wn * G[-1].imag
+    ext = G[-1].real[None] * (wn / wx) ** p_tail - 1j * (M1s[None] + (cn - M1s)[None] * (wn / wx) ** 2) / wx
+    wx = wx[:, 0, 0]
+    return (np.concatenate([w, wx]), np.concatenate([G, np.where(pattern[None], ext, 0.0)]),
+            np.concatenate([np.ones(nd), np.full(wx.size, TAIL_WEIGHT)]))
+
+
+def _ls_weights(we, Ge, tw, nd, pattern, ainf_s, inband, judge, sc):
+    """Least-squares weights (real, imaginary parts) per ω: relative, the error measure's (each
+    part at each ω by 1/its size; the tail absolute), or, with a judge, where the response feels
+    the kernel (relative; LS_FLOOR elsewhere)."""
+    re, im = part_sizes(np.where(pattern[None], Ge, 0.0), we, ainf_s,
+                        np.concatenate([inband, np.zeros(we.size - nd, bool)]))
+    wr, wi = tw / re, tw / im
+    if judge is not None:
+        feel = judge.sensitivity(sc)
+        feel = np.maximum(feel / max(feel.max(), 1e-300), LS_FLOOR)
+        wr = wi = tw * np.concatenate([feel, np.full(we.size - nd, feel[-1])])
+    return wr, wi
+
+
+def _column_realisation(poles, Cr, ent, m):
+    """(A, B, C) of a group's common-pole fit: one copy of the poles per input column."""
+    Lam, bvec = _poles_real_form(poles)
+    N = Lam.shape[0]
+    A = np.kron(np.eye(m), Lam)
+    B = np.kron(np.eye(m), bvec[:, None])
+    C = np.zeros((m, m * N))
+    for e, (i, j) in enumerate(ent):
+        C[i, j * N:(j + 1) * N] = Cr[:, e]
+    return A, B, C
+
+
+def _smallest_order(trial, n, target):
+    """(r, error, (A, B, C)): the smallest truncation order r <= n whose error is within
+    target, by bisection (the error is close to monotone in r), then up past any order
+    rejected for slow or unstable poles."""
+    lo, hi = 1, n
     while lo < hi:
         mid = (lo + hi) // 2
         if trial(mid)[0] <= target:
@@ -305,87 +339,9 @@ def _fit_group(w, Kg, pattern, bem, ainf, inband, unit_class, tol, max_order, n_
         else:
             lo = mid + 1
     err, abc = trial(lo)
-    while abc is None and lo < hsv.size:  # every order rejected (slow poles) up to here
+    while abc is None and lo < n:  # every order rejected (slow poles) up to here
         lo += 1
         err, abc = trial(lo)
     if abc is None:
         raise HydroError("radiation fit: no truncation order free of slow or unstable poles")
-    Ar, Br, Cr_ = abc
-    info = {"poles": [[float(p.real), float(p.imag)] for p in poles], "history": history, "hsv": hsv.tolist(),
-            "order": int(lo), "error_gate": float(err)}
-    before = (Ar, Br / sc[None, :], Cr_ / sc[:, None])
-    if passive_states:
-        Ar, Br, Cr_, err, info["passivity"] = make_passive(trial, error, (Ar, Br, Cr_), err, target, hsv.size,
-                                                           passive_states, we, np.where(pattern[None], Ge, 0.0), wt,
-                                                           dc_zero, M1s, profile)
-        info["order"] = int(Ar.shape[0])
-    return Ar, Br / sc[None, :], Cr_ / sc[:, None], info, before
-
-
-def _best_scaled_fit(common, rest, dofs, passive, judge=None):
-    """Fit one group under each distinct congruence scaling (per unit class, per DOF) and keep the
-    model that meets tol, then one whose passivity enforcement kept C B = K(0+), then the fewest
-    states, then the most accurate (error on the group's data).
-
-    Which weighting lets the fit reach the tolerance soonest depends on the data: per-DOF scaling
-    helps a small, clean entry; per-class scaling keeps the fit off a small, noisy one."""
-    w, Kg, _, bem, ainf, inband = common
-    tol = rest[0]
-    options = {"unit class": [_unit_class(d) for d in dofs], "per DOF": list(dofs)}
-    if np.allclose(_congruence_scale(Kg, options["unit class"]), _congruence_scale(Kg, options["per DOF"])):
-        options.pop("per DOF")
-    best, tried = None, []
-    for label, classes in options.items():
-        args = (*common, classes, *rest)
-        *abc, rep, before = _fit_group(*args, judge=judge)
-        # passive fits may need more poles: fit deeper, retry; only if the unconstrained fit met
-        # the target (else more poles do not help, and the retry doubles a long fit's time)
-        if passive and not rep["passivity"]["met"] and rep["error_gate"] <= rest[0]:
-            *abc2, rep2, _ = _fit_group(*args, vf_frac=0.15, judge=judge)
-            if rep2["passivity"]["error_after"] < rep["passivity"]["error_after"]:
-                abc, rep = abc2, {**rep2, "deeper_vector_fit": True}
-        err = group_error(abc, common, judge)
-        markov_dropped = rep.get("passivity", {}).get("markov_kept") is False
-        tried.append({"scaling": label, "n_states": int(abc[0].shape[0]), "error": float(err),
-                      "markov_dropped": markov_dropped})
-        key = (err > tol, markov_dropped, abc[0].shape[0], err)
-        if best is None or key < best[0]:
-            best = (key, abc, {**rep, "scaling": label}, before)
-    _, abc, rep, before = best
-    return abc, {**rep, "scalings_tried": tried}, before
-
-
-def group_error(abc, common, judge=None) -> float:
-    """The error that gates a group's fit (A, B, C): on its kernel data (``common`` as
-    _best_scaled_fit takes it), or the device response's through ``judge``."""
-    w, Kg, _, bem, ainf, inband = common
-    fit = _response(*abc, None, w, 1e10)
-    return (_gate(fit, Kg, w, ainf, bem, inband) if judge is None
-            else float(np.max(judge(fit) * np.where(bem, 1.0, INTERP_WEIGHT))))
-
-
-SAME_GROUP = 1e-6    # groups whose kernel data agree to this (relative; BEM round-off of
-# identical bodies solved apart is ~1e-9) are candidates to share one fit
-
-
-def same_group_fit(done, common, markov, judge, tol):
-    """A fit already made for an identical group (``done``: [(common, markov, abc, rep, before,
-    its error there)]), reused when its data agree to SAME_GROUP and its error on this group,
-    judged as this group's own fit would be (its device response differs: another place in the
-    chain), meets ``tol`` or is no worse than where it was made (a tolerance the data do not
-    allow); else None. Identical bodies without hydrodynamic interaction then cost one fit."""
-    Kg = common[1]
-    size = max(float(np.max(np.abs(Kg))), 1e-300)
-    for other, other_markov, abc, rep, before, made_err in done:
-        if other[1].shape != Kg.shape or (markov is None) != (other_markov is None):
-            continue
-        same = (np.max(np.abs(other[1] - Kg)) <= SAME_GROUP * size
-                and np.allclose(other[4], common[4], rtol=SAME_GROUP, atol=0)
-                and (markov is None or np.allclose(other_markov, markov, rtol=SAME_GROUP,
-                                                   atol=SAME_GROUP * np.max(np.abs(markov)))))
-        if not same:
-            continue
-        err = group_error(abc, common, judge)
-        if err <= max(tol, made_err * (1 + 1e-9)):
-            return abc, {**rep, "error_gate": err, "reused": True}, before
-    return None
+    return lo, err, abc

@@ -180,22 +180,8 @@ def design(plant, wave, name: str, *, pto: str | None = None, simulate_s: float 
         tuner["other_ptos"] = (f"{name} acts on every PTO; one PTO's power has no bound of its "
                                f"own (the others can feed it): the total is bounded")
 
-    margins = None
-    if linear:
-        from ...controllers import loop_margins
-        gains = {k: parameters[k] for k in CONTRACT[name]}
-        margins = loop_margins(plant, gains, pto=pto_obj.name, params=others)
-        if not margins.stable:
-            notes.append(f"{name}: the closed loop is unstable on the plant, so it was not "
-                         f"simulated. {margins.message}")
-        from ...controllers import loop_robustness, share_explained
-        tuner["robustness"] = loop_robustness(margins)
-        if margins.stable and not tuner["robustness"]["meets"]:
-            notes.append(f"{name}: below the robustness floors: "
-                         f"{tuner['robustness']['why']}")
-        if not many and plant.hydro is not None:
-            tuner["share"] = share_explained(plant, wave, pto_obj.name, predicted, name)
-
+    margins = _loop_checks(plant, wave, name, parameters, pto_obj.name, predicted, others,
+                           tuner, notes) if linear else None
     duration = simulate_s if simulate_s is not None else _duration(wave, margins)
     # a sea on a uniform grid repeats every T_r: scored over its last whole repeat period,
     # the metrics are the period means the bounds are (a window after the ramp is not)
@@ -212,40 +198,14 @@ def design(plant, wave, name: str, *, pto: str | None = None, simulate_s: float 
     metrics = simulation = ds = None
     percent = {"complex_conjugate": None, "constrained": None}
     if margins is None or margins.stable:
-        from mbcontrol.analysis import pto_metrics, summary
-        from mbcontrol.sim import simulate
         if default_dt and getattr(controller, "period", None):
             dt = controller.period / math.ceil(controller.period / dt - 1e-9)
         if wave.omega.size == 1 and duration < wave.ramp_time + 10 * period:
             notes.append(f"{duration:.4g} s is shorter than the ramp ({wave.ramp_time:.4g} s) "
                          f"plus the 10-period metrics window: the metrics include the start-up")
-        try:
-            ds = simulate(plant, wave, duration=duration, dt=dt, controller=controller)
-        except SimulationError as exc:     # e.g. a loop stable only when linearised
-            notes.append(f"{name}: the closed-loop simulation failed: {exc}")
-        else:
-            if whole:
-                ds.attrs["statistics_from_s"] = duration - repeat
-                ds.attrs["statistics_note"] = (f"the last whole repeat period of the sea "
-                                               f"({repeat:.4g} s), as its bounds")
-            metrics = pto_metrics(ds, pto_obj)
-            simulation = {"duration_s": float(duration), "dt_s": float(dt),
-                          "summary": summary(ds, plant)}
-            if not simulation["summary"]["valid"]:
-                notes.append("the closed-loop result is INVALID: "
-                             + "; ".join(simulation["summary"]["invalid_reasons"]))
-            power = metrics["mean_power_W"]
-            for key, ref in (("complex_conjugate", bound.get("complex_conjugate_W")),
-                             ("constrained", bound.get("constrained_W"))):
-                percent[key] = 100 * power / ref if ref else None
-            if bound.get("electrical_W"):
-                percent["electrical"] = (100 * metrics["mean_electrical_power_W"]
-                                         / bound["electrical_W"])
-            if bound.get("total_complex_conjugate_W"):
-                total = sum(pto_metrics(ds, p)["mean_power_W"] for p in plant.scene.ptos)
-                metrics["total_mean_power_W"] = total
-                percent["total_complex_conjugate"] = (100 * total
-                                                      / bound["total_complex_conjugate_W"])
+        metrics, simulation, ds = _closed_loop(
+            plant, wave, controller, pto_obj, name=name, duration=duration, dt=dt,
+            repeat=repeat if whole else None, bound=bound, percent=percent, notes=notes)
     for key, value in percent.items():     # a bound beaten: linear theory failed this run
         kind = bound.get("constrained_kind", "bound") if key == "constrained" else "bound"
         if value is not None and kind == "bound" and value > 100 * (1 + BOUND_TOLERANCE):
@@ -253,6 +213,59 @@ def design(plant, wave, name: str, *, pto: str | None = None, simulate_s: float 
                          f"bound: the linear theory behind the bound does not hold for this run")
     return DesignResult(name, pto_obj.name, parameters, predicted, bound, metrics, percent,
                         margins, tuner, simulation, notes, ds)
+
+
+def _loop_checks(plant, wave, name, parameters, pto, predicted, others, tuner, notes):
+    """A linear law's margins on the plant, its robustness (into `tuner`) and, for one PTO,
+    the share of the prediction linear theory explains; what the reader should know into
+    `notes`."""
+    from ...controllers import loop_margins, loop_robustness, share_explained
+    gains = {k: parameters[k] for k in CONTRACT[name]}
+    margins = loop_margins(plant, gains, pto=pto, params=others)
+    if not margins.stable:
+        notes.append(f"{name}: the closed loop is unstable on the plant, so it was not "
+                     f"simulated. {margins.message}")
+    tuner["robustness"] = loop_robustness(margins)
+    if margins.stable and not tuner["robustness"]["meets"]:
+        notes.append(f"{name}: below the robustness floors: {tuner['robustness']['why']}")
+    if len(plant.scene.ptos) == 1 and plant.hydro is not None:
+        tuner["share"] = share_explained(plant, wave, pto, predicted, name)
+    return margins
+
+
+def _closed_loop(plant, wave, controller, pto_obj, *, name, duration, dt, repeat, bound,
+                 percent, notes):
+    """Simulate the designed loop and score it: (metrics, simulation, dataset), with each
+    bound's percentage into `percent`; all None when the simulation fails (said in `notes`).
+    repeat: a sea's repeat period (s) when the run is scored over its last whole one."""
+    from mbcontrol.analysis import pto_metrics, summary
+    from mbcontrol.sim import simulate
+    try:
+        ds = simulate(plant, wave, duration=duration, dt=dt, controller=controller)
+    except SimulationError as exc:     # e.g. a loop stable only when linearised
+        notes.append(f"{name}: the closed-loop simulation failed: {exc}")
+        return None, None, None
+    if repeat is not None:
+        ds.attrs["statistics_from_s"] = duration - repeat
+        ds.attrs["statistics_note"] = (f"the last whole repeat period of the sea "
+                                       f"({repeat:.4g} s), as its bounds")
+    metrics = pto_metrics(ds, pto_obj)
+    simulation = {"duration_s": float(duration), "dt_s": float(dt),
+                  "summary": summary(ds, plant)}
+    if not simulation["summary"]["valid"]:
+        notes.append("the closed-loop result is INVALID: "
+                     + "; ".join(simulation["summary"]["invalid_reasons"]))
+    power = metrics["mean_power_W"]
+    for key, ref in (("complex_conjugate", bound.get("complex_conjugate_W")),
+                     ("constrained", bound.get("constrained_W"))):
+        percent[key] = 100 * power / ref if ref else None
+    if bound.get("electrical_W"):
+        percent["electrical"] = 100 * metrics["mean_electrical_power_W"] / bound["electrical_W"]
+    if bound.get("total_complex_conjugate_W"):
+        total = sum(pto_metrics(ds, p)["mean_power_W"] for p in plant.scene.ptos)
+        metrics["total_mean_power_W"] = total
+        percent["total_complex_conjugate"] = 100 * total / bound["total_complex_conjugate_W"]
+    return metrics, simulation, ds
 
 
 def _pto(plant, pto):

@@ -63,48 +63,67 @@ def tune(plant, wave, name, pto_obj, limits, model_params, notes, robust: bool =
                          "are reported)")
         return _tune_jointly(plant, wave, name, limits, model_params, own, extra)
     if name in ("passive", "reactive"):
-        from ...controllers import optimal_damping, reactive_tuning
-        tuner = optimal_damping if name == "passive" else reactive_tuning
-        kw = _limit_kwargs(tuner, finite, tuner.__name__, notes)
-        if pto_obj.efficiency != 1 and _accepts(tuner, "efficiency"):
-            kw["efficiency"] = float(pto_obj.efficiency)    # tune for electrical power
-        info = {"function": tuner.__name__, "settings": dict(kw)}
-        if limits:                # and the linear model's range (analysis.envelope)
-            kw["envelope"] = True
-            info["envelope"] = {"share": ENVELOPE_SHARE, "inside": True}
-            if math.isfinite(pto_obj.rated_power):     # detuned to the PTO's rated power
-                kw["rated_power"] = info["settings"]["rated_power"] = pto_obj.rated_power
-        if robust and name == "reactive":
-            kw["robust"] = info["robust"] = True
-        try:
-            if name == "passive":
-                damping, predicted = tuner(plant, wave, pto=pto, params=model_params, **kw)
-                stiffness = None
-            else:
-                damping, stiffness, predicted = tuner(plant, wave, pto, params=model_params,
-                                                      **kw)
-        except OutsideEnvelope as exc:     # flagged, with the damper that comes closest
-            damping, stiffness, predicted = exc.fallback
-            stiffness = None if name == "passive" else stiffness
-            info["envelope"].update(inside=False, ratio=exc.ratio, reason=str(exc))
-            notes.append(f"OUTSIDE ITS ENVELOPE: {exc}; the damper that comes closest is used")
-        tuned = {"damping": damping}
-        if stiffness is not None:
-            tuned["stiffness"] = stiffness
-        return {**tuned, **own}, predicted, info, extra
+        return _tune_linear(plant, wave, name, pto_obj, limits, model_params, notes, robust,
+                            finite=finite, own=own, extra=extra)
     if name in ("latching", "declutching"):
-        from ...controllers import optimal_declutch, optimal_latch_time
-        if model_params:
-            raise ControllerError("model_params: latching and declutching tune by simulating the "
-                                  "plant itself")
-        tuner, key = ((optimal_latch_time, "latch_time") if name == "latching"
-                      else (optimal_declutch, "declutch_time"))
-        kw = _limit_kwargs(tuner, finite, tuner.__name__, notes)
-        hold, damping, simulated = tuner(plant, wave, pto=pto, **kw)
-        return ({"damping": damping, key: hold, **own}, None,
-                {"function": tuner.__name__, "settings": kw, "simulated_power_W": simulated,
-                 "dt_s": wave.period / 500}, extra)
-    # mpc (or another registered controller): no tuner; its defaults and the PTO's limits
+        return _tune_switching(plant, wave, name, pto_obj.name, model_params, notes,
+                               finite=finite, own=own, extra=extra)
+    return _untuned(wave, name, model_params, finite=finite, own=own, extra=extra)
+
+
+def _tune_linear(plant, wave, name, pto_obj, limits, model_params, notes, robust, *, finite,
+                 own, extra):
+    """A passive or reactive law tuned for one PTO: within its limits, the linear model's
+    envelope and its rated power (with limits); flagged, not refused, outside the envelope."""
+    from ...controllers import optimal_damping, reactive_tuning
+    pto = pto_obj.name
+    tuner = optimal_damping if name == "passive" else reactive_tuning
+    kw = _limit_kwargs(tuner, finite, tuner.__name__, notes)
+    if pto_obj.efficiency != 1 and _accepts(tuner, "efficiency"):
+        kw["efficiency"] = float(pto_obj.efficiency)    # tune for electrical power
+    info = {"function": tuner.__name__, "settings": dict(kw)}
+    if limits:                # and the linear model's range (analysis.envelope)
+        kw["envelope"] = True
+        info["envelope"] = {"share": ENVELOPE_SHARE, "inside": True}
+        if math.isfinite(pto_obj.rated_power):     # detuned to the PTO's rated power
+            kw["rated_power"] = info["settings"]["rated_power"] = pto_obj.rated_power
+    if robust and name == "reactive":
+        kw["robust"] = info["robust"] = True
+    try:
+        if name == "passive":
+            damping, predicted = tuner(plant, wave, pto=pto, params=model_params, **kw)
+            stiffness = None
+        else:
+            damping, stiffness, predicted = tuner(plant, wave, pto, params=model_params, **kw)
+    except OutsideEnvelope as exc:     # flagged, with the damper that comes closest
+        damping, stiffness, predicted = exc.fallback
+        stiffness = None if name == "passive" else stiffness
+        info["envelope"].update(inside=False, ratio=exc.ratio, reason=str(exc))
+        notes.append(f"OUTSIDE ITS ENVELOPE: {exc}; the damper that comes closest is used")
+    tuned = {"damping": damping}
+    if stiffness is not None:
+        tuned["stiffness"] = stiffness
+    return {**tuned, **own}, predicted, info, extra
+
+
+def _tune_switching(plant, wave, name, pto, model_params, notes, *, finite, own, extra):
+    """A latching or declutching law, tuned by simulating the plant itself."""
+    from ...controllers import optimal_declutch, optimal_latch_time
+    if model_params:
+        raise ControllerError("model_params: latching and declutching tune by simulating the "
+                              "plant itself")
+    tuner, key = ((optimal_latch_time, "latch_time") if name == "latching"
+                  else (optimal_declutch, "declutch_time"))
+    kw = _limit_kwargs(tuner, finite, tuner.__name__, notes)
+    hold, damping, simulated = tuner(plant, wave, pto=pto, **kw)
+    return ({"damping": damping, key: hold, **own}, None,
+            {"function": tuner.__name__, "settings": kw, "simulated_power_W": simulated,
+             "dt_s": wave.period / 500}, extra)
+
+
+def _untuned(wave, name, model_params, *, finite, own, extra):
+    """An MPC (or another registered controller): no tuner; its defaults and the PTO's
+    limits, with a horizon and a slew limit fitted to the wave."""
     if model_params:
         raise ControllerError("model_params: this controller is not tuned, so there is no model "
                               "to get wrong")

@@ -123,8 +123,7 @@ def assemble(cases, store: CaseStore, seas, vary: dict, seeds: int, attrs: dict)
               "weight": ("sea", [s.weight for s in seas])}
     coords.update({n: list(map(float, vary[n])) for n in names})
     ds = xr.Dataset(data, coords=coords)
-    ds.attrs.update({k: json.dumps(v) if isinstance(v, (dict, list)) else v
-                     for k, v in attrs.items() if v is not None and not
+    ds.attrs.update({k: v for k, v in attrs.items() if v is not None and not   # JSON in files only
                      (isinstance(v, float) and math.isnan(v))})
     return ds
 

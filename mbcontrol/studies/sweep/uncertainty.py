@@ -116,8 +116,9 @@ def add_uncertainty(summary: dict, ds, seas, plant, *, controller, settings, par
     else:
         components.append(bud.absent("radiation_fit", "B", "linear",
                                      f"needs a linear law ({why_not})"))
-    components.append(_parameters(identified, weights, plant, waves, laws, params, controller,
-                                  capped, why_not, power, rows))
+    components.append(_parameters(identified, weights, plant, waves, laws, params=params,
+                                  controller=controller, capped=capped, why_not=why_not,
+                                  power=power, rows=rows))
     power_valid = np.where(np.isfinite(power), power, 0.0)
     if rated:
         power_valid = np.minimum(power_valid, rated)
@@ -170,7 +171,7 @@ def _model(identified, weights, power, capped) -> dict:
         f"{identified['model_error_source']}, x2 for power ({identified['source']})")
 
 
-def _parameters(identified, weights, plant, waves, laws, params, controller, capped,
+def _parameters(identified, weights, plant, waves, laws, *, params, controller, capped,
                 why_not, power, rows) -> dict:
     if identified is None or not identified["names"]:
         return bud.absent("parameters", "B", "linear",
