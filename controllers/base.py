@@ -1,34 +1,12 @@
-"""The Controller protocol: what `simulate` needs from a PTO controller.
-
-A controller is bound to a plant by `reset(plant)` (it looks up the signals it measures by
-name), then called as `controller(t, y) -> u` every `period` seconds with the plant's output
-vector y; u (one force or torque per PTO, N or N m) is held until the next call (zero-order
-hold). In closed loop u is the PTO's whole force: the scene's PTO law is set aside. A controller whose law is a static CasADi expression of y may also return it from
-`casadi_law(plant)`; with period equal to the simulation step it then runs inside compiled code.
-A controller with the attribute `uses_state = True` is called as `controller(t, y, x)` with the
-plant's whole state x as well: full-state feedback, an oracle for studies (no real device
-measures radiation states), which its describe() must say.
+"""The controllers' common helpers. The Controller protocol they implement, with the optional
+members the simulator and the exporters may use, is declared where the simulator lives
+(`mbcontrol.sim.protocol`) and re-exported here.
 """
 from __future__ import annotations
 
-from typing import Protocol, runtime_checkable
-
 import numpy as np
 from mbcontrol.errors import UnknownName
-
-
-@runtime_checkable
-class Controller(Protocol):
-    name: str
-    period: float | None   # s, zero-order-hold period; None: every simulation step
-
-    def reset(self, plant) -> None: ...
-
-    def __call__(self, t: float, y: np.ndarray) -> np.ndarray: ...
-
-    def casadi_law(self, plant): ...
-
-    def describe(self) -> dict: ...
+from mbcontrol.sim import Controller  # noqa: F401   (the protocol, re-exported)
 
 
 def signal_indices(plant, names: list[str]) -> list[int]:

@@ -71,3 +71,17 @@ def test_cli_lists_every_key_and_its_help_shows_the_value_in_force(capsys, monke
     with pytest.raises(SystemExit):
         main(["sweep", "--help"])
     assert "default 0.1 s: 'sweep.dt'" in capsys.readouterr().out.replace("\n", " ")
+
+
+def test_the_radiation_tolerance_has_one_default():
+    """The radiation fit's tolerance was written in five places with two values (0.01, 0.02);
+    every entry point now takes 'hydro.radiation_tol' when none is given."""
+    import inspect
+
+    from mbcontrol.hydro import fit_radiation, fit_radiation_columns
+    from mbcontrol.scene.model import HydroSettings
+    for fit in (fit_radiation, fit_radiation_columns):
+        assert inspect.signature(fit).parameters["tol"].default is None
+    assert HydroSettings().radiation_tol == defaults.get("hydro.radiation_tol") == 0.01
+    with defaults.override(hydro_radiation_tol=0.03):
+        assert HydroSettings().radiation_tol == 0.03

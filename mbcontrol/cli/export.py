@@ -9,6 +9,7 @@ import sys
 from pathlib import Path
 
 from ..errors import InputError
+from ..sim import period_of
 from .commands import _plant, _wave
 
 EXPORT_HELP = """Export a PTO controller as C and as FMI 2.0 co-simulation FMUs, with its plant.
@@ -93,10 +94,10 @@ def run_export(args) -> int:
     duration = args.duration or (20 * period_hint if args.wave == "regular" else 200.0)
     wave = _wave(args, plant, duration)
     controller, origin = _controller(args, plant, wave)
-    dt = args.dt or _step(float(wave.period) / 200, getattr(controller, "period", None))
+    dt = args.dt or _step(float(wave.period) / 200, period_of(controller))
     out = Path(args.out)
     exported = export_controller(controller, plant, out, model=plant.name,
-                                 step=getattr(controller, "period", None) or dt)
+                                 step=period_of(controller) or dt)
     plant_fmu = export_plant(plant, wave, out, dt=dt, model=plant.name)
     report = {"model": plant.name, "controller": controller.name, "origin": origin,
               "parameters": {p.name: p.value for p in exported.spec.parameters},

@@ -8,6 +8,7 @@ import time
 
 import numpy as np
 
+from ..sim import period_of
 from .runtime import CController, force_error, step_statistics
 
 
@@ -20,7 +21,7 @@ def closed_loop_check(plant, wave, controller, exported, *, duration: float, dt:
     (the timing replays its measurements)."""
     from mbcontrol.controllers import mean_power
     from mbcontrol.sim import simulate
-    period = getattr(controller, "period", None)
+    period = period_of(controller)
     reference = simulate(plant, wave, duration=duration, dt=dt, controller=controller,
                          method="rk4")
     c_ctrl = CController.from_export(exported, period=period)
@@ -77,7 +78,7 @@ def step_timing(controller, exported, record, plant, *, python_steps: int | None
     """Step times (us) of the C library over the measurements of `record` (a Dataset of a
     closed-loop run) at the controller's calls, and of the Python controller over the same
     (the first python_steps of them). Both from a fresh start; the C one timed inside C."""
-    period = getattr(controller, "period", None)
+    period = period_of(controller)
     t = record["time"].values
     if period:                             # the samples the controller acts on
         every = max(1, int(round(period / (t[1] - t[0]))))

@@ -6,6 +6,7 @@ import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
+from ..sim import period_of
 from .build import (FMU_FILES, compile_library, csrc, guid, identifier, model_description,
                     platform_folder, variable, write_sources, zip_fmu)
 from .spec import ControllerSpec, controller_spec
@@ -46,7 +47,7 @@ def export_controller(controller, plant, out_dir, *, model: str | None = None,
         fmu_sources = [src / s.name for s in sources if s.name != "mbc_bench.c"] + \
             [src / "fmu_controller.c"]
         compile_library(fmu_sources, binaries / f"{ident}.so", ("-fvisibility=hidden",))
-        period = getattr(controller, "period", None)
+        period = period_of(controller)
         (fmu_root / "modelDescription.xml").write_text(
             controller_description(spec, ident, step or period or 0.01, period))
         fmu = out_dir / f"{ident}.fmu"

@@ -16,6 +16,7 @@ import casadi as ca
 import numpy as np
 
 from ..errors import InputError
+from ..sim import period_of
 
 # The exported QP's iteration cap per variable: the bound on a step's time. Past it the step
 # takes the previous plan's next move (within the force and rate limits; mbc_mpc.c).
@@ -58,7 +59,7 @@ def controller_spec(controller, plant) -> ControllerSpec:
     if build is not None:
         spec = build(controller, plant)
         # s; the FMU samples on this grid (0: at every communication point)
-        spec.defines["MBC_SAMPLE_PERIOD"] = repr(float(getattr(controller, "period", None) or 0.0))
+        spec.defines["MBC_SAMPLE_PERIOD"] = repr(float(period_of(controller) or 0.0))
         return spec
     raise InputError(f"export: controller {name!r} cannot be exported; exportable: passive, "
                      f"reactive, latching, declutching, mpc (NMPC's solver, IPOPT, generates "

@@ -20,6 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import defaults
+
 DOF_NAMES = ("Surge", "Sway", "Heave", "Roll", "Pitch", "Yaw")
 JOINT_TYPES = ("revolute", "prismatic", "fixed", "free")
 
@@ -230,7 +232,8 @@ class HydroSettings:
     omega: tuple[float, ...] = ()              # rad/s, BEM frequencies
     headings: tuple[float, ...] = (0.0,)       # rad, NED wave directions
     lid: bool = True
-    radiation_tol: float = 0.01                # radiation fit error (hydro.fit.radiation, "Error")
+    radiation_tol: float = field(              # radiation fit error (hydro.fit.radiation, "Error")
+        default_factory=lambda: defaults.get("hydro.radiation_tol"))
     radiation_fit: str = "auto"                # "coupled" | "columns" (hydro.fit.array_fit) | "auto"
     fit_judged_by: str = "response"            # "response": the device's (hydro.fit.response_error);
                                                # "kernel": K(jω)'s own error (hydro.fit.fit_error)

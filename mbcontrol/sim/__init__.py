@@ -13,6 +13,8 @@ from .integrators import prepare, rk4_step, wave_terms
 from .light import can_run as can_run_light
 from .light import simulate_arrays
 from .methods import METHODS, method
+from .protocol import OPTIONAL as CONTROLLER_OPTIONAL
+from .protocol import Controller, estimation_report, period_of, uses_state
 from .reference import simulate_convolution
 from .sampled import closed_loop_map, verdict as sampled_verdict
 from .sensitivity import sensitivity_name, sensitivity_plant
@@ -23,4 +25,5 @@ __all__ = ["simulate", "simulate_batch", "simulate_convolution", "energy_audit",
            "method", "stability_limit", "linear_stability_limit", "stability_table",
            "batch_states", "compiler", "plant_outputs", "prepare", "rk4_step", "wave_terms",
            "can_run_light", "simulate_arrays", "closed_loop_map", "sampled_verdict",
-           "sensitivity_name", "sensitivity_plant"]
+           "sensitivity_name", "sensitivity_plant", "Controller", "CONTROLLER_OPTIONAL", "period_of",
+           "uses_state", "estimation_report"]

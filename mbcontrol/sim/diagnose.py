@@ -25,6 +25,8 @@ import contextvars
 import casadi as ca
 import numpy as np
 
+from .protocol import name_of
+
 POLE_TOLERANCE = 1e-6        # Re(pole) above this times max(1, |fastest pole|), 1/s: unstable
 RERUN_MARGIN = 0.5           # the half-step rerun diverging before (1 + this) t_fail: physical
 RERUN_EXTRA_S = 5.0          # ... or within this many seconds of it
@@ -33,8 +35,7 @@ _RERUN = contextvars.ContextVar("mbcontrol_sim_diagnose_rerun", default=False)
 
 
 def controller_name(controller) -> str:
-    name = getattr(controller, "name", None) or type(controller).__name__
-    return repr(name)
+    return repr(name_of(controller))
 
 
 def law_loop(plant, law, p, x=None):

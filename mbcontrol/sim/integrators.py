@@ -26,6 +26,7 @@ from ..errors import InputError
 from ..plant import derived, f_by_parts
 from .compiled import compile_function
 from .methods import METHODS, method, radiation_exponential, radiation_split
+from .protocol import parametric_law
 
 CHUNK = 512         # steps per compiled call: long enough that Python overhead vanishes
 # Above CALL_F_STATES a step calls the plant's f as one function (MX) instead of inlining its
@@ -64,7 +65,7 @@ def embedded_law(controller, plant):
     casadi_law (gains None); (None, None) without a controller."""
     if controller is None:
         return None, None
-    parametric = getattr(controller, "casadi_law_parametric", None)
+    parametric = parametric_law(controller)
     if parametric is not None:
         law, gains = parametric(plant)
         return law, np.asarray(gains, float)

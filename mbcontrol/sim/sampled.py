@@ -26,6 +26,7 @@ import numpy as np
 
 from ..lti import zoh
 from . import diagnose
+from .protocol import period_of, uses_state
 
 
 def closed_loop_map(A, B, C, D, K, period: float) -> np.ndarray:
@@ -97,8 +98,8 @@ def check(plant, controller, p, dt: float):
     """The sampled-loop verdict (`verdict`) of a controller with a period and a static CasADi
     law, linearised at rest with parameters p; None when there is nothing to check (no
     controller, no period, no law, or full-state feedback)."""
-    period = getattr(controller, "period", None) if controller is not None else None
-    if not period or getattr(controller, "uses_state", False):
+    period = period_of(controller)
+    if not period or uses_state(controller):
         return None
     law = diagnose.static_law(plant, controller)
     if law is None:

@@ -28,6 +28,7 @@ from ..results import jsonable
 from . import diagnose, integrators, sampled
 from .held import HeldStepper
 from .moorings import mooring_report
+from .protocol import estimation_report, uses_state
 
 
 def simulate(plant, wave=None, *, duration: float, dt: float | None = None, controller=None,
@@ -107,7 +108,7 @@ def simulate(plant, wave=None, *, duration: float, dt: float | None = None, cont
     if not spec.fixed_step:
         ds.attrs["rtol"] = rtol
     ds.attrs["moorings"] = mooring_report(plant, ds)
-    report = getattr(controller, "estimation_report", None)    # an estimator's accuracy
+    report = estimation_report(controller)    # an estimator's accuracy
     if report is not None:
         ds.attrs["estimator"] = jsonable(report(t, W))
     if loop is not None:                 # analysis.validity reads it
@@ -195,7 +196,7 @@ def _last_command(plant, controller, t, x, U, w, p) -> np.ndarray:
 def _command(controller, t, y, x, nu) -> np.ndarray:
     """The controller's command; a controller with `uses_state = True` (full-state feedback,
     an oracle for studies) is also handed the plant's state."""
-    u = controller(t, y, x) if getattr(controller, "uses_state", False) else controller(t, y)
+    u = controller(t, y, x) if uses_state(controller) else controller(t, y)
     return np.asarray(u, float).reshape(nu)
 
 

@@ -32,6 +32,7 @@ import time
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
+from mbcontrol import defaults
 from mbcontrol.errors import HydroError
 
 from .array_passivity import enforce_columns
@@ -78,15 +79,17 @@ def column_classes(K, tol=SYMMETRY_TOL):
     return out
 
 
-def fit_radiation_columns(ds, dofs=None, *, tol: float = 0.02, omega_max=None, response_band=None,
+def fit_radiation_columns(ds, dofs=None, *, tol: float | None = None, omega_max=None, response_band=None,
                           max_order: int = 80, n_iter: int = 10) -> RadiationModel:
     """Fit K(jω) of ``dofs`` column by column (module docstring); a stable, passive RadiationModel.
 
     tol : the global RMS error over the fit band (and, with ``response_band`` (lo, hi) rad/s,
-    the per-frequency error there, module radiation "Error") to meet, else HydroError.
+    the per-frequency error there, module radiation "Error") to meet, else HydroError (None: the
+    'hydro.radiation_tol' default).
     omega_max : fit only ω <= omega_max (rad/s). max_order : most poles per column. n_iter :
     pole relocations per order."""
     t_start = time.perf_counter()
+    tol = defaults.get("hydro.radiation_tol") if tol is None else tol
     w, K, dofs = kernel_data(ds, dofs, omega_max)
     if w.size < 4:
         raise HydroError(f"fit_radiation_columns: {w.size} frequencies below omega_max={omega_max}; "

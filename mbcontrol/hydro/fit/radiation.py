@@ -54,6 +54,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.linalg as sla
 
+from mbcontrol import defaults
 from mbcontrol.errors import HydroError
 
 from ..data.dataset import matrix
@@ -162,13 +163,14 @@ def coupled_groups(ds, dofs) -> list[list[str]]:
     return [[dofs[i] for i in g] for g in _groups(reciprocal(K)[0])[0]]
 
 
-def fit_radiation(ds, dofs=None, *, tol: float = 0.02, max_order: int = 30, omega_max=None,
+def fit_radiation(ds, dofs=None, *, tol: float | None = None, max_order: int = 30, omega_max=None,
                   n_iter: int = 20, dc_zero: bool = True, refit: bool = True,
                   markov: bool = True, passive: bool = True,
                   passive_max_states: int = 100, response_band=None, device=None) -> RadiationModel:
     """Fit one coupled, strictly proper, stable state-space model to K(jω) of ``dofs``.
 
     tol : target error (RadiationModel.fit_error), met per decoupled group so the total meets it
+        (None: the 'hydro.radiation_tol' default, mbcontrol.defaults);
         too. response_band : (lo, hi) rad/s where the error is judged per frequency (module
         docstring, "Error"); None: the global error only (the worst per frequency is reported). With a
         ``device``, the band where the device's response is judged instead.
@@ -191,16 +193,16 @@ def fit_radiation(ds, dofs=None, *, tol: float = 0.02, max_order: int = 30, omeg
         up to passive_max_states for the smallest meeting tol (an SDP per order: ~1 s at 51 states, ~4 s
         at 90). fit_error is that of the returned model; report["passivity"] has before/after numbers.
     """
+    tol = defaults.get("hydro.radiation_tol") if tol is None else tol
     w, K, dofs = kernel_data(ds, dofs, omega_max)
     if w.size < 4:
         raise HydroError(f"fit_radiation: {w.size} frequencies below omega_max={omega_max}; expected at least 4")
     n = len(dofs)
     Ks, asym = reciprocal(K)                 # BEM reciprocity, up to discretisation
     groups, link = _groups(Ks)
-    # K(t=0+) = (2/π)∫B dω = C B, with B(0) = 0 and the power-law tail of impulse_response. Only
-    # meaningful for a group whose B has decayed inside the band (Σ|B_ii| over its DOFs at ω_max
-    # <= 25 % of its peak); otherwise the tail is a guess and neither the constraint nor the
-    # extrapolation is used for that group.
+    # K(t=0+) = (2/π)∫B dω = C B, with B(0) = 0 and the power-law tail of impulse_response. Only meaningful
+    # for a group whose B has decayed inside the band (Σ|B_ii| over its DOFs at ω_max <= 25 % of its peak);
+    # otherwise the tail is a guess and neither the constraint nor the extrapolation is used for that group.
     wz, Bz, p_tail = _with_tail(w, Ks.real, "auto")
     M1_all = _cos_transform(wz, Bz, np.zeros(1))[0] if markov else None
     diag_b = np.abs(np.einsum("kii->ki", Ks.real))

@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
+from ... import defaults
 from ...atomic import atomic_path
 from ...cache import cache_dir
 from ...console import status
@@ -47,7 +48,7 @@ def cached_fit(data: xr.Dataset, dofs, tol, source: str, omega_max: float = np.i
     data, the DOFs, the tolerance, the bands, the method and the device."""
     if method not in ("coupled", "columns"):
         raise HydroError(f"radiation fit method {method!r}: expected 'coupled' or 'columns'")
-    tol = 0.01 if tol is None else tol
+    tol = defaults.get("hydro.radiation_tol") if tol is None else tol
     digest = hashlib.sha256()
     for var in ("added_mass", "radiation_damping", "added_mass_inf"):
         digest.update(np.ascontiguousarray(data[var].values).tobytes())

@@ -55,6 +55,7 @@ from mbcontrol.errors import ControllerError, SimulationError
 from mbcontrol.results import jsonable
 
 from ...controllers import REGISTRY, make
+from ...sim import period_of
 from .tuning import CONTRACT, tune
 
 MAX_HARMONICS = 25            # the constrained bound's QP stays < 0.1 s (0.07 s at 15)
@@ -198,7 +199,7 @@ def design(plant, wave, name: str, *, pto: str | None = None, simulate_s: float 
     metrics = simulation = ds = None
     percent = {"complex_conjugate": None, "constrained": None}
     if margins is None or margins.stable:
-        if default_dt and getattr(controller, "period", None):
+        if default_dt and period_of(controller):
             dt = controller.period / math.ceil(controller.period / dt - 1e-9)
         if wave.omega.size == 1 and duration < wave.ramp_time + 10 * period:
             notes.append(f"{duration:.4g} s is shorter than the ramp ({wave.ramp_time:.4g} s) "
