@@ -88,7 +88,7 @@ class HydroModel:
             return interpolate_complex(self.omega, self.excitation_coefficients(direction), omega)
         direction = np.asarray(direction, float)
         if direction.shape != omega.shape:
-            raise ValueError(f"{self.source}: one wave direction per frequency expected, got "
+            raise HydroError(f"{self.source}: one wave direction per frequency expected, got "
                              f"{direction.size} directions for {omega.size} frequencies")
         weights = heading_matrix(self.data["wave_direction"].values, direction, self.source)
         data = self.data["excitation_force"].sel(influenced_dof=list(self.dofs)).transpose(

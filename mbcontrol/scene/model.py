@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import defaults
+from ..errors import InputError
 
 DOF_NAMES = ("Surge", "Sway", "Heave", "Roll", "Pitch", "Yaw")
 JOINT_TYPES = ("revolute", "prismatic", "fixed", "free")
@@ -119,7 +120,7 @@ class Pto:
         without one the two are the same force, and "machine" is returned."""
         on = self.force_max_on if force_on is None else {"wec": "hull"}.get(force_on, force_on)
         if on not in ("machine", "hull"):
-            raise ValueError(f"PTO {self.name!r}: force_on {force_on!r}: expected 'machine' "
+            raise InputError(f"PTO {self.name!r}: force_on {force_on!r}: expected 'machine' "
                              f"or 'hull'")
         return "hull" if on == "hull" and self.drivetrain is not None else "machine"
 

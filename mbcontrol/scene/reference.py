@@ -16,6 +16,7 @@ import re
 import tomllib
 from pathlib import Path
 
+from ..errors import InputError
 from .checks import Reader
 from .units import SI_UNIT
 
@@ -374,6 +375,6 @@ def in_readme(readme: str) -> str:
     """README text with the reference between its scene-keys markers replaced by markdown()."""
     head, found, rest = readme.partition(BEGIN)
     if not found or END not in rest:
-        raise ValueError(f"README: expected the markers {BEGIN.strip()} and {END}")
+        raise InputError(f"README: expected the markers {BEGIN.strip()} and {END}")
     return head + BEGIN + markdown() + END + rest.partition(END)[2]
 

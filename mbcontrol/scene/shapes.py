@@ -13,6 +13,7 @@ import math
 
 import numpy as np
 
+from ..errors import SceneError
 from .checks import _REQUIRED   # the scene readers' own marker of a required key
 from .units import UnitError, to_si
 
@@ -121,7 +122,7 @@ def immersed_volume(geometry) -> float:
         return revolution_volume(geometry.profile, geometry.center[2])
     hint = (" (a vertical cylinder of radius R from freeboard f to draft d is type = "
             "\"revolution\", profile = [[R, -f], [R, d], [0, d]])" if kind == "cylinder" else "")
-    raise ValueError(f"mass = \"displaced\" needs a geometry whose mesh holds its exact volume, "
+    raise SceneError(f"mass = \"displaced\" needs a geometry whose mesh holds its exact volume, "
                      f"type {' or '.join(DISPLACED_KINDS)}; got type = \"{kind}\"{hint}, or give the mass in kg")
 
 

@@ -22,6 +22,7 @@ import json
 import numpy as np
 import xarray as xr
 
+from ...errors import HydroError
 from ...waves import wavenumber
 from .solve import _geometry_for_key, compute
 from ..mesh.geometry import BemBody
@@ -99,7 +100,7 @@ def merge(parts: list[xr.Dataset]) -> xr.Dataset:
     for p in parts[1:]:
         if not (np.array_equal(p["omega"], first["omega"])
                 and np.array_equal(p["wave_direction"], first["wave_direction"])):
-            raise ValueError("merge: the bodies were solved on different frequencies or headings")
+            raise HydroError("merge: the bodies were solved on different frequencies or headings")
     dofs = [str(d) for p in parts for d in p["radiating_dof"].values]
     out = {}
     for name, da in first.data_vars.items():

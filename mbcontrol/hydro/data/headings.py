@@ -35,7 +35,7 @@ def headings_for_spread(mean: float, spread: float, step: float = STEP,
     needs: mean +- sigmas sigma on a uniform step no larger than `step` (rad), or the whole
     circle [-pi, pi) on such a step when that sector reaches +-pi."""
     if not (step > 0 and spread > 0 and math.isfinite(mean)):
-        raise ValueError(f"headings_for_spread: expected spread > 0 and step > 0 (rad), got "
+        raise HydroError(f"headings_for_spread: expected spread > 0 and step > 0 (rad), got "
                          f"{spread!r}, {step!r}")
     half = sigmas * spread
     if half >= math.pi - 1e-9:
