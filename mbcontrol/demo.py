@@ -34,7 +34,22 @@ def main(argv=None) -> int:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     report: dict = {"model": MODEL}
+    plant = _hydrodynamics(report)
+    sys = _linear(plant, report, out)
+    step("3/6 nonlinear time domain vs BEM-direct frequency domain (regular waves, H = 1 cm)")
+    report["validation"] = validate(plant, sys, out)
+    sea, laws = _design(plant, report, args.duration)
+    report["closed_loop"] = _closed_loop(plant, sea, laws, report, out, args.duration)
 
+    step("6/6 summary")
+    (out / "summary.json").write_text(json.dumps(report, indent=2, default=float))
+    (out / "summary.md").write_text(markdown(report))
+    print(f"  wrote {out}/summary.json, summary.md, bode.png, td_vs_fd.png, closed_loop.png")
+    return 0
+
+
+def _hydrodynamics(report: dict):
+    """Stage 1: the plant from its scene, hydrodynamics and radiation fit included."""
     step("1/6 scene and hydrodynamics")
     start = time.perf_counter()
     plant = build_plant(MODEL)
@@ -45,7 +60,11 @@ def main(argv=None) -> int:
                        "build_s": time.perf_counter() - start}
     print(f"  {len(plant.hydro.dofs)} hydro DOFs, radiation model {rad.order} states "
           f"(fit error {rad.fit_error:.2%}), plant built in {report['plant']['build_s']:.2f} s")
+    return plant
 
+
+def _linear(plant, report: dict, out: Path):
+    """Stage 2: the linearised plant (no Coulomb friction), its poles and Bode plot."""
     step("2/6 linearised control plant and Bode plot")
     sys = linearize(plant, params=NO_COULOMB)
     poles = np.linalg.eigvals(np.asarray(sys.A))
@@ -56,13 +75,15 @@ def main(argv=None) -> int:
     report["linear"] = {"n_states": int(sys.nstates), "stable": bool(np.all(poles.real < 0)),
                         "slowest_pole_real": float(poles.real.max())}
     print(f"  {sys.nstates} states, stable: {report['linear']['stable']}; bode.png")
+    return sys
 
-    step("3/6 nonlinear time domain vs BEM-direct frequency domain (regular waves, H = 1 cm)")
-    report["validation"] = validate(plant, sys, out)
 
+def _design(plant, report: dict, duration: float):
+    """Stage 4: passive and reactive laws tuned for a JONSWAP sea, MPCs set up for it, and
+    the complex-conjugate bound: (the sea, {label: controller or None})."""
     step("4/6 passive and reactive PTO laws designed for a JONSWAP sea (Hs 3 cm, Tp 1.1 s)")
     from mbcontrol.controllers import Passive, optimal_damping
-    sea = waves.irregular(0.03, 1.1, gamma=3.3, seed=1, duration=args.duration)
+    sea = waves.irregular(0.03, 1.1, gamma=3.3, seed=1, duration=duration)
     damping, p_design = optimal_damping(plant, sea)
     c_scene = float(plant.p0[plant.parameters.index("hinge_pto__damping")])
     report["design"] = {"sea": sea.describe(), "scene_damping": c_scene,
@@ -82,30 +103,36 @@ def main(argv=None) -> int:
     print(f"  reactive within the {limit:g} N m torque limit: damping {c_r:.3g}, stiffness "
           f"{k_r:.3g} N m/rad; predicted {p_r * 1e3:.3g} mW; complex-conjugate bound "
           f"{bound * 1e3:.3g} mW")
-
-    step(f"5/6 closed loop on the nonlinear plant ({args.duration:.0f} s)")
     # a drive's slew limit: a full torque reversal in a fifth of the peak period at the least
     rate = 5 * 2 * limit / sea.period
+    report["design"]["mpc_rate_limit"] = rate
+    return sea, {f"scene PTO law ({c_scene:g} N m s/rad)": None,
+                 "passive, designed": Passive(damping),
+                 "reactive, designed": Reactive(c_r, k_r),
+                 f"MPC (AR), {limit:g} N m, {rate:.0f} N m/s":
+                     Mpc(horizon_s=1.2, dt_s=0.03, wave=sea, forecast="ar", rate_max=rate),
+                 f"MPC (AR), {limit:g} N m, no rate limit":
+                     Mpc(horizon_s=1.2, dt_s=0.03, wave=sea, forecast="ar")}
+
+
+def _closed_loop(plant, sea, laws: dict, report: dict, out: Path, duration: float) -> dict:
+    """Stage 5: each law in closed loop on the nonlinear plant, checked and plotted: the runs'
+    summaries by label."""
+    step(f"5/6 closed loop on the nonlinear plant ({duration:.0f} s)")
     runs, records = {}, {}
-    for label, controller in ((f"scene PTO law ({c_scene:g} N m s/rad)", None),
-                              ("passive, designed", Passive(damping)),
-                              ("reactive, designed", Reactive(c_r, k_r)),
-                              (f"MPC (AR), {limit:g} N m, {rate:.0f} N m/s",
-                               Mpc(horizon_s=1.2, dt_s=0.03, wave=sea, forecast="ar",
-                                   rate_max=rate)),
-                              (f"MPC (AR), {limit:g} N m, no rate limit",
-                               Mpc(horizon_s=1.2, dt_s=0.03, wave=sea, forecast="ar"))):
-        ds = simulate(plant, sea, duration=args.duration, dt=0.005, controller=controller)
+    for label, controller in laws.items():
+        ds = simulate(plant, sea, duration=duration, dt=0.005, controller=controller)
         runs[label], records[label] = summary(ds, plant), ds
         print(f"  {label:34s} mean power {runs[label]['ptos']['hinge_pto']['mean_power_W'] * 1e3:7.3f}"
               f" mW, max torque {runs[label]['ptos']['hinge_pto']['max_force']:.3f} N m, "
-              f"simulated at {args.duration / runs[label]['wall_time_s']:,.0f}x real time")
+              f"simulated at {duration / runs[label]['wall_time_s']:,.0f}x real time")
     failed = {k: r["invalid_reasons"] for k, r in runs.items() if not r["valid"]}
     print("  every run passed its physics checks (power bound of its wave, energy balance, "
           "linear range)" if not failed else
           "\n".join(f"  INVALID {k}: {'; '.join(v)}" for k, v in failed.items()))
     limited, free = (runs[k]["ptos"]["hinge_pto"]["mean_power_W"] for k in list(runs)[-2:])
-    report["design"].update(mpc_rate_limit=rate, mpc_power_change_by_rate_limit=limited / free - 1)
+    rate = report["design"]["mpc_rate_limit"]
+    report["design"]["mpc_power_change_by_rate_limit"] = limited / free - 1
     print(f"  the {rate:.0f} N m/s torque-rate limit changes the MPC's power by "
           f"{100 * (limited / free - 1):+.1f} %")
     mean_mw = {k: f"mean {r['ptos']['hinge_pto']['mean_power_W'] * 1e3:.3g} mW"
@@ -113,7 +140,7 @@ def main(argv=None) -> int:
     plotting.compare_runs({k: v.sel(time=slice(20, 40)) for k, v in records.items()},
                           ["hinge", "hinge_pto__force", "hinge_pto__power"],
                           title=f"hinged barge in a JONSWAP sea (Hs 3 cm, Tp 1.1 s): each column "
-                                f"one controller; 20-40 s of each {args.duration:g} s run shown, "
+                                f"one controller; 20-40 s of each {duration:g} s run shown, "
                                 f"means over each run after its ramp",
                           units={"hinge": "rad", "hinge_pto__force": "N m",
                                  "hinge_pto__power": "W"},
@@ -121,13 +148,7 @@ def main(argv=None) -> int:
                                   "hinge_pto__power": "absorbed power"},
                           notes={"hinge_pto__power": mean_mw},
                           path=out / "closed_loop.png")
-    report["closed_loop"] = runs
-
-    step("6/6 summary")
-    (out / "summary.json").write_text(json.dumps(report, indent=2, default=float))
-    (out / "summary.md").write_text(markdown(report))
-    print(f"  wrote {out}/summary.json, summary.md, bode.png, td_vs_fd.png, closed_loop.png")
-    return 0
+    return runs
 
 
 def validate(plant, sys, out: Path) -> dict:

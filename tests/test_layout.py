@@ -1,7 +1,8 @@
 """The house's layout, read from the source with `ast`: imports run one way along the flow
 (scene < multibody < hydro < plant < sim < analysis < controllers < studies < export < cli), no module
-imports itself back through others, no module is past the size rule, no generated file is
-committed. Function-level (lazy) imports count as much as module-level ones."""
+imports itself back through others, another package is entered only by its face (its
+__init__), no module and no function is past the size rule, no generated file is committed.
+Function-level (lazy) imports count as much as module-level ones."""
 import ast
 import subprocess
 from pathlib import Path
@@ -315,3 +316,34 @@ def test_the_face_rule_sees_reaching_imports(statement, reaches):
     if statement.startswith("from ."):
         module = "mbcontrol.plant.build"
     assert _reached(module, MODULES[module], node) == reaches
+
+
+MAX_FUNCTION_LINES = 80      # a function's code past its docstring; past that it is two steps
+MAX_POSITIONAL = 10          # past that a call site cannot be read without the signature
+
+
+def _function_sizes():
+    """(where, code lines, positional parameters) of every function in the package."""
+    for module, path in MODULES.items():
+        for node in ast.walk(ast.parse(path.read_text(), str(path))):
+            if not isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                continue
+            body = node.body
+            if (len(body) > 1 and isinstance(body[0], ast.Expr)
+                    and isinstance(body[0].value, ast.Constant)
+                    and isinstance(body[0].value.value, str)):
+                body = body[1:]
+            args = node.args
+            positional = [a.arg for a in args.posonlyargs + args.args if a.arg not in ("self", "cls")]
+            yield (f"{path.relative_to(ROOT)}:{node.lineno} {node.name}",
+                   node.end_lineno - body[0].lineno + 1, len(positional))
+
+
+def test_no_function_past_the_size_rule():
+    """The module rule one level down: a function over ~80 lines of code does several things,
+    and one with over ~10 positional parameters is called by position (issue 39 found one of
+    107 lines and 17)."""
+    long = [f"{where}: {n} lines" for where, n, _ in _function_sizes() if n > MAX_FUNCTION_LINES]
+    many = [f"{where}: {p} positional parameters" for where, _, p in _function_sizes()
+            if p > MAX_POSITIONAL]
+    assert not long + many, "\n".join(long + many)

@@ -205,7 +205,22 @@ def build_parser() -> argparse.ArgumentParser:
     loudness.add_argument("-q", "--quiet", action="store_true",
                           help="only warnings and errors: no status lines, no progress bars")
     sub = parser.add_subparsers(title="commands", metavar="COMMAND")
+    _add_reference_commands(sub)
+    _add_hydro(sub)
+    _add_simulate(sub, controllers)
+    _add_design(sub, controllers)
+    _add_bench(sub)
+    _add_fidelity(sub)
+    _add_linearize(sub)
+    add_identify_parser(sub)
+    add_sweep_parser(sub)
+    add_codesign_parser(sub, _wave_options)
+    add_export_parser(sub, _model_options, _wave_options)
+    return parser
 
+
+def _add_reference_commands(sub) -> None:
+    """models, defaults, keys: what the toolbox holds and takes."""
     p = sub.add_parser("models", help="list the catalogue, or describe one model: its bodies, "
                                       "joints, PTOs, parameters and the controllers' settings")
     p.add_argument("name", nargs="?", help="a model (catalogue name or scene .toml) to describe")
@@ -224,6 +239,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="write the reference into FILE's scene-keys section (default README.md)")
     p.set_defaults(run=run_keys)
 
+
+def _add_hydro(sub) -> None:
     p = sub.add_parser("hydro", help="load or compute a model's BEM data and fit its radiation "
                                      "model; print the fit report")
     _model_options(p)
@@ -236,6 +253,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="print the report as JSON")
     p.set_defaults(run=run_hydro)
 
+
+def _add_simulate(sub, controllers: str) -> None:
     p = sub.add_parser("simulate", help="simulate a model in waves (nonlinear process plant)",
                        description=SIMULATE_HELP, formatter_class=argparse.RawTextHelpFormatter)
     _model_options(p)
@@ -268,6 +287,8 @@ def build_parser() -> argparse.ArgumentParser:
                         "(exit status 3 without this flag)")
     p.set_defaults(run=run_simulate)
 
+
+def _add_design(sub, controllers: str) -> None:
     p = sub.add_parser("design", help="tune a controller for a sea; check its stability margins, "
                                       "bound it and simulate it",
                        description=DESIGN_HELP, formatter_class=argparse.RawTextHelpFormatter)
@@ -295,6 +316,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="print the design as JSON")
     p.set_defaults(run=run_design)
 
+
+def _add_bench(sub) -> None:
     p = sub.add_parser("bench", help="speed against accuracy: work-precision chart and table of "
                                      "every integration method and radiation order; stability "
                                      "limits", description=BENCH_HELP,
@@ -317,6 +340,8 @@ def build_parser() -> argparse.ArgumentParser:
                                                "(default out/bench/MODEL)")
     p.set_defaults(run=run_bench)
 
+
+def _add_fidelity(sub) -> None:
     p = sub.add_parser("fidelity", help="the cheapest model that meets an error tolerance in a sea "
                                         "(fidelity='auto'): what it dropped and what that cost",
                        formatter_class=argparse.RawTextHelpFormatter)
@@ -330,6 +355,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", help="write the candidate table to this netCDF file")
     p.set_defaults(run=run_fidelity)
 
+
+def _add_linearize(sub) -> None:
     p = sub.add_parser("linearize", help="linearise about rest; poles, Bode plot")
     _model_options(p)
     p.add_argument("--bode", metavar="FILE.png", help="write a Bode plot")
@@ -340,11 +367,6 @@ def build_parser() -> argparse.ArgumentParser:
                         "(a smoothed Coulomb friction linearises to its slope at rest)")
     p.add_argument("--json", action="store_true", help="print signals and poles as JSON")
     p.set_defaults(run=run_linearize)
-    add_identify_parser(sub)
-    add_sweep_parser(sub)
-    add_codesign_parser(sub, _wave_options)
-    add_export_parser(sub, _model_options, _wave_options)
-    return parser
 
 
 def _model_options(p) -> None:

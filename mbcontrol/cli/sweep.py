@@ -216,30 +216,14 @@ def run_sweep(args) -> int:
 
     from mbcontrol.controllers import REGISTRY
 
-    from ..studies.sweep import grid, read_seas, sweep
+    from ..studies.sweep import sweep
     from .commands import _key_value, _warn_if_absorbs_nothing, parse_settings
-    if args.hs is not None:
-        if not args.tp:
-            raise InputError("--hs needs --tp (the grid's peak periods)")
-        seas = grid(args.hs, args.tp, args.gamma)
-    else:
-        if args.tp:
-            raise InputError("--tp goes with --hs; a --seas file gives its own periods")
-        seas = read_seas(args.seas, args.gamma)
-    seas = spread_seas(seas, args.spread, args.spreading)
+    seas = _seas(args)
     if args.set and not args.controller:
         raise InputError("--set needs --controller")
     cls = REGISTRY.get(args.controller) if args.controller else None
     settings = parse_settings(args.set, inspect.signature(cls).parameters if cls else {})
-    vary = {}
-    for item in args.vary:
-        name, _, values = item.partition("=")
-        try:
-            vary[name.strip()] = [float(v) for v in values.split(",") if v.strip()]
-        except ValueError:
-            raise InputError(f"--vary {item}: expected NAME=v1,v2,... with numbers") from None
-        if not vary[name.strip()]:
-            raise InputError(f"--vary {item}: expected NAME=v1,v2,... with at least one value")
+    vary = _vary(args.vary)
     if not args.design:
         _warn_if_absorbs_nothing(args.controller, settings, vary)
     common = dict(seeds=args.seeds, vary=vary, params=dict(_key_value(s, "--param") for s in args.param),
@@ -269,7 +253,42 @@ def run_sweep(args) -> int:
         plot_sweep(ds, summary, args.plot)
     if args.json:
         print(json.dumps(summary, indent=2))
-        return 0
+    else:
+        _print_summary(summary, args.store)
+    return 0
+
+
+def _seas(args) -> list:
+    """The seas of --hs/--tp (a grid) or --seas (a site file), spread as asked."""
+    from ..studies.sweep import grid, read_seas
+    if args.hs is not None:
+        if not args.tp:
+            raise InputError("--hs needs --tp (the grid's peak periods)")
+        seas = grid(args.hs, args.tp, args.gamma)
+    else:
+        if args.tp:
+            raise InputError("--tp goes with --hs; a --seas file gives its own periods")
+        seas = read_seas(args.seas, args.gamma)
+    return spread_seas(seas, args.spread, args.spreading)
+
+
+def _vary(items: list[str]) -> dict:
+    """--vary NAME=v1,v2,... as {name: [values]}."""
+    vary = {}
+    for item in items:
+        name, _, values = item.partition("=")
+        try:
+            vary[name.strip()] = [float(v) for v in values.split(",") if v.strip()]
+        except ValueError:
+            raise InputError(f"--vary {item}: expected NAME=v1,v2,... with numbers") from None
+        if not vary[name.strip()]:
+            raise InputError(f"--vary {item}: expected NAME=v1,v2,... with at least one value")
+    return vary
+
+
+def _print_summary(summary: dict, store) -> None:
+    """The sweep's text report: a row per sea, notes, invalid and failed cases, the annual
+    energy with its interval and budget, a farm's q factor."""
     print(f"{summary['model']}: {summary['cases']} cases ({summary['computed']} computed, "
           f"{summary['reused']} reused) in {summary['wall_time_s']:.1f} s")
     farm = summary.get("farm")
@@ -312,6 +331,5 @@ def run_sweep(args) -> int:
         print(f"  farm of {farm['devices']} devices: annual energy {summary['annual_energy_MWh']:.4g} MWh "
               f"against {farm['annual_energy_isolated_MWh']:.4g} MWh for as many devices alone: "
               f"q = {farm['q_annual']:.3f}")
-    if args.store:
-        print(f"wrote {args.store}/sweep.nc", file=sys.stderr)
-    return 0
+    if store:
+        print(f"wrote {store}/sweep.nc", file=sys.stderr)

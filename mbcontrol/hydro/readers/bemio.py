@@ -64,6 +64,28 @@ def _orient_stiffness(C: np.ndarray, notes: list, name: str) -> np.ndarray:
     return C
 
 
+def _body_excitation(f, hc: str, src: str, rows: slice, rho: float, g: float, targets: dict) -> set:
+    """One body's excitation parts (total, Froude-Krylov, scattering: `targets`, (Nβ, Nω, n)),
+    dimensional and conjugated for e^{-iωt}, into its rows; the optional parts the file lacks
+    (absent or nan)."""
+    lacking = set()
+    for key, target in targets.items():
+        nh, nw = target.shape[:2]
+        if f"{hc}/{key}/re" not in f:
+            if key == "excitation":
+                raise HydroError(f"{src}: missing '{hc}/excitation/re'; expected excitation data")
+            lacking.add(key)
+            continue
+        re_ = _array(f, f"{hc}/{key}/re", src, (6, nh, nw))
+        im_ = _array(f, f"{hc}/{key}/im", src, (6, nh, nw))
+        if key != "excitation" and np.all(np.isnan(re_)):
+            lacking.add(key)
+            continue
+        # (6, Nβ, Nω) -> (Nβ, Nω, 6); conjugate for e^{-iωt}
+        target[:, :, rows] = np.transpose(re_ - 1j * im_, (1, 2, 0)) * rho * g
+    return lacking
+
+
 def read_bemio(path, *, body_names=None, **clean_kw):
     """Read a BEMIO ``.h5`` file into the data-frame dataset (dimensional, e^{-iωt}, z up).
 
@@ -122,20 +144,10 @@ def read_bemio(path, *, body_names=None, **clean_kw):
             Ainf[rows, :] = _array(f, f"{hc}/added_mass/inf_freq", src, (6, n)) * rho
             C = _array(f, f"{hc}/linear_restoring_stiffness", src, (6, 6))
             K[rows, rows] = _orient_stiffness(C, notes, found[-1]) * rho * g
-            for key, target in (("excitation", exc), ("excitation/froude-krylov", fk),
-                                ("excitation/scattering", sc)):
-                if f"{hc}/{key}/re" not in f:
-                    if key == "excitation":
-                        raise HydroError(f"{src}: missing '{hc}/excitation/re'; expected excitation data")
-                    have_fk, have_sc = (False, have_sc) if "froude" in key else (have_fk, False)
-                    continue
-                re_ = _array(f, f"{hc}/{key}/re", src, (6, nh, nw))
-                im_ = _array(f, f"{hc}/{key}/im", src, (6, nh, nw))
-                if key != "excitation" and np.all(np.isnan(re_)):
-                    have_fk, have_sc = (False, have_sc) if "froude" in key else (have_fk, False)
-                    continue
-                # (6, Nβ, Nω) -> (Nβ, Nω, 6); conjugate for e^{-iωt}
-                target[:, :, rows] = np.transpose(re_ - 1j * im_, (1, 2, 0)) * rho * g
+            lacking = _body_excitation(f, hc, src, rows, rho, g, {
+                "excitation": exc, "excitation/froude-krylov": fk, "excitation/scattering": sc})
+            have_fk = have_fk and "excitation/froude-krylov" not in lacking
+            have_sc = have_sc and "excitation/scattering" not in lacking
             ref.append(_array(f, f"{p}/cg", src).reshape(-1)[:3])
             cob.append(_array(f, f"{p}/cb", src).reshape(-1)[:3])
             vol.append(float(_array(f, f"{p}/disp_vol", src).reshape(-1)[0]))

@@ -133,18 +133,9 @@ def _per_body(ds, name, bodies, single, src):
     return None
 
 
-def read_capytaine(path, *, body_names=None, **clean_kw) -> xr.Dataset:
-    """Read a Capytaine netCDF dataset (or an mbcontrol one) into the data-frame dataset.
-
-    ``body_names`` (one per body, in the file's order) replace the names in the file.
-    ``**clean_kw`` are options of :func:`mbcontrol.hydro.readers.clean`.
-    """
-    path = Path(path)
-    src = f"Capytaine {path}"
-    raw = _open(path, src)
-    if "mbc_encoded_attrs" in raw.attrs or "matrix_layout" in raw.attrs:
-        return clean(_from_mbcontrol(path, f"mbcontrol {path}", body_names), source=f"mbcontrol {path}", **clean_kw)
-    ds = _merge_complex(raw)
+def _one_condition(ds: xr.Dataset, src: str) -> xr.Dataset:
+    """The results checked for radiation and diffraction, on an omega dimension, at one g, rho,
+    depth and (zero) speed."""
     for v in ("added_mass", "radiation_damping"):
         if v not in ds:
             raise HydroError(f"{src}: no '{v}' variable; expected radiation results (capytaine.export_dataset)")
@@ -162,6 +153,46 @@ def read_capytaine(path, *, body_names=None, **clean_kw) -> xr.Dataset:
             if ds.sizes[d] != 1:
                 raise HydroError(f"{src}: {ds.sizes[d]} values of {d}; expected one (select one first)")
             ds = ds.isel({d: 0})
+    return ds
+
+
+def _body_points(ds, file_bodies, names, single, src, *, rho, parsed, order, notes):
+    """(centres of buoyancy, of mass (or None), reference points, displaced volumes m^3) per
+    body; a body without a rotation_center and with translation DOFs only refers to its centre
+    of mass (noted)."""
+    cob = _per_body(ds, "center_of_buoyancy", file_bodies, single, src)
+    rc = _per_body(ds, "rotation_center", file_bodies, single, src)
+    com = _per_body(ds, "center_of_mass", file_bodies, single, src)
+    if cob is None:
+        raise HydroError(f"{src}: no 'center_of_buoyancy'; expected Capytaine hydrostatics in the dataset")
+    if "disp_mass" in ds:
+        vol = np.atleast_1d(np.asarray(ds["disp_mass"].values, dtype=float)).reshape(-1) / rho
+    else:
+        raise HydroError(f"{src}: no 'disp_mass'; expected Capytaine hydrostatics in the dataset")
+    ref = np.zeros((len(file_bodies), 3)) if rc is None else rc.copy()
+    for k, b in enumerate(file_bodies):
+        if not np.all(np.isfinite(ref[k])):
+            has_rot = any(parsed[d][0] == b and parsed[d][1] in ("Roll", "Pitch", "Yaw") for d in order)
+            if has_rot:
+                raise HydroError(f"{src}: body {b!r} has rotation DOFs but no rotation_center; expected it")
+            ref[k] = com[k] if com is not None and np.all(np.isfinite(com[k])) else 0.0
+            notes.append(f"body {names[k]}: no rotation_center (translation DOFs only); reference_point set to "
+                         f"{ref[k].tolist()}, which does not change translation-only data")
+    return cob, com, ref, vol
+
+
+def read_capytaine(path, *, body_names=None, **clean_kw) -> xr.Dataset:
+    """Read a Capytaine netCDF dataset (or an mbcontrol one) into the data-frame dataset.
+
+    ``body_names`` (one per body, in the file's order) replace the names in the file.
+    ``**clean_kw`` are options of :func:`mbcontrol.hydro.readers.clean`.
+    """
+    path = Path(path)
+    src = f"Capytaine {path}"
+    raw = _open(path, src)
+    if "mbc_encoded_attrs" in raw.attrs or "matrix_layout" in raw.attrs:
+        return clean(_from_mbcontrol(path, f"mbcontrol {path}", body_names), source=f"mbcontrol {path}", **clean_kw)
+    ds = _one_condition(_merge_complex(raw), src)
     rho, g = _single(ds, "rho", src), _single(ds, "g", src)
     depth = _single(ds, "water_depth", src)
     if _single(ds, "forward_speed", src, default=0.0) != 0.0:
@@ -214,25 +245,8 @@ def read_capytaine(path, *, body_names=None, **clean_kw) -> xr.Dataset:
     else:
         raise HydroError(f"{src}: no 'hydrostatic_stiffness'; expected Capytaine hydrostatics in the dataset "
                          "(give the body a center_of_mass before solving)")
-    nb = len(file_bodies)
-    cob = _per_body(ds, "center_of_buoyancy", file_bodies, single, src)
-    rc = _per_body(ds, "rotation_center", file_bodies, single, src)
-    com = _per_body(ds, "center_of_mass", file_bodies, single, src)
-    if cob is None:
-        raise HydroError(f"{src}: no 'center_of_buoyancy'; expected Capytaine hydrostatics in the dataset")
-    if "disp_mass" in ds:
-        vol = np.atleast_1d(np.asarray(ds["disp_mass"].values, dtype=float)).reshape(-1) / rho
-    else:
-        raise HydroError(f"{src}: no 'disp_mass'; expected Capytaine hydrostatics in the dataset")
-    ref = np.zeros((nb, 3)) if rc is None else rc.copy()
-    for k, b in enumerate(file_bodies):
-        if not np.all(np.isfinite(ref[k])):
-            has_rot = any(parsed[d][0] == b and parsed[d][1] in ("Roll", "Pitch", "Yaw") for d in order)
-            if has_rot:
-                raise HydroError(f"{src}: body {b!r} has rotation DOFs but no rotation_center; expected it")
-            ref[k] = com[k] if com is not None and np.all(np.isfinite(com[k])) else 0.0
-            notes.append(f"body {names[k]}: no rotation_center (translation DOFs only); reference_point set to "
-                         f"{ref[k].tolist()}, which does not change translation-only data")
+    cob, com, ref, vol = _body_points(ds, file_bodies, names, single, src, rho=rho, parsed=parsed,
+                                      order=order, notes=notes)
     notes.append("reference_point = Capytaine rotation_center of each body; cog = center_of_mass")
     ds_out = build_dataset(bodies=names, dofs=dofs, omega=w[fin], A=Afull[fin], B=Bfull[fin], K=K, exc=exc,
                            headings=heads, A0=A0, Ainf=Ainf, fk=fk, diff=diff, volume=vol, cob=cob, ref=ref,

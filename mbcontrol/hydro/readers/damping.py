@@ -31,6 +31,36 @@ def _flag_damping(Ss, diag_tol, eig_tol):
     return out
 
 
+def _runs(bad) -> list[tuple[int, int]]:
+    """(first, last) index of each run of consecutive flagged frequencies."""
+    n = len(bad)
+    runs, k = [], 0
+    while k < n:
+        if bad[k]:
+            k1 = k
+            while k1 + 1 < n and bad[k1 + 1]:
+                k1 += 1
+            runs.append((k, k1))
+            k = k1 + 1
+        else:
+            k += 1
+    return runs
+
+
+def _repairs_text(changes: list, dofs: list) -> str:
+    """One sentence on the repairs: how many frequencies, where, which DOFs, by which method."""
+    nw = sum(len(c["omega"]) for c in changes)
+    runs_txt = [f"{c['omega'][0]:.4g}" + (f"..{c['omega'][-1]:.4g}" if len(c["omega"]) > 1 else "") for c in changes]
+    touched = sorted({d for c in changes for d in c["dofs"]}, key=dofs.index)
+    kinds = {}
+    for c in changes:
+        key = c["method"].split(" (")[0].split(":")[0]
+        kinds[key] = kinds.get(key, 0) + len(c["omega"])
+    return (f"negative radiation damping repaired at {nw} frequencies (ω = {', '.join(runs_txt)} rad/s; DOFs "
+            f"{touched}; " + "; ".join(f"{k}: {v}" for k, v in kinds.items())
+            + "); details in attrs['cleaning']['negative_damping']")
+
+
 def repair_negative_damping(ds, src, record, notes, *, diag_tol, eig_tol, max_run, end_zero_tol, mode):
     dofs = [str(d) for d in ds["radiating_dof"].values]
     w = np.asarray(ds["omega"].values, dtype=float)
@@ -47,18 +77,8 @@ def repair_negative_damping(ds, src, record, notes, *, diag_tol, eig_tol, max_ru
                          f"(DOFs {[dofs[i] for i in sorted(flags[k][1])]}, min scaled eigenvalue "
                          f"{flags[k][2]:.3g}); expected B(ω) positive semi-definite")
     n = len(w)
-    runs, k = [], 0
-    while k < n:
-        if bad[k]:
-            k1 = k
-            while k1 + 1 < n and bad[k1 + 1]:
-                k1 += 1
-            runs.append((k, k1))
-            k = k1 + 1
-        else:
-            k += 1
     changes = []
-    for k0, k1 in runs:
+    for k0, k1 in _runs(bad):
         idx = list(range(k0, k1 + 1))
         off = sorted(set().union(*(flags[i][1] for i in idx)))
         before = min(flags[i][2] for i in idx)
@@ -112,16 +132,7 @@ def repair_negative_damping(ds, src, record, notes, *, diag_tol, eig_tol, max_ru
                         "method": method, "min_scaled_eigenvalue_before": before})
     set_force_first(ds, "radiation_damping", B)
     record["negative_damping"] = changes
-    nw = sum(len(c["omega"]) for c in changes)
-    runs_txt = [f"{c['omega'][0]:.4g}" + (f"..{c['omega'][-1]:.4g}" if len(c["omega"]) > 1 else "") for c in changes]
-    touched = sorted({d for c in changes for d in c["dofs"]}, key=dofs.index)
-    kinds = {}
-    for c in changes:
-        key = c["method"].split(" (")[0].split(":")[0]
-        kinds[key] = kinds.get(key, 0) + len(c["omega"])
-    text = (f"negative radiation damping repaired at {nw} frequencies (ω = {', '.join(runs_txt)} rad/s; DOFs "
-            f"{touched}; " + "; ".join(f"{k}: {v}" for k, v in kinds.items())
-            + "); details in attrs['cleaning']['negative_damping']")
+    text = _repairs_text(changes, dofs)
     notes.append(text)
     warnings.warn(f"{src}: {text}", HydroCleaningWarning, stacklevel=4)
     return ds

@@ -189,16 +189,7 @@ def read_wamit(path, *, rho: float = 1000.0, g: float | None = None, body_names=
     hdr, blocks = parsed["hdr"], parsed["blocks"]
     notes = []
     bodies = hdr["bodies"]
-    if not bodies:
-        raise HydroError(f"{src}: no body parameters (no 'XBODY =' line); expected a complete WAMIT .out file")
-    for k, b in enumerate(bodies):
-        if abs(b["phi"]) > 0:
-            raise HydroError(f"{src}: body {k + 1} has PHIBODY = {b['phi']} deg (line {b['line']}); only bodies "
-                             "whose axes are parallel to the global axes (PHIBODY = 0) are supported")
-        for key, size in (("vol", 3), ("cob", 3), ("c3", 3), ("c4", 3), ("c5", 2)):
-            if len(b.get(key, [])) < size:
-                raise HydroError(f"{src}: body {k + 1}: hydrostatic data incomplete ({key}); "
-                                 "expected Volumes, Center of Buoyancy and C(3,3)..C(5,6) lines")
+    _check_bodies(src, bodies)
     g_file = hdr["g"]
     if g_file is None:
         raise HydroError(f"{src}: no 'Gravity:' line; expected the WAMIT header")
@@ -217,12 +208,42 @@ def read_wamit(path, *, rho: float = 1000.0, g: float | None = None, body_names=
     dofs = dof_names(names)
     if any(v is not None and v > 0 for v in hdr["irr"]):
         notes.append("WAMIT irregular-frequency removal was on (IRR > 0)")
-
-    zero = [b for b in blocks if b.period == math.inf]
-    inf = [b for b in blocks if b.period == 0.0]
     fin = [b for b in blocks if 0.0 < b.period < math.inf]
     if not fin:
         raise HydroError(f"{src}: missing frequencies: no 'Wave period (sec) =' blocks with coefficients")
+    _check_modes(src, blocks, nb)
+    w, A, B, A0, Ainf = _radiation(blocks, n, rho, L)
+    exc, fk, diff, heads = _excitation(src, fin, n, rho, g, L, excitation, notes)
+    K, vol, cob, ref, cog, awp = _hydrostatics(bodies, names, rho, g, L, notes)
+    cog_arr = np.array(cog)
+    notes.append("reference_point = XBODY origin of each body; cog and center_of_buoyancy converted from body "
+                 "to global coordinates; waterplane_area = C(3,3)/(rho g)")
+    ds = build_dataset(bodies=names, dofs=dofs, omega=w, A=A, B=B, K=K, exc=exc, headings=np.radians(heads),
+                       A0=A0, Ainf=Ainf, fk=fk, diff=diff, volume=vol, cob=np.array(cob), ref=np.array(ref),
+                       cog=None if np.isnan(cog_arr).any() else cog_arr, awp=awp, rho=rho, g=g, depth=depth,
+                       source=src, notes=notes)
+    ds.attrs["length_scale"] = L
+    ds.attrs["original_time_convention"] = "exp(+i omega t) (WAMIT); excitation conjugated"
+    return clean(ds, source=src, **clean_kw)
+
+
+def _check_bodies(src: str, bodies: list) -> None:
+    """Refuse a file without body parameters, a rotated body, incomplete hydrostatics."""
+    if not bodies:
+        raise HydroError(f"{src}: no body parameters (no 'XBODY =' line); expected a complete WAMIT .out file")
+    for k, b in enumerate(bodies):
+        if abs(b["phi"]) > 0:
+            raise HydroError(f"{src}: body {k + 1} has PHIBODY = {b['phi']} deg (line {b['line']}); only bodies "
+                             "whose axes are parallel to the global axes (PHIBODY = 0) are supported")
+        for key, size in (("vol", 3), ("cob", 3), ("c3", 3), ("c4", 3), ("c5", 2)):
+            if len(b.get(key, [])) < size:
+                raise HydroError(f"{src}: body {k + 1}: hydrostatic data incomplete ({key}); "
+                                 "expected Volumes, Center of Buoyancy and C(3,3)..C(5,6) lines")
+
+
+def _check_modes(src: str, blocks: list, nb: int) -> None:
+    """Every mode index of the coefficient and excitation blocks is one of the bodies' 6 nb."""
+    n = 6 * nb
     for b in blocks:
         bad = [ij for ij in list(b.A) + list(b.B) if max(ij) > n or min(ij) < 1]
         if bad:
@@ -234,17 +255,25 @@ def read_wamit(path, *, rho: float = 1000.0, g: float | None = None, body_names=
                 raise HydroError(f"{src}: wrong DOF count: {kind} excitation mode {max(modes)} in the block of "
                                  f"period {b.period} s, but the file has {nb} bod(y/ies) = {n} modes")
 
-    rot = np.array([(k % 6) >= 3 for k in range(n)], dtype=int)
+
+def _rotational(n: int) -> np.ndarray:
+    """1 for a rotational mode, 0 for a translational one."""
+    return np.array([(k % 6) >= 3 for k in range(n)], dtype=int)
+
+
+def _radiation(blocks: list, n: int, rho: float, L: float):
+    """(ω rad/s, A, B at the finite periods, A(0), A(∞)), dimensional (B missing: nan)."""
+    rot = _rotational(n)
     kmat = 3 + rot[:, None] + rot[None, :]          # L exponent of A, B
-    cmat = 2 + rot[:, None] + rot[None, :]          # L exponent of C
-    mvec = 2 + rot                                   # L exponent of X
 
     def matrix(d: dict, scale) -> np.ndarray:
         M = np.zeros((n, n))
         for (i, j), v in d.items():
             M[i - 1, j - 1] = v
         return M * scale
-
+    zero = [b for b in blocks if b.period == math.inf]
+    inf = [b for b in blocks if b.period == 0.0]
+    fin = [b for b in blocks if 0.0 < b.period < math.inf]
     w = np.array([2 * math.pi / b.period for b in fin])
     A = np.full((len(fin), n, n), np.nan)
     B = np.full((len(fin), n, n), np.nan)
@@ -256,7 +285,13 @@ def read_wamit(path, *, rho: float = 1000.0, g: float | None = None, body_names=
                 B[k] = np.nan  # an added-mass-only block: damping missing
     A0 = matrix(zero[-1].A, rho * L ** kmat) if zero and zero[-1].A else None
     Ainf = matrix(inf[-1].A, rho * L ** kmat) if inf and inf[-1].A else None
+    return w, A, B, A0, Ainf
 
+
+def _excitation(src: str, fin: list, n: int, rho: float, g: float, L: float, excitation: str, notes: list):
+    """(excitation, Froude-Krylov, scattering wrenches (headings, ω, modes) or None, headings deg),
+    e^{-iωt}, from the chosen WAMIT excitation (the other one, noted, when it is absent)."""
+    mvec = 2 + _rotational(n)                        # L exponent of X
     kinds = {k for b in fin for k in b.exc}
     chosen = excitation if excitation in kinds else ("haskind" if excitation == "diffraction" else "diffraction")
     if chosen not in kinds:
@@ -278,13 +313,19 @@ def read_wamit(path, *, rho: float = 1000.0, g: float | None = None, body_names=
                     # e^{+iωt} -> e^{-iωt}: complex conjugate
                     X[ih, k, i - 1] = mod * np.exp(-1j * math.radians(ph)) * rho * g * L ** mvec[i - 1]
         return X
-
-    exc = wrench(chosen)
     fk = wrench("froude_krylov") if "froude_krylov" in kinds else None
     diff = wrench("scattering") if "scattering" in kinds else None
     if fk is not None:
         notes.append("froude_krylov_force / diffraction_force from WAMIT's FROUDE-KRYLOV / SCATTERING blocks")
+    return wrench(chosen), fk, diff, heads
 
+
+def _hydrostatics(bodies: list, names: list, rho: float, g: float, L: float, notes: list):
+    """(K force-first, volumes, centres of buoyancy, reference points, CoGs (nan: absent),
+    waterplane areas) of the bodies, dimensional and global."""
+    n = 6 * len(bodies)
+    rot = _rotational(n)
+    cmat = 2 + rot[:, None] + rot[None, :]          # L exponent of C
     K = np.zeros((n, n))
     vol, cob, ref, cog, awp = [], [], [], [], []
     for k, b in enumerate(bodies):
@@ -308,13 +349,4 @@ def read_wamit(path, *, rho: float = 1000.0, g: float | None = None, body_names=
         cog.append(origin + np.asarray(b["cog"][:3], dtype=float) if len(b.get("cog", [])) >= 3 else
                    np.full(3, np.nan))
         awp.append(c33 * L ** 2)
-    cog_arr = np.array(cog)
-    notes.append("reference_point = XBODY origin of each body; cog and center_of_buoyancy converted from body "
-                 "to global coordinates; waterplane_area = C(3,3)/(rho g)")
-    ds = build_dataset(bodies=names, dofs=dofs, omega=w, A=A, B=B, K=K, exc=exc, headings=np.radians(heads),
-                       A0=A0, Ainf=Ainf, fk=fk, diff=diff, volume=vol, cob=np.array(cob), ref=np.array(ref),
-                       cog=None if np.isnan(cog_arr).any() else cog_arr, awp=awp, rho=rho, g=g, depth=depth,
-                       source=src, notes=notes)
-    ds.attrs["length_scale"] = L
-    ds.attrs["original_time_convention"] = "exp(+i omega t) (WAMIT); excitation conjugated"
-    return clean(ds, source=src, **clean_kw)
+    return K, vol, cob, ref, cog, awp
