@@ -18,17 +18,24 @@ $(VENV)/bin/python:
 	$(PY) -m pip install --quiet --upgrade pip
 
 # --no-compile: Python compiles what is imported when it is first imported; byte-compiling every
-# installed module up front took 53 of the 85 s of a fresh install here
+# installed module up front took 53 of the 85 s of a fresh install here.
+# PYTHONWARNINGS: setuptools notes, for any editable install that maps folders into a package
+# (controllers/ and models/ become mbcontrol.controllers and mbcontrol.models, the fixed top
+# level), that a folder of the package's name in the working directory may shadow it. That is
+# known here (tests import mbcontrol.controllers, never the folder), and the note is 10 lines
+# of noise in every install.
+PIP := PYTHONWARNINGS="ignore:Editable installation" $(PY) -m pip install --quiet --no-compile
+
 $(VENV)/.installed: pyproject.toml | $(VENV)/bin/python
-	$(PY) -m pip install --quiet --no-compile -e .
+	$(PIP) -e .
 	touch $@
 
 $(VENV)/.installed-test: pyproject.toml | $(VENV)/bin/python
-	$(PY) -m pip install --quiet --no-compile -e ".[test]"
+	$(PIP) -e ".[test]"
 	touch $@ $(VENV)/.installed
 
 $(VENV)/.installed-docs: pyproject.toml | $(VENV)/bin/python
-	$(PY) -m pip install --quiet --no-compile -e ".[test,docs]"
+	$(PIP) -e ".[test,docs]"
 	touch $@ $(VENV)/.installed-test $(VENV)/.installed
 
 demo: $(VENV)/.installed

@@ -218,6 +218,12 @@ def test_every_package_is_installed():
     packages = {m for m, path in MODULES.items() if path.name == "__init__.py"}
     assert packages == listed, (f"missing from pyproject.toml: {sorted(packages - listed)}; "
                                 f"listed but absent: {sorted(listed - packages)}")
+    # a folder of data files (C sources, fits) is a package too, or setuptools warns at every
+    # install and a wheel may leave it out
+    folders = {".".join([prefix, *d.relative_to(folder).parts]) for prefix, folder in
+               SOURCE_DIRS.items() for d in [folder, *folder.rglob("*")]
+               if d.is_dir() and d.name != "__pycache__" and any(f.is_file() for f in d.iterdir())}
+    assert folders <= listed, f"folders with files that are not packages: {sorted(folders - listed)}"
 
 
 def test_cited_test_files_exist():
