@@ -63,26 +63,17 @@ def catalogue(names=None) -> dict:
 
 
 def convert(scene, out: Path) -> None:
-    """Third-party data (scene.hydro.source) -> body-frame dataset at the scene's CoGs."""
+    """Third-party data (scene.hydro.source) -> body-frame dataset at the scene's CoGs (the
+    library's own conversion, mbcontrol.hydro.source), written as the scene's hydro file."""
     from mbcontrol.hydro import write_netcdf_atomic
-    from mbcontrol.hydro.readers import read_hydro, to_scene_frames
+    from mbcontrol.hydro import converted_source
 
-    h = scene.hydro
-    if not Path(h.source).exists():
-        raise SystemExit(f"{scene.path}: hydro.source {h.source} does not exist")
     t0 = time.perf_counter()
-    # only the DOFs the scene declares (e.g. heave for sliders): asymmetric or non-passive
-    # data in DOFs the scene never moves must not block it
-    bodies = list(h.source_bodies) or [b.name for b in scene.bodies if b.hydro]
-    dofs = [f"{b}__{d}" for b in bodies for d in h.dofs]
-    data = read_hydro(h.source, body_names=bodies, dofs=dofs, **h.source_options)
-    cogs = {b.name: b.cog for b in scene.bodies if b.hydro}
-    body_frames = to_scene_frames(data, cogs)
-    for note in data.attrs.get("notes", []) if isinstance(data.attrs.get("notes"), list) else []:
+    _, body_frames = converted_source(scene)
+    for note in body_frames.attrs.get("notes", []):
         print(f"  note: {note}")
-    body_frames.attrs["converted_from"] = Path(h.source).name
     write_netcdf_atomic(body_frames, out)
-    print(f"{scene.name}: wrote {out} from {Path(h.source).name} "
+    print(f"{scene.name}: wrote {out} from {Path(scene.hydro.source).name} "
           f"({body_frames.sizes['omega']} frequencies, {time.perf_counter() - t0:.1f} s)")
 
 

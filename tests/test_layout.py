@@ -104,7 +104,7 @@ def test_imports_run_one_way_along_the_flow():
     assert not upstream, "\n".join(sorted(upstream))
 
 
-HYDRO_STAGES = ("mesh", "data", ("bem", "readers"), "fit", "model")   # issue 37: hydro's rooms
+HYDRO_STAGES = ("mesh", "data", ("bem", "readers"), ("fit", "source"), "model")   # issue 37: hydro's rooms
 
 
 def _hydro_rank(module: str):

@@ -40,6 +40,17 @@ def run_models(args) -> int:
     return 0
 
 
+def _what_was_read(data) -> dict | None:
+    """A third-party BEM file's conversion: the file, the readers' notes (what they found and
+    repaired) and their repairs in detail; None for data made by mbcontrol's own BEM run."""
+    from ..results import record
+    if "converted_from" not in data.attrs:
+        return None
+    return {"file": str(data.attrs["converted_from"]),
+            "notes": [str(n) for n in record(data.attrs, "notes", [])],
+            "repairs": jsonable(record(data.attrs, "cleaning", {}))}
+
+
 def run_hydro(args) -> int:
     from ..plant import response_error_of
     plant = _plant(args, radiation_tol=args.tol)
@@ -56,13 +67,17 @@ def run_hydro(args) -> int:
               "fit_error": float(rad.fit_error), "judged_by": judged_by, **{k: rep.get(k) for k in (
                   "tol", "tol_met", "response_band", "band_error", "worst", "rms_error", "limited_by")},
               "response_error": response["error"] if response else None, "response_worst": response,
-              "max_pole_real_part": float(np.max(np.linalg.eigvals(rad.A).real)), "report": jsonable(rep)}
+              "max_pole_real_part": float(np.max(np.linalg.eigvals(rad.A).real)), "report": jsonable(rep),
+              "read": _what_was_read(plant.hydro.data)}
     if args.json:
         print(json.dumps(report, indent=2))
     else:
         print(f"{plant.name}: hydro data {report['source']}\n  DOFs ({len(report['dofs'])}): "
               f"{', '.join(report['dofs'])}\n  {report['n_omega']} frequencies, "
               f"{report['omega_rad_s'][0]:.3g}..{report['omega_rad_s'][1]:.3g} rad/s")
+        if report["read"]:
+            print(f"  read from {report['read']['file']}, as the readers found it:")
+            print("\n".join(f"    - {note}" for note in report["read"]["notes"]))
         print(f"  radiation model: {rad.order} states, slowest pole real part {report['max_pole_real_part']:.3g} 1/s")
         if rep.get("response_worst"):
             rw = rep["response_worst"]

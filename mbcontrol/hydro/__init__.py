@@ -40,6 +40,7 @@ from .fit.response_error import Device, response_error_on
 from .fit.ssforms import state_blocks
 from .mesh.large_angle import buoyancy
 from .model import FITS_SERVED, obstacle_bodies, shipped_fits_dir
+from .source import converted_source
 
 __all__ = [
     "read_netcdf", "write_netcdf_atomic",
@@ -51,5 +52,5 @@ __all__ = [
     "heading_matrix", "axisymmetric_headings",
     "HydroModel", "load_hydro_model", "load_hydro_data", "fit_hydro_model", "fit_method", "geometry_dict",
     "compute_isolated", "SECTOR_SIGMAS", "Device", "response_error_on", "state_blocks", "buoyancy",
-    "FITS_SERVED", "obstacle_bodies", "shipped_fits_dir",
+    "FITS_SERVED", "obstacle_bodies", "shipped_fits_dir", "converted_source",
 ]

@@ -15,6 +15,7 @@ import numpy as np
 import xarray as xr
 
 from ..cache import cache_dir
+from ..console import status
 from ..errors import HydroError
 from ..scene import DOF_NAMES, Scene
 from ..waves import Wave, coefficient_series, excitation_series, interpolate_complex
@@ -28,6 +29,7 @@ from .fit.radiation import RadiationModel, coupled_groups
 from .fit.response_error import Device
 from .fit.store import FITS_SERVED, cached_fit, fit_band_limit, model_from_arrays, shipped_fits_dir  # noqa: F401 (the model's face)
 from .fit.ssforms import modal_blocks
+from .source import converted_source
 
 
 @dataclass(frozen=True)
@@ -193,14 +195,23 @@ def fit_method(setting: str, dofs, data: xr.Dataset | None = None) -> str:
 
 
 def load_hydro_data(scene: Scene, dofs) -> tuple[str, xr.Dataset]:
-    """(source, body-frame BEM dataset) holding at least `dofs`, without a radiation fit."""
-    # a precomputed file wins; a scene that also gives BEM frequencies falls back to a (cached)
-    # BEM run when the file is absent, e.g. for a parameter value nobody precomputed
-    if scene.hydro.file and (Path(scene.hydro.file).exists() or not scene.hydro.omega):
-        source = scene.hydro.file
-        if not Path(source).exists():
-            raise HydroError(_missing_file(scene))
+    """(source, body-frame BEM dataset) holding at least `dofs`, without a radiation fit.
+
+    First match wins: the precomputed [hydro] file when it exists; the scene's own BEM results
+    ([hydro] source: WAMIT, BEMIO or Capytaine, converted once and cached, mbcontrol.hydro.source);
+    a (cached) Capytaine run on [hydro] omega. A scene with both source and omega uses the source
+    and says so; one whose file is missing, with neither, is told what to do."""
+    h = scene.hydro
+    if h.file and Path(h.file).exists():
+        source = h.file
         data = read_netcdf(source)
+    elif h.source:
+        if h.omega:
+            status(f"{scene.name}: [hydro] source {Path(h.source).name} is used; [hydro] omega "
+                   f"(BEM frequencies for Capytaine) is not (remove one of them)", __name__)
+        source, data = converted_source(scene)
+    elif h.file and not h.omega:
+        raise HydroError(_missing_file(scene))
     else:
         source, data = _run_bem(scene, dofs)
     _check_dofs(data, dofs, source)
@@ -221,7 +232,8 @@ def _missing_file(scene: Scene) -> str:
         text += (f"The catalogue has one of that name, for its own geometry: copy it beside "
                  f"your scene (cp {shipped} {path.parent}/) or set file = \"{shipped}\"; ")
     return text + ("or remove `file` and give [hydro] omega (rad/s) to compute the data with "
-                   "Capytaine from the bodies' geometry")
+                   "Capytaine from the bodies' geometry, or [hydro] source = \"FILE\" to use your own "
+                   "BEM results (a WAMIT .out, BEMIO .h5 or Capytaine .nc file)")
 
 
 def fit_hydro_model(data: xr.Dataset, dofs, tol: float | None, source: str,

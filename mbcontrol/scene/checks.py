@@ -317,13 +317,15 @@ def check_topology(scene, top: Reader):
         for i, item in enumerate(items):
             if item.body not in bodies:
                 raise SceneError(f"{where}: {kind}[{i}].body: unknown body {item.body!r}")
-    if scene.hydro.file is None or scene.hydro.hydrostatics == "large_angle":
+    given = scene.hydro.file is not None or scene.hydro.source is not None
+    if not given or scene.hydro.hydrostatics == "large_angle":
         for i, body in enumerate(scene.bodies):
             if body.hydro and body.geometry is None:
                 raise SceneError(f"{where}: body[{i}].geometry: body '{body.name}' takes "
-                                 f"hydrodynamic loads but has no geometry and the scene has no "
-                                 f"hydro.file (or asks for large-angle hydrostatics); give one, "
-                                 f"or set hydro = false")
+                                 f"hydrodynamic loads but has no geometry, and the scene gives "
+                                 f"no hydrodynamic data ([hydro] file, or source: your WAMIT "
+                                 f".out, BEMIO .h5 or Capytaine .nc) or asks for large-angle "
+                                 f"hydrostatics; give a geometry, or data, or set hydro = false")
     return replace(scene, joints=tuple(joints))
 
 

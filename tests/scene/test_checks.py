@@ -270,8 +270,9 @@ def test_unknown_catalogue_name():
 
 def test_hydro_loads_without_geometry_or_hydro_file(tmp_path):
     path = write(tmp_path, variant((B_HYDRO, "cog = [1.5, 0.0, 0.0]")))   # b: hydro on
-    with fails(path, "body[1].geometry", r"body 'b' takes hydrodynamic loads but has no geometry "
-                                         r"and the scene has no hydro\.file"):
+    with fails(path, "body[1].geometry", r"body 'b' takes hydrodynamic loads but has no geometry, "
+                                         r"and the scene gives no hydrodynamic data \(\[hydro\] "
+                                         r"file, or source"):
         load_scene(path)
 
 
