@@ -261,6 +261,13 @@ def _add_simulate(sub, controllers: str) -> None:
     _wave_options(p)
     p.add_argument("--duration", type=float, default=None,
                    help="simulated time, s (default: 30 periods, or 600 s for irregular seas)")
+    p.add_argument("--repeat", type=float, metavar="S",
+                   help="a sea's repeat period, s: its components 2 pi / S apart (default: the\n"
+                        "duration); design simulates two repeat periods of a 600 s sea")
+    p.add_argument("--from", dest="window_from", metavar="S|last-repeat",
+                   help="the statistics start at S seconds, or over the sea's last whole repeat\n"
+                        "period, as design scores it (default: the last 10 periods of a\n"
+                        "regular wave, after the ramp in a sea; after a controller's warm-up)")
     p.add_argument("--dt", type=float, help=f"time step, s ({default_help('sim.dt')})")
     p.add_argument("--method", choices=tuple(METHODS),
                    help="\n".join([*(f"{m.name}: {m.description}" for m in METHODS.values()),

@@ -130,12 +130,14 @@ def run_simulate(args) -> int:
             duration = 30 * args.period if args.wave == "regular" and args.period else 600.0
     elif duration is None:
         duration = 60.0
-    wave = _wave(args, plant, duration)
+    wave = _wave(args, plant, args.repeat or duration)
     controller = _controller(args, wave)
     params = dict(_key_value(s, "--param") for s in args.param)
     ds = simulate(plant, wave, duration=duration, dt=args.dt, controller=controller,
                   method=args.method, rtol=args.rtol, params=params or None,
                   progress=not args.json)
+    if args.window_from is not None:
+        ds.attrs.update(_window(args.window_from, wave, duration))
     result = summary(ds, plant)             # checks the result; the verdict goes into ds.attrs
     if args.out:
         from ..results import save_dataset
@@ -160,6 +162,29 @@ def run_simulate(args) -> int:
 
 
 INVALID_EXIT = 3        # `simulate`'s exit status for a result that failed its physics checks
+
+
+def _window(given: str, wave, duration: float) -> dict:
+    """--from S or last-repeat: the run record's statistics start (s) and why."""
+    if given == "last-repeat":
+        if wave is None or wave.omega.size < 2 or not wave.d_omega:
+            raise InputError("--from last-repeat needs a sea (--wave jonswap or pm): a regular "
+                             "wave's statistics are its last 10 periods already")
+        repeat = 2 * math.pi / wave.d_omega
+        if duration < repeat * (1 - 1e-9):
+            raise InputError(f"--from last-repeat: the run ({duration:g} s) is shorter than the "
+                             f"sea's repeat period ({repeat:.6g} s); give --duration of at "
+                             f"least that, or --repeat")
+        return {"statistics_from_s": duration - repeat,
+                "statistics_note": f"the last whole repeat period of the sea ({repeat:.4g} s), "
+                                   f"as its bounds"}
+    try:
+        start = float(given)
+    except ValueError:
+        raise InputError(f"--from {given}: expected seconds or 'last-repeat'") from None
+    if not 0 <= start < duration:
+        raise InputError(f"--from {given}: expected 0 <= S < the duration ({duration:g} s)")
+    return {"statistics_from_s": start, "statistics_note": f"from {start:g} s (--from)"}
 
 
 def run_bench(args) -> int:

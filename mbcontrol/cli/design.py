@@ -17,7 +17,7 @@ def run_design(args) -> int:
     result = design(plant, wave, args.controller, pto=args.pto, simulate_s=args.duration,
                     dt=args.dt, bounds={"auto": True, "full": "full", "off": False}[args.bounds],
                     limits=not args.unconstrained, robust=args.robust)
-    command = _simulate_command(args, result)
+    command = _simulate_command(args, result, args.duration or 600.0)
     if args.json:
         print(json.dumps({**result.to_dict(), "model": plant.name, "wave": wave.describe(),
                           "simulate_command": command}, indent=2, allow_nan=False))
@@ -28,10 +28,12 @@ def run_design(args) -> int:
     return 0
 
 
-def _simulate_command(args, result) -> str:
-    """The `mbcontrol simulate` command line that re-runs the design's simulation; numbers
-    in repr form, which round-trips a float exactly, except duration and step: 12
-    significant digits (289.992, not 289.99199999999996: the same steps)."""
+def _simulate_command(args, result, repeat: float) -> str:
+    """The `mbcontrol simulate` command line that re-runs the design's simulation and scores it
+    as design did: the same sea (its repeat period `repeat`, s, when the run is longer) and the
+    same statistics window; numbers in repr form, which round-trips a float exactly, except
+    duration, step and repeat period: 12 significant digits (289.992, not
+    289.99199999999996: the same steps)."""
     import shlex
     words = ["mbcontrol", "simulate", args.model]
     for item in args.scene_param:
@@ -46,6 +48,10 @@ def _simulate_command(args, result) -> str:
     sim = result.simulation
     if sim is not None:
         words += ["--duration", f"{sim['duration_s']:.12g}", "--dt", f"{sim['dt_s']:.12g}"]
+        if args.wave != "regular" and abs(sim["duration_s"] - repeat) > 1e-9 * repeat:
+            words += ["--repeat", f"{repeat:.12g}"]
+        if "repeat period" in sim["summary"]["window"]:      # scored as its bounds are
+            words += ["--from", "last-repeat"]
     words += ["--controller", result.name]
     for key, value in result.parameters.items():
         items = value.items() if isinstance(value, dict) else [(None, value)]

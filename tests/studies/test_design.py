@@ -243,6 +243,31 @@ def test_cli_design_json_reruns_with_simulate(capsys):
     assert json.loads(out)["ptos"]["pto"]["mean_power_W"] == pytest.approx(power, rel=1e-6)
 
 
+def test_the_rerun_line_of_a_sea_design_gives_the_designs_numbers(capsys):
+    """In a sea `design` simulates two repeat periods of a 600 s sea and scores the second (as
+    its bounds are period means). Its re-run line once simulated a 1200 s sea instead, scored
+    after the ramp: the issue's rm3 case reported 118.6 kW and 2.675 MN in design, 117.9 kW and
+    3.062 MN from the line. The line now says --repeat and --from last-repeat."""
+    sea = ["--wave", "jonswap", "--hs", "2", "--tp", "8"]
+    code, out, _ = run(capsys, "design", "sphere", "--controller", "passive", *sea,
+                       "--bounds", "off", "--json")
+    assert code == 0
+    result = json.loads(out)
+    line = result["simulate_command"]
+    assert "--repeat 600 --from last-repeat" in line and "--duration 1200" in line
+    code, out, _ = run(capsys, *shlex.split(line)[1:], "--json")
+    again = json.loads(out)
+    assert code == 0 and again["window"] == result["simulation"]["summary"]["window"]
+    # the line rounds the damping to 6 digits: measured 1e-10 (power) and 2.4e-7 (force)
+    assert again["ptos"]["pto"]["mean_power_W"] == pytest.approx(
+        result["metrics"]["mean_power_W"], rel=1e-6)
+    assert again["ptos"]["pto"]["max_force"] == pytest.approx(
+        result["metrics"]["max_force"], rel=1e-5)
+    code, _, err = run(capsys, "simulate", "sphere", "--wave", "regular", "--height", "1",
+                       "--period", "8", "--from", "last-repeat")
+    assert code == 1 and "--from last-repeat needs a sea" in err
+
+
 def test_robustness_floors_against_the_hand_gain_margin(plant):
     """A negative PTO spring on the heaving sphere has gain margin K / |stiffness| (the module
     docstring's hand result, K = rho g A_wp = 770.5 kN/m): -K / 1.5 is flagged below the
