@@ -54,12 +54,24 @@ def set_verbosity(level: int) -> None:
 
 
 def progress_bar(**options):
-    """A tqdm bar for long work, off when the default "log.quiet" is set (-q, MBCONTROL_QUIET=1)
-    or TQDM_DISABLE is; options go to tqdm (total, desc, unit ...)."""
+    """A tqdm bar for long work, on a terminal or in a Jupyter kernel only: off when stderr is
+    a pipe or a file (a CI log, `2> log`: a bar redrawn with carriage returns garbles them),
+    when the default "log.quiet" is set (-q, MBCONTROL_QUIET=1) or TQDM_DISABLE is; options
+    go to tqdm (total, desc, unit ...)."""
     from tqdm.auto import tqdm
-    if defaults.get("log.quiet"):
+    if defaults.get("log.quiet") or not _interactive():
         options["disable"] = True
     return tqdm(**options)
+
+
+def _interactive() -> bool:
+    """Does a person watch stderr: a terminal, or a notebook's kernel?"""
+    try:
+        if sys.stderr.isatty():
+            return True
+    except (AttributeError, ValueError):       # a closed or a bare stream
+        pass
+    return "ipykernel" in sys.modules
 
 
 def flush_c_stdio() -> None:

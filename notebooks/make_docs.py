@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import argparse
 import io
+import os
 import pkgutil
 import re
 import shutil
@@ -176,6 +177,8 @@ def api(src: Path) -> list[str]:
         lines = [group, "=" * len(group), ""]
         if group != "mbcontrol":            # a package: its docstring; members on their pages
             lines += [f".. automodule:: {group}", "   :no-members:", ""]
+        else:
+            lines += _entry_points()
         for module in sorted(set(modules) - {group}):
             lines += [module, "-" * len(module), "", f".. automodule:: {module}"]
             lines += ["   :no-members:", ""] if module in packages else [""]
@@ -184,24 +187,100 @@ def api(src: Path) -> list[str]:
     return pages
 
 
+# the order a user learns in: the tour first
+TUTORIALS = ("tour_hinged_barge", "controllers_sphere", "electrical_sphere", "power_matrix",
+             "work_precision_rm3", "identification_flume", "export_fmu", "farm_layouts",
+             "codesign")
+# a warning as Python prints it: "/path/to/module.py:123: SomeWarning: message", then the
+# source line that warned, indented
+_WARNING = re.compile(r"^\S*?([\w.]+\.py):\d+: (\w+(?:Warning|Error)): ")
+
+
+def tidy(nb):
+    """A tutorial as a reader should see it: results, not logs. Status lines ("mbcontrol:
+    compiling ..."), progress bars, tqdm's own warnings and the source lines warnings echo are
+    dropped; a warning keeps its category and message, once per notebook, without the build
+    machine's paths; the checkout's path is left out of any output (paths relative to the
+    repository)."""
+    root = str(ROOT) + "/"
+    seen: set = set()
+    for cell in nb.cells:
+        kept = []
+        for out in cell.get("outputs", []):
+            if out.get("output_type") == "stream" and out.get("name") == "stderr":
+                out["text"] = _tidy_stderr(out["text"], seen)
+                if not out["text"].strip():
+                    continue
+            for key in ("text",):
+                if isinstance(out.get(key), str):
+                    out[key] = out[key].replace(root, "")
+            for mime, value in (out.get("data") or {}).items():
+                if mime.startswith("text/") and isinstance(value, str):
+                    out["data"][mime] = value.replace(root, "")
+            kept.append(out)
+        cell["outputs"] = kept
+    return nb
+
+
+def _tidy_stderr(text: str, seen: set) -> str:
+    lines, skip_source = [], False
+    for line in text.replace("\r", "\n").splitlines():
+        if skip_source and line.startswith("  "):
+            skip_source = False
+            continue
+        skip_source = False
+        if line.startswith("mbcontrol: ") or "█" in line or re.search(r"\d+/\d+ \[", line):
+            continue                               # a status line or a progress bar
+        match = _WARNING.match(line)
+        if match:
+            line, skip_source = f"{match.group(2)}: {line[match.end():]}", True
+            if match.group(2) == "TqdmWarning" or line in seen:
+                continue                           # the kernel's widgets; said once already
+            seen.add(line)
+        if line.strip():
+            lines.append(line)
+    return "\n".join(lines) + ("\n" if lines else "")
+
+
+def _entry_points() -> list[str]:
+    """The names `from mbcontrol import ...` gives (loaded on first use, so autodoc's walk of
+    the modules does not see them under these names)."""
+    import inspect
+
+    import mbcontrol
+    lines = ["Entry points", "-" * 12, "",
+             "What a script imports from the package itself, e.g. ``from mbcontrol import "
+             "load_scene, build_plant, simulate``; each is documented again on its module's "
+             "page.", ""]
+    for name in mbcontrol.__all__:
+        value = getattr(mbcontrol, name)
+        kind = ("autoclass" if inspect.isclass(value) else "autofunction" if callable(value)
+                else None)
+        if kind:
+            lines += [f".. {kind}:: mbcontrol.{name}", "   :no-index:", ""]
+    return lines
+
+
 def tutorials(src: Path) -> list[str]:
     """The notebooks, executed: the test suite's copies when newer than the source, else run
-    here (nbclient, as the tests do)."""
+    here (nbclient, as the tests do); tidied (`tidy`), in TUTORIALS' order."""
     import nbformat
     from nbclient import NotebookClient
     folder = src / "tutorials"
     folder.mkdir(exist_ok=True)
     pages = []
-    for path in sorted(NOTEBOOKS.glob("*.ipynb")):
+    order = {name: k for k, name in enumerate(TUTORIALS)}
+    for path in sorted(NOTEBOOKS.glob("*.ipynb"), key=lambda p: (order.get(p.stem, 99), p.stem)):
         done = EXECUTED / path.name
         if done.exists() and done.stat().st_mtime >= path.stat().st_mtime:
             nb = nbformat.read(done, as_version=4)
         else:
             print(f"[docs] executing {path.name} (no executed copy from the tests)", flush=True)
+            os.environ["MBCONTROL_QUIET"] = "1"        # no status lines or bars in a tutorial
             nb = nbformat.read(path, as_version=4)
             NotebookClient(nb, timeout=900, kernel_name="python3",
                            resources={"metadata": {"path": str(NOTEBOOKS)}}).execute()
-        nbformat.write(nb, folder / path.name)
+        nbformat.write(tidy(nb), folder / path.name)
         pages.append(f"tutorials/{path.stem}")
     return pages
 

@@ -108,7 +108,9 @@ CONTROLLERS = [
              "    bx.plot(d.time, d.pto__force / 1e6, label=f'{n}: force (MN)')\n"
              "bx.axhline(F_MAX / 1e6, color='C3', ls=':')\nbx.axhline(-F_MAX / 1e6, color='C3', ls=':')\n"
              "bx.set_xlabel('time (s)')\nbx.set_ylabel('PTO force, MN')\nbx.legend(fontsize=8)\nfig.tight_layout()\n"
-             "fig.savefig('figures/controllers_sphere.png', dpi=110)"),
+             "# written under out/ (the README's copy, notebooks/figures/, is refreshed from it by hand)\n"
+             "from pathlib import Path\nPath('../out/figures').mkdir(parents=True, exist_ok=True)\n"
+             "fig.savefig('../out/figures/controllers_sphere.png', dpi=110)"),
 ]
 
 
@@ -130,7 +132,9 @@ WORK_PRECISION = [
     ("md", "## The chart\nDown and to the left is better. A line stops where its method "
            "becomes unstable; the radiation-order points show the model error a cruder fit "
            "costs, against the time it saves."),
-    ("code", "fig = wp.plot(ds, 'figures/work_precision_rm3.png')"),
+    ("code", "# written under out/ (the README's copy, notebooks/figures/, is refreshed from it by hand)\n"
+             "from pathlib import Path\nPath('../out/figures').mkdir(parents=True, exist_ok=True)\n"
+             "fig = wp.plot(ds, '../out/figures/work_precision_rm3.png')"),
     ("md", "## The cheapest run within 1 % RMS, and where each method fails\n"
            "The largest stable step comes from the linearised one-step map (its spectral "
            "radius ≤ 1); the scene's fit has 36 radiation states, whose fastest poles limit "

@@ -85,3 +85,24 @@ def test_the_radiation_tolerance_has_one_default():
     assert HydroSettings().radiation_tol == defaults.get("hydro.radiation_tol") == 0.01
     with defaults.override(hydro_radiation_tol=0.03):
         assert HydroSettings().radiation_tol == 0.03
+
+
+def test_progress_bars_only_where_a_person_watches(monkeypatch):
+    """A bar redrawn with carriage returns garbles a CI log or a file: on a terminal (or in a
+    notebook's kernel) only."""
+    import io
+    import sys
+
+    from mbcontrol.console import progress_bar
+
+    class Terminal(io.StringIO):
+        def isatty(self):
+            return True
+    monkeypatch.delitem(sys.modules, "ipykernel", raising=False)
+    monkeypatch.setenv("MBCONTROL_QUIET", "0")
+    monkeypatch.setattr(sys, "stderr", io.StringIO())
+    assert progress_bar(total=3).disable
+    monkeypatch.setattr(sys, "stderr", Terminal())
+    bar = progress_bar(total=3, file=sys.stderr)
+    assert not bar.disable
+    bar.close()

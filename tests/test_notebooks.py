@@ -1,6 +1,8 @@
 """Every notebook in notebooks/ runs top to bottom (its own asserts included). The executed
 copy is kept in out/notebooks/ for the documentation (`make docs` renders it with its figures
 instead of running the notebook again)."""
+import json
+import sys
 from pathlib import Path
 
 import nbformat
@@ -15,13 +17,26 @@ EXECUTED = ROOT / "out" / "notebooks"
 
 
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=[p.name for p in NOTEBOOKS])
-def test_notebook_runs(path):
+def test_notebook_runs(path, monkeypatch):
+    """...and, as the documentation shows it (make_docs.tidy), holds no compile message,
+    progress bar or path of the machine that ran it."""
+    monkeypatch.setenv("MBCONTROL_QUIET", "1")        # the kernel's: no status lines or bars
     nb = nbformat.read(path, as_version=4)
     NotebookClient(nb, timeout=600, kernel_name="python3",
                    resources={"metadata": {"path": str(path.parent)}}).execute()
     EXECUTED.mkdir(parents=True, exist_ok=True)
     with atomic_path(EXECUTED / path.name) as tmp:
         nbformat.write(nb, str(tmp))
+    shown = json.dumps([cell.get("outputs", []) for cell in _tidy()(nb).cells])
+    leaks = [w for w in (str(ROOT), sys.prefix, "site-packages", "compiling", "mbcontrol: ")
+             if w in shown]
+    assert not leaks, f"{path.name}: the rendered tutorial shows {leaks}"
+
+
+def _tidy():
+    """What the documentation does to an executed notebook (notebooks/make_docs.py)."""
+    import runpy
+    return runpy.run_path(str(ROOT / "notebooks" / "make_docs.py"))["tidy"]
 
 
 def test_there_are_notebooks():

@@ -47,6 +47,26 @@ ENERGY_TOLERANCE = 0.05           # of the excitation's absolute work over the r
 ANGLE_MAX_RAD = math.radians(30.0)
 DRAFT_FACTOR = 1.0                # relative heave limit in mean drafts
 
+# every reason a result is INVALID ends with what to do about it, after REMEDY (the CLI prints
+# it on a line of its own; no ";" in a remedy: a sweep joins a case's reasons with "; ")
+REMEDY = ". Remedy: "
+REMEDIES = {
+    "bound": "a smaller time step (--dt) or a tighter radiation fit ([hydro] radiation_tol): "
+             "`mbcontrol bench MODEL` shows each method's error",
+    "energy": "a smaller time step (--dt) or another method (--method: `mbcontrol bench "
+              "MODEL` compares them)",
+    "range": "a smaller sea, a stroke limit on the PTO (its stroke_max, or --set "
+             "stroke_max=...), large-angle hydrostatics ([hydro] hydrostatics = "
+             "\"large_angle\"), or --allow-invalid to see the number anyway",
+}
+
+
+def split_remedy(reason: str) -> tuple[str, str | None]:
+    """(what failed, what to do) of an INVALID reason; None when it names no remedy."""
+    what, _, remedy = reason.partition(REMEDY)
+    return what, remedy or None
+
+
 RESPONSE_GRIDS_KEPT = 256         # (params, direction, frequency grid) a plant keeps responses for
 
 
@@ -109,7 +129,7 @@ def assess_values(plant, wave, params, *, window, mean_power_W: float, energy=No
                 f"mean absorbed power {_watts(mean_power_W)} exceeds the complex-conjugate "
                 f"bound of its wave ({_watts(bound['bound_W'])}; allowed "
                 f"{_watts(allowed)} with {POWER_ALLOWANCE:.0%} for finite records and "
-                f"nonlinear terms): no controller can absorb that")
+                f"nonlinear terms): no controller can absorb that{REMEDY}{REMEDIES['bound']}")
     if energy is not None:
         exc, absorbed, gained, magnitude = energy
         slack = ENERGY_TOLERANCE * magnitude
@@ -118,7 +138,8 @@ def assess_values(plant, wave, params, *, window, mean_power_W: float, energy=No
         if absorbed > exc - gained + slack:
             reasons.append(
                 f"energy balance: the PTOs absorbed {absorbed:.4g} J while the waves did "
-                f"{exc:.4g} J of work and the device gained {gained:.4g} J")
+                f"{exc:.4g} J of work and the device gained {gained:.4g} J"
+                f"{REMEDY}{REMEDIES['energy']}")
     warnings = []
     for body, e in (excursions or {}).items():
         limits = (("relative heave", "relative_heave", e.get("relative_heave_limit_m"), "m", 1.0),
@@ -133,7 +154,7 @@ def assess_values(plant, wave, params, *, window, mean_power_W: float, energy=No
                 reasons.append(
                     f"body {body!r}: significant {what} {e[f'{key}_significant'] * scale:.3g} "
                     f"{unit}, {where} ({limit * scale:.3g} {unit}): linear hydrodynamics do "
-                    f"not hold there")
+                    f"not hold there{REMEDY}{REMEDIES['range']}")
             elif e[f"{key}_max"] > limit:
                 warnings.append(
                     f"body {body!r}: {what} peaks at {e[f'{key}_max'] * scale:.3g} {unit}, "

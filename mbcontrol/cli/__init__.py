@@ -15,6 +15,10 @@ Examples:
   mbcontrol fidelity sphere --wave jonswap --hs 2.5 --tp 9.67 --tol 0.01
   mbcontrol export sphere --controller mpc --wave jonswap --hs 2 --tp 9 --out out/export
   mbcontrol identify flume_section --data ../shared/data/tank/scenario_c/5*.csv.xz --out out/id
+
+Exit status: 0 done; 1 bad input (the message names the file, the field and what was
+expected); 2 a bad command line; 3 a result (simulate) or sweep cases failed their physics
+checks: printed INVALID with a remedy (--allow-invalid: 0); 4 sweep cases failed to run.
 """
 from __future__ import annotations
 
@@ -33,57 +37,9 @@ from .describe import default_help, run_defaults, run_keys
 from .design import run_design
 from .codesign import add_parser as add_codesign_parser
 from .export import add_parser as add_export_parser
+from .helptext import BENCH_HELP, DESIGN_HELP, SIMULATE_HELP
 from .identify import add_parser as add_identify_parser
 from .sweep import add_parser as add_sweep_parser
-
-SIMULATE_HELP = """Simulate a model in waves on the nonlinear process plant, open or closed loop.
-
-Every result is checked before it is printed: the PTOs' mean absorbed power against the
-complex-conjugate bound of the simulated wave (multiport, straight from the BEM data), the
-energy balance (the PTOs cannot absorb more than the waves did work), and the motions
-against the validity of linear hydrodynamics (significant heave relative to the free surface
-within the body's mean draft; roll and pitch within 30 deg). A result that fails is printed
-marked INVALID with its reasons ("valid": false, "invalid_reasons" in --json, at the top
-and per PTO) and the command exits with status 3, unless --allow-invalid.
-Statistics are over the record after the wave's ramp and the controller's warm-up.
-A predictive controller's forecast is causal unless asked (--set forecast=known: the true
-future wave, reported as a non-causal upper bound).
-
---set values are numbers, true/false, none, or words (e.g. --set forecast=ar).
-"""
-
-DESIGN_HELP = """Tune a PTO controller for a sea, then check, bound and simulate it.
-
-The controller is tuned by its module's tuner (passive: optimal damping; reactive: complex-
-conjugate matching, or the best stable pair in a sea; latching / declutching: hold time by
-closed-loop simulation, regular waves only; mpc: its defaults, given the wave), within the
-PTO's force and stroke limits unless --unconstrained. It prints the tuned parameters, the
-power linear theory predicts, the stability margins of a linear law (gain, phase, distance
-of the Nyquist curve from -1, closed-loop poles), the complex-conjugate and force/stroke-
-constrained power bounds, and the metrics of a closed-loop simulation on the nonlinear plant
-with the share of each bound it reaches. It ends with the `mbcontrol simulate` command line
-that re-runs that simulation (the parameters as --set KEY=VALUE).
-
-Example:
-  mbcontrol design sphere --controller passive --wave regular --height 2.5 --period 9.6664
-"""
-
-
-BENCH_HELP = """Speed against accuracy for one model in one sea, measured on this machine.
-
-Runs every integration method over a ladder of steps (rk3, rk4, dopri5, exp-rk4: period/4
-down to period/256) or tolerances (cvodes, adams: rtol 1e-3..1e-7), and the radiation model
-at several fit tolerances (fewer states), and measures for each run:
-  error: max over joint coordinates of RMS(q - q_ref)/RMS(q_ref) after the ramp, q_ref a
-         converged dopri5 run (its own error is printed);
-  cost:  wall time of excitation synthesis + time-stepping (compilation excluded), one core.
-Writes work_precision.png, work_precision.csv and work_precision.nc to --out, prints the
-table, and names the cheapest setting within 1 % RMS. With --stability, adds each method's
-largest stable step (stability.csv).
-
-Example:
-  mbcontrol bench sphere --wave jonswap --hs 2.5 --tp 9.67 --duration 300
-"""
 
 
 def _format_warning(message, category, filename, lineno, line=None) -> str:

@@ -10,6 +10,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..results import jsonable
+from .messages import invalid_lines
 
 
 HYDRO_SCALES = ("__added_mass_scale", "__radiation_scale", "__excitation_scale")
@@ -155,8 +156,7 @@ def run_simulate(args) -> int:
     for note in result["validity_warnings"]:
         print(f"mbcontrol: warning: {note}", file=sys.stderr)
     if not result["valid"]:
-        for reason in result["invalid_reasons"]:
-            print(f"mbcontrol: INVALID result: {reason}", file=sys.stderr)
+        print("\n".join(invalid_lines(result["invalid_reasons"], "mbcontrol: ")), file=sys.stderr)
         return 0 if args.allow_invalid else INVALID_EXIT
     return 0
 
@@ -353,4 +353,4 @@ def _print_summary(result: dict, plant) -> None:
         print(f"  excitation estimate error {100 * result['estimator']['excitation_error']:.3g} %"
               f" (RMS, against the simulation's true excitation)")
     print("  result: valid (bound, energy balance, linear-hydrodynamics range checked)"
-          if result["valid"] else "  result: INVALID - " + "; ".join(result["invalid_reasons"]))
+          if result["valid"] else "\n".join(invalid_lines(result["invalid_reasons"])))

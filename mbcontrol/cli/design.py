@@ -6,6 +6,7 @@ import sys
 
 from ..errors import InputError
 from .commands import _plant, _wave
+from .messages import invalid_lines
 
 
 def run_design(args) -> int:
@@ -140,7 +141,7 @@ def _print_design(plant, wave, result, command) -> None:
                   f"(RMS, against the simulation's true excitation, after "
                   f"{estimator['window_start_s']:.4g} s)")
         print("    result: valid (bound, energy balance, linear-hydrodynamics range checked)"
-              if result.valid else "    result: INVALID - " + "; ".join(result.invalid_reasons))
+              if result.valid else "\n".join(invalid_lines(result.invalid_reasons, "    ")))
     print(f"  re-run: {command}")
 
 

@@ -7,6 +7,7 @@ import sys
 from .. import defaults
 from ..errors import InputError
 from .describe import default_help
+from .messages import without_remedies
 
 SWEEP_HELP = """Simulate a model in closed loop over sea states (an Hs x Tp grid or a weighted
 list), wave seeds and varied settings, and report power, capture width and annual energy.
@@ -170,6 +171,10 @@ def add_parser(sub) -> None:
     p.add_argument("--width", type=float, help="characteristic width, m (capture width ratio)")
     p.add_argument("--plot", metavar="FILE.png", help="power matrix, capture width, energy")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
+    p.add_argument("--allow-invalid", action="store_true",
+                   help="exit 0 even when cases fail their physics checks (they are still left\n"
+                        "out of every figure); exit status 3 without this flag, 4 when cases\n"
+                        "failed to run")
     p.set_defaults(run=run_sweep)
 
 
@@ -255,7 +260,13 @@ def run_sweep(args) -> int:
         print(json.dumps(summary, indent=2))
     else:
         _print_summary(summary, args.store)
-    return 0
+    if summary["failed_cases"]:
+        return FAILED_EXIT
+    return INVALID_EXIT if summary["invalid_cases"] and not args.allow_invalid else 0
+
+
+INVALID_EXIT = 3     # cases failed their physics checks (as `simulate` for one result)
+FAILED_EXIT = 4      # cases failed to run (diverged or raised): the sweep is incomplete
 
 
 def _seas(args) -> list:
@@ -311,10 +322,17 @@ def _print_summary(summary: dict, store) -> None:
             print(f"         {_design_line(row)}")
     for note in summary["notes"]:
         print(f"  note: {note}")
+    remedies = []
     for label, key in (("INVALID", "invalid"), ("FAILED", "failed")):
         for case in summary[key][:10]:
+            reasons, found = without_remedies(str(case["reasons"]))
+            remedies += [r for r in found if r not in remedies]
             print(f"  {label} Hs {case['hs']:.3g} m, Tp {case['tp']:.3g} s, seed "
-                  f"{case['seed']}: {case['reasons']}")
+                  f"{case['seed']}: {reasons}")
+        if len(summary[key]) > 10:
+            print(f"  ... and {len(summary[key]) - 10} more {label.lower()} cases (--json lists all)")
+    for remedy in remedies:
+        print(f"  remedy: {remedy}")
     if summary["annual_energy_MWh"] is not None:
         share = summary["annual_energy_coverage"]
         print(f"  weighted mean power {summary['weighted_mean_power_W'] / 1e3:.4g} kW; annual "

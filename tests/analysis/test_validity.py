@@ -158,3 +158,26 @@ def test_cli_exits_non_zero_on_an_invalid_result(capsys):
         out = json.loads(capsys.readouterr().out)
         assert out["valid"] is False and out["ptos"]["pto"]["invalid_reasons"]
         assert main(args + ["--allow-invalid"]) == 0
+
+
+def test_every_invalid_reason_says_what_to_do():
+    """Each way a result fails (above its wave's bound, energy out of nothing, motions beyond
+    linear hydrodynamics) names its remedy after ". Remedy: ", which the CLI prints on a line
+    of its own (issue 40: "INVALID ... linear hydrodynamics do not hold there" named none)."""
+    from mbcontrol.analysis import split_remedy
+    from mbcontrol.analysis.validity import DRAFT_FACTOR, assess_values
+    plant = build_plant("sphere")
+    wave = waves.regular(1.0, 8.0)
+    draft = 3.33                                              # V / A_wp of the hemisphere, m
+    verdict = assess_values(
+        plant, wave, plant.p0, window=(0.0, 80.0), mean_power_W=1e9,
+        energy=(1e6, 3e6, 0.0, 1e6),                          # absorbed 3x the waves' work
+        excursions={"sphere": {"relative_heave_limit_m": draft,
+                               "relative_heave_significant": 2 * DRAFT_FACTOR * draft,
+                               "relative_heave_max": 2 * DRAFT_FACTOR * draft,
+                               "relative_heave_share_beyond": 0.5}})
+    reasons = verdict["invalid_reasons"]
+    assert len(reasons) == 3 and not verdict["valid"]
+    for reason, remedy_word in zip(reasons, ("radiation_tol", "--method", "large_angle")):
+        what, remedy = split_remedy(reason)
+        assert what and remedy and remedy_word in remedy and ";" not in remedy

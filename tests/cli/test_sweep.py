@@ -198,3 +198,16 @@ def test_a_designed_mpc_runs_on_the_sweeps_step(capsys):
     steps = period / 0.05
     assert steps == pytest.approx(round(steps)) and abs(period - 9.0 / 40) <= 0.025 + 1e-12
     assert s["seas"][0]["settings"]["horizon_s"] == 9.0
+
+
+def test_a_sweep_with_invalid_cases_exits_3_and_says_what_to_do(capsys):
+    """Exit status 3 as `simulate` for an invalid result (0 with --allow-invalid); the text
+    names the case, its reason and, once, the remedy; no JSON key names in it."""
+    argv = ["sweep", "sphere", "--hs", "1", "16", "--tp", "8", "--controller", "passive",
+            "--set", "damping=2e5", "--duration", "60", "--workers", "0"]
+    code, out, _ = run(capsys, *argv)
+    assert code == 3
+    assert "INVALID Hs 16 m, Tp 8 s, seed 0: body 'sphere': significant relative heave" in out
+    assert out.count("remedy: a smaller sea") == 1 and "'invalid'" not in out
+    code, out, _ = run(capsys, *argv, "--allow-invalid")
+    assert code == 0 and "INVALID Hs 16 m" in out

@@ -215,11 +215,12 @@ def _summary(ds, seas, run, wall, n_cases) -> dict:
     listed, crashed = _cases_where(ds, invalid), _cases_where(ds, failed)
     if listed:
         notes.append(f"{len(listed)} of {n_cases} cases failed their physics checks and are "
-                     f"left out of every mean, matrix and annual figure (listed in 'invalid')")
+                     f"left out of every mean, matrix and annual figure (listed with their "
+                     f"sea, seed and reasons)")
     if crashed:
         notes.append(f"{len(crashed)} of {n_cases} cases failed to run (diverged or raised) "
-                     f"and are left out of every mean, matrix and annual figure (listed in "
-                     f"'failed', with their sea, seed and reason)")
+                     f"and are left out of every mean, matrix and annual figure (listed with "
+                     f"their sea, seed and reason)")
     return {"model": ds.attrs["model"], "cases": n_cases, "computed": run["computed"],
             "reused": run["reused"], "wall_time_s": wall,
             "valid_cases": n_cases - len(listed) - len(crashed),
