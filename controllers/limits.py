@@ -78,6 +78,17 @@ def casadi_saturate(u, limits: np.ndarray):
                         for i, f in enumerate(limits)])
 
 
+def linear_law_parametric(plant, velocity, position, limits):
+    """u = -(c v + k x) per PTO, saturated, with [c..., k...] as parameters: the passive law
+    (k = 0) and the reactive law share it, so one compiled simulation chunk serves both, and
+    every gain (sim.simulate embeds it). velocity, position: the PTOs' output indices."""
+    n = len(velocity)
+    y = ca.SX.sym("y", len(plant.outputs))
+    g = ca.SX.sym("gains", 2 * n)
+    u = -(g[:n] * y[velocity] + g[n:] * y[position])
+    return ca.Function("linear_law_p", [y, g], [casadi_saturate(u, limits)])
+
+
 def limits_report(limits) -> list | None:
     """describe()'s view of the force limits: one per PTO, None where there is none (JSON
     has no infinity); None before reset."""

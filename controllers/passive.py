@@ -16,7 +16,7 @@ from mbcontrol.errors import ControllerError
 
 from .base import per_pto, signal_indices
 from .impedance import base_params, default_bounds
-from .limits import casadi_saturate, force_limits, limits_report, saturate
+from .limits import casadi_saturate, force_limits, limits_report, linear_law_parametric, saturate
 from .tuning import constrained_tuning, electrical_winding
 
 
@@ -45,6 +45,7 @@ class Passive:
             raise ControllerError(f"passive damping must be >= 0, got {self._gains}")
         self._limits = force_limits(plant, self.force_max)
         self._velocity = signal_indices(plant, [f"{n}__velocity" for n in names])
+        self._position = signal_indices(plant, [f"{n}__position" for n in names])
         self._law = None
 
     def __call__(self, t: float, y: np.ndarray) -> np.ndarray:
@@ -68,12 +69,11 @@ class Passive:
         return self._law
 
     def casadi_law_parametric(self, plant):
-        """(law (y, damping per PTO) -> u, the dampings): the same law with its gains as
-        parameters, so compiled code serves every damping (sim.simulate embeds this one)."""
-        y = ca.SX.sym("y", len(plant.outputs))
-        c = ca.SX.sym("damping", len(self._gains))
-        u = casadi_saturate(-c * y[self._velocity], self._limits)
-        return ca.Function("passive_law_p", [y, c], [u]), self._gains.copy()
+        """(law (y, gains) -> u, the gains): the reactive law's form with zero stiffness, its
+        gains as parameters, so compiled code serves every damping and the reactive law too
+        (sim.simulate embeds this one)."""
+        law = linear_law_parametric(plant, self._velocity, self._position, self._limits)
+        return law, np.concatenate([self._gains, np.zeros(len(self._gains))])
 
     def describe(self) -> dict:
         return {"name": self.name, "damping": self.damping, "period_s": self.period,

@@ -34,7 +34,7 @@ from mbcontrol.errors import ControllerError
 
 from .base import per_pto, signal_indices
 from .impedance import closed_loop_stability, intrinsic_impedance
-from .limits import casadi_saturate, force_limits, limits_report, saturate
+from .limits import casadi_saturate, force_limits, limits_report, linear_law_parametric, saturate
 from .tuning import constrained_tuning, electrical_winding, multistart
 
 
@@ -100,11 +100,7 @@ class Reactive:
     def casadi_law_parametric(self, plant):
         """(law (y, [damping, stiffness] per PTO) -> u, their values): the same law with its
         gains as parameters, so compiled code serves every pair (sim.simulate embeds it)."""
-        n = len(self._c)
-        y = ca.SX.sym("y", len(plant.outputs))
-        g = ca.SX.sym("gains", 2 * n)
-        u = -(g[:n] * y[self._velocity] + g[n:] * y[self._position])
-        law = ca.Function("reactive_law_p", [y, g], [casadi_saturate(u, self._limits)])
+        law = linear_law_parametric(plant, self._velocity, self._position, self._limits)
         return law, np.concatenate([self._c, self._k])
 
     def describe(self) -> dict:

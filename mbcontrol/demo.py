@@ -69,9 +69,10 @@ def _linear(plant, report: dict, out: Path):
     sys = linearize(plant, params=NO_COULOMB)
     poles = np.linalg.eigvals(np.asarray(sys.A))
     omega = np.geomspace(1.0, 30.0, 300)
-    plotting.bode(sys, [("u__hinge_pto", "hinge_pto__velocity"), ("w__barge2__Heave", "hinge")],
-                  omega, title="hinged barge: PTO torque -> hinge rate; barge-2 heave force -> "
-                  "hinge angle", path=out / "bode.png")
+    pairs = [("u__hinge_pto", "hinge_pto__velocity"), ("w__barge2__Heave", "hinge")]
+    plotting.bode(sys, pairs, omega, title="hinged barge, linearised at rest (no Coulomb "
+                  "friction)", units={name: plant.units(name) for pair in pairs for name in pair},
+                  path=out / "bode.png")
     report["linear"] = {"n_states": int(sys.nstates), "stable": bool(np.all(poles.real < 0)),
                         "slowest_pole_real": float(poles.real.max())}
     print(f"  {sys.nstates} states, stable: {report['linear']['stable']}; bode.png")
@@ -143,10 +144,11 @@ def _closed_loop(plant, sea, laws: dict, report: dict, out: Path, duration: floa
                                 f"one controller; 20-40 s of each {duration:g} s run shown, "
                                 f"means over each run after its ramp",
                           units={"hinge": "rad", "hinge_pto__force": "N m",
-                                 "hinge_pto__power": "W"},
+                                 "hinge_pto__power": "mW"},
                           labels={"hinge": "hinge angle", "hinge_pto__force": "PTO torque",
                                   "hinge_pto__power": "absorbed power"},
                           notes={"hinge_pto__power": mean_mw},
+                          own_scale=("hinge_pto__power",), scale={"hinge_pto__power": 1e3},
                           path=out / "closed_loop.png")
     return runs
 

@@ -28,29 +28,36 @@ def save(fig, path) -> Path:
     return path
 
 
-def bode(sys, pairs, omega, *, title=None, path=None, fd=None):
-    """Magnitude and phase of sys from input to output for each (input, output) pair.
+def bode(sys, pairs, omega, *, title=None, path=None, fd=None, units=None):
+    """Magnitude and phase of sys from input to output, a column per (input, output) pair,
+    titled by the channel, its magnitude in the output's unit per the input's (units: signal
+    name -> unit, e.g. ProcessPlant.units; SI without).
 
     fd: optional {(input, output): complex response on omega} drawn as markers (e.g. the
     BEM-direct frequency-domain solution) over the state-space lines.
     """
-    fig, (ax_mag, ax_ph) = plt.subplots(2, 1, sharex=True, figsize=(7.5, 6))
+    fig, axes = plt.subplots(2, len(pairs), sharex=True, squeeze=False,
+                             figsize=(4.2 * len(pairs) + 0.8, 5.6))
     A, B, C, D = (np.asarray(M) for M in (sys.A, sys.B, sys.C, sys.D))
-    for inp, out in pairs:
+    for k, (inp, out) in enumerate(pairs):
+        ax_mag, ax_ph = axes[:, k]
         i, o = sys.input_labels.index(inp), sys.output_labels.index(out)
         G = frequency_response(A, B[:, i], C[o], D[o, i], omega)[:, 0, 0]
-        line, = ax_mag.loglog(omega, np.abs(G), label=f"{signal_label(inp)} → {signal_label(out)}")
-        ax_ph.semilogx(omega, np.degrees(np.unwrap(np.angle(G))), color=line.get_color())
+        ax_mag.loglog(omega, np.abs(G), label="linearised state space")
+        ax_ph.semilogx(omega, np.degrees(np.unwrap(np.angle(G))))
         if fd and (inp, out) in fd:
-            ref = fd[(inp, out)]
-            ax_mag.loglog(omega, np.abs(ref), "o", ms=3, color=line.get_color(), alpha=0.6)
-    ax_mag.set_ylabel("magnitude (SI units of output / input)")
-    ax_ph.set_ylabel("phase (deg)")
-    ax_ph.set_xlabel("ω (rad/s)")
-    ax_mag.legend(fontsize=8)
-    ax_mag.grid(True, which="both", alpha=0.3)
-    ax_ph.grid(True, which="both", alpha=0.3)
-    ax_mag.set_title(title or f"Bode: {sys.name}")
+            ax_mag.loglog(omega, np.abs(fd[(inp, out)]), "o", ms=3, color="C1", alpha=0.7,
+                          label="frequency domain (BEM data)")
+            ax_mag.legend(fontsize=8)
+        unit_in, unit_out = ((units or {}).get(inp) or "SI", (units or {}).get(out) or "SI")
+        ax_mag.set_title(f"{signal_label(inp)} → {signal_label(out)}", fontsize=10)
+        ax_mag.set_ylabel(f"magnitude ({unit_out} per {unit_in})")
+        ax_ph.set_ylabel("phase (deg)")
+        ax_ph.set_xlabel("ω (rad/s)")
+        for ax in (ax_mag, ax_ph):
+            ax.grid(True, which="both", alpha=0.3)
+    fig.suptitle(title or f"Bode: {sys.name}")
+    fig.tight_layout()
     if path:
         save(fig, path)
     return fig
@@ -83,9 +90,11 @@ def _ylabel(ax, name, unit, label=None):
                   (label or signal_label(name)), fontsize=8)
 
 
-def time_series(ds, names, *, title=None, path=None, units=None):
+def time_series(ds, names, *, title=None, path=None, units=None, labels=None):
     """Stacked time histories of named variables of a simulation result, each labelled for a
-    reader with its unit; power panels carry their mean over the statistics window."""
+    reader with its unit (labels: name -> label, default `signal_label`); power panels carry
+    their mean over the statistics window; the title says the model, the wave and the
+    controller."""
     fig, axes = plt.subplots(len(names), 1, sharex=True, figsize=(8, 1.9 * len(names) + 0.6))
     axes = np.atleast_1d(axes)
     start = _window_start(ds)
@@ -93,19 +102,37 @@ def time_series(ds, names, *, title=None, path=None, units=None):
         t, y = ds["time"].values, ds[name].values
         ax.plot(t, y, lw=0.9)
         unit = (units or {}).get(name, ds[name].attrs.get("units", ""))
-        _ylabel(ax, name, unit)
+        _ylabel(ax, name, unit, (labels or {}).get(name))
         if name.endswith("__power") and np.any(t >= start):
             mean = float(np.mean(y[t >= start]))
-            ax.axhline(mean, color="C3", lw=0.9, ls="--")
-            ax.annotate(f"mean {mean:.3g} {unit} (t >= {start:.3g} s)", (0.01, 0.88),
-                        xycoords="axes fraction", fontsize=8, color="C3")
+            ax.axhline(mean, color="0.25", lw=0.9, ls="--")   # red is for INVALID results
+            ax.annotate(f"mean {mean:.3g} {unit} (t >= {start:.3g} s; grey: not in the "
+                        f"statistics)", (0.01, 0.88), xycoords="axes fraction", fontsize=8,
+                        color="0.15")
         ax.grid(alpha=0.3)
     axes[-1].set_xlabel("time (s)")
-    axes[0].set_title(title or ds.attrs.get("model", ""))
+    axes[0].set_title(title or _run_title(ds))
     mark_result(ds, axes, axes[0])
     if path:
         save(fig, path)
     return fig
+
+
+def _run_title(ds) -> str:
+    """A run's model, wave and controller, from its record: "sphere, JONSWAP Hs 2 m, Tp 8 s,
+    seed 0; controller passive"."""
+    wave = record(ds.attrs, "wave", {})
+    kind = wave.get("type", "none")
+    if kind == "regular" and "height" in wave:
+        sea = f"regular wave H {wave['height']:.3g} m, T {wave['period']:.3g} s"
+    elif "hs" in wave:
+        sea = (f"{kind.upper()} Hs {wave['hs']:.3g} m, Tp {wave['tp']:.3g} s, seed "
+               f"{wave.get('seed', 0)}")
+    else:
+        sea = "still water" if kind == "none" else f"{kind} wave"
+    controller = record(ds.attrs, "controller")
+    law = (controller or {}).get("name", "the scene's PTO laws")
+    return f"{ds.attrs.get('model', '')}, {sea}; controller: {law}"
 
 
 INVALID_FACE = "#fde4e4"        # axes of a result that failed its physics checks
@@ -150,22 +177,32 @@ def mark_result(ds, axes, title_ax) -> None:
 
 
 def compare_runs(runs: dict, names, *, title=None, units=None, path=None, labels=None,
-                 notes=None):
+                 notes=None, own_scale=(), scale=None):
     """Runs side by side: a column per run (titled by its label), a row per variable, each
-    row on one y scale, so what the title of a column says is what it shows. labels: name ->
-    the row's label (default `signal_label`); notes: name -> {run label: text} written in the
-    panel (e.g. the run's mean power, which a shared scale can hide)."""
-    fig, axes = plt.subplots(len(names), len(runs), sharex=True, sharey="row", squeeze=False,
+    row on one y scale, so what the title of a column says is what it shows; a row named in
+    `own_scale` gets a scale per column instead (a power whose peaks differ tenfold between
+    laws), its tick labels on every column. labels: name -> the row's label (default
+    `signal_label`); notes: name -> {run label: text} written in the panel (e.g. the run's
+    mean power); scale: name -> factor the values are multiplied by (with its unit in
+    `units`, e.g. 1e3 for mW)."""
+    fig, axes = plt.subplots(len(names), len(runs), sharex=True, squeeze=False,
                              figsize=(3.2 * len(runs), 1.8 * len(names) + 0.9))
+    for i, name in enumerate(names):                 # one scale per row, unless asked
+        if name not in own_scale:
+            for ax in axes[i, 1:]:
+                ax.sharey(axes[i, 0])
+                ax.tick_params(labelleft=False)
     for j, (label, ds) in enumerate(runs.items()):
         axes[0, j].set_title(label, fontsize=8)
         for i, name in enumerate(names):
-            axes[i, j].plot(ds["time"].values, ds[name].values, lw=0.8)
+            factor = (scale or {}).get(name, 1.0)
+            axes[i, j].plot(ds["time"].values, factor * ds[name].values, lw=0.8)
             axes[i, j].grid(alpha=0.3)
             text = (notes or {}).get(name, {}).get(label)
             if text:
                 axes[i, j].annotate(text, (0.02, 0.86), xycoords="axes fraction", fontsize=8,
-                                    color="C3", fontweight="bold")
+                                    color="0.15", fontweight="bold",
+                                    bbox={"facecolor": "white", "alpha": 0.8, "lw": 0})
             if j == 0:
                 _ylabel(axes[i, j], name, (units or {}).get(name, ""), (labels or {}).get(name))
         axes[-1, j].set_xlabel("time (s)")

@@ -247,7 +247,7 @@ def test_quiet_and_verbose(tmp_path):
         return subprocess.run([sys.executable, "-m", "mbcontrol", *flags, *args], env=env,
                               capture_output=True, text=True, check=True).stderr
 
-    assert "mbcontrol: compiling chunk" in stderr(cache="a")
+    assert "mbcontrol: compiling sphere: 512 rk4 steps per call" in stderr(cache="a")
     quiet = stderr("-q", cache="b")
     assert "compiling" not in quiet and "step/s" not in quiet
-    assert "mbcontrol: compiling chunk" in stderr("-v", cache="c")
+    assert "mbcontrol: compiling sphere: 512 rk4 steps per call" in stderr("-v", cache="c")

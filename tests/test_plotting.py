@@ -52,4 +52,7 @@ def test_time_series_labels_units_and_marks_the_mean_power(tmp_path):
     start = ds.attrs["wave"]["ramp_s"]
     t, p = ds["time"].values, ds["pto__power"].values
     note = [t.get_text() for t in fig.axes[2].texts]
-    assert note == [f"mean {np.mean(p[t >= start]):.3g} W (t >= {start:.3g} s)"]
+    assert note == [f"mean {np.mean(p[t >= start]):.3g} W (t >= {start:.3g} s; grey: not in "
+                    f"the statistics)"]
+    assert fig.axes[0].get_title() == "sphere, JONSWAP Hs 2 m, Tp 9 s, seed 1; controller: the " \
+                                      "scene's PTO laws"

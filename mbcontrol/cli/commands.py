@@ -148,7 +148,7 @@ def run_simulate(args) -> int:
         from ..plotting import time_series
         names = list(plant.topology.tree.coordinate_names) + [
             f"{p.name}__power" for p in plant.scene.ptos]
-        time_series(ds, ["eta"] + names, path=args.plot)
+        time_series(ds, ["eta"] + names, path=args.plot, labels=_coordinate_labels(plant))
     if args.json:
         print(json.dumps(result, indent=2))
     else:
@@ -159,6 +159,21 @@ def run_simulate(args) -> int:
         print("\n".join(invalid_lines(result["invalid_reasons"], "mbcontrol: ")), file=sys.stderr)
         return 0 if args.allow_invalid else INVALID_EXIT
     return 0
+
+
+def _coordinate_labels(plant) -> dict:
+    """A joint coordinate's label with its direction: "heave (along z, NED: + down)"."""
+    labels = {}
+    for joint in plant.scene.joints:
+        axis = getattr(joint, "axis", None)
+        if joint.type not in ("prismatic", "revolute") or axis is None:
+            continue
+        named = {(1, 0, 0): "x", (0, 1, 0): "y", (0, 0, 1): "z, NED: + down",
+                 (-1, 0, 0): "-x", (0, -1, 0): "-y", (0, 0, -1): "-z, NED: + up"}
+        key = tuple(int(round(float(a))) for a in axis)
+        where = named.get(key, "(" + ", ".join(f"{float(a):.3g}" for a in axis) + ")")
+        labels[joint.name] = f"{joint.name} ({'along' if joint.type == 'prismatic' else 'about'} {where})"
+    return labels
 
 
 INVALID_EXIT = 3        # `simulate`'s exit status for a result that failed its physics checks

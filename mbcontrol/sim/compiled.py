@@ -109,9 +109,11 @@ def compiler() -> str | None:
     return None
 
 
-def compile_function(fun: ca.Function, enabled: bool = True, optimise: bool = True) -> ca.Function:
+def compile_function(fun: ca.Function, enabled: bool = True, optimise: bool = True, *,
+                     label: str | None = None) -> ca.Function:
     """A native-code version of `fun` (same signature), from the cache when possible; FLAGS, or
-    PLAIN_FLAGS with ``optimise=False``."""
+    PLAIN_FLAGS with ``optimise=False``. label: what the compile message calls it (default
+    its name), so that two structures of one name read apart."""
     global _warned
     cc = compiler() if enabled else None
     if cc is None:
@@ -134,15 +136,15 @@ def compile_function(fun: ca.Function, enabled: bool = True, optimise: bool = Tr
     with exclusive(library):   # a second process needing this code waits and loads it
         if library.exists() and _verified(library):     # another process just built it
             return ca.external(fun.name(), str(library))
-        return _build(fun, source, flags, cc, folder, library)
+        return _build(fun, source, flags, cc, folder, library, label or fun.name())
 
 
-def _build(fun, source, flags, cc, folder: Path, library: Path) -> ca.Function:
+def _build(fun, source, flags, cc, folder: Path, library: Path, label: str) -> ca.Function:
     """Compile `source` into `library` (see compile_function); the interpreted `fun` on a
     compiler error, with a warning."""
     _remove_stale_builds(folder)
     started = time.perf_counter()
-    status(f"compiling {fun.name()} ({len(source) // 1000} kB of C): typically 2-60 s, cached "
+    status(f"compiling {label} ({len(source) // 1000} kB of C): typically 2-60 s, cached "
            f"afterwards (each distinct structure compiles once)", __name__)
     with tempfile.TemporaryDirectory(prefix="build-", dir=folder) as tmp:
         c_file = Path(tmp) / f"{fun.name()}.c"
@@ -155,7 +157,7 @@ def _build(fun, source, flags, cc, folder: Path, library: Path) -> ca.Function:
                           f"interpreted CasADi code", RuntimeWarning, stacklevel=3)
             return fun
         seconds = time.perf_counter() - started
-        status(f"compiled {fun.name()} in {seconds:.1f} s", __name__)
+        status(f"compiled {label} in {seconds:.1f} s", __name__)
         with open(folder / "builds.log", "a") as log:     # what the cache cost, one line a build
             log.write(f"{time.strftime('%Y-%m-%dT%H:%M:%S')}\t{fun.name()}\t"
                       f"{len(source) // 1000} kB\t{seconds:.2f} s\t{flags[0]}\n")

@@ -190,9 +190,11 @@ def law_key(law):
 
 def _chunk_function(plant, method_name, law, compiled: bool, length: int) -> ca.Function:
     """The compiled chunk of `length` steps of a plant (and law), built once per plant."""
+    label = (f"{plant.name}: {length} {method_name} steps per call"
+             + (f", {law.name()} in the loop" if law is not None else ""))
     return derived(plant, ("sim.chunk", method_name, law_key(law), compiled, length),
                    lambda: compile_function(chunk_symbolic(plant, method_name, law, length),
-                                            enabled=compiled))
+                                            enabled=compiled, label=label))
 
 
 def prepare(plant, n: int, method_name: str = "rk4", law=None, compiled=True) -> None:
