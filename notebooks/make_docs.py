@@ -1,7 +1,7 @@
 """Build the documentation site (`make docs`): Sphinx, every page generated from its source.
 
 Writes a Sphinx source tree into OUT/src and the HTML into OUT/html, warnings as errors:
-- the guide: README.md, its figure paths made to work from the site;
+- the first page (README.md) and the guide (notebooks/guide.md), figures copied in;
 - the scene-key reference (`mbcontrol.scene.reference`, the parser's own account), the
   defaults (`mbcontrol.defaults`) and every command's `--help` (the real parser);
 - the tutorials: the notebooks with their outputs and figures. The test suite executes each
@@ -90,6 +90,7 @@ measured accuracy, controllers with their bounds, identification and sweeps.
 :maxdepth: 2
 :caption: Guide
 
+start
 guide
 scene_keys
 defaults
@@ -113,14 +114,14 @@ cli
 
 
 def guide(src: Path) -> None:
-    """README.md as the guide: paths to files of the repository become links to them (the
-    site is built beside the clone), figures are copied in."""
-    text = (ROOT / "README.md").read_text()
+    """README.md as the first page, notebooks/guide.md as the guide, their figures copied in."""
     figures = src / "figures"
     figures.mkdir(exist_ok=True)
     for png in (NOTEBOOKS / "figures").glob("*.png"):
         shutil.copy2(png, figures / png.name)
-    text = text.replace("](notebooks/figures/", "](figures/")
+    start = (ROOT / "README.md").read_text().replace("](notebooks/guide.md)", "](guide.md)")
+    (src / "start.md").write_text(start.replace("](notebooks/figures/", "](figures/"))
+    text = (NOTEBOOKS / "guide.md").read_text().replace("](../README.md)", "](start.md)")
     (src / "guide.md").write_text(text)
 
 
@@ -205,6 +206,8 @@ def tidy(nb):
     root = str(ROOT) + "/"
     seen: set = set()
     for cell in nb.cells:
+        if cell.get("cell_type") != "code":
+            continue
         kept = []
         for out in cell.get("outputs", []):
             if out.get("output_type") == "stream" and out.get("name") == "stderr":

@@ -1,7 +1,9 @@
-"""Reading README.md the way a test checks it: its tables, code blocks and commands.
+"""Reading the documents the way a test checks them: README.md (the front door) and
+notebooks/guide.md (the reference it points to), their tables, code blocks and commands.
 
-Tests that check a number the README quotes read it from here, not from a copy, so the
-README cannot drift from what the code computes: edit either and the test says which.
+Tests that check a number the documents quote read it from here, not from a copy, so they
+cannot drift from what the code computes: edit either and the test says which. Both files are
+read as one text (README first); `where` names the file and line of a line of that text.
 """
 from __future__ import annotations
 
@@ -11,11 +13,23 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 README = ROOT / "README.md"
+GUIDE = ROOT / "notebooks" / "guide.md"
+DOCUMENTS = (README, GUIDE)
 NUMBER = re.compile(r"[-+]?\d[\d,]*\.?\d*(?:e[-+]?\d+)?")
 
 
 def text() -> str:
-    return README.read_text()
+    return "".join(path.read_text() for path in DOCUMENTS)
+
+
+def where(line: int) -> str:
+    """'notebooks/guide.md line 12' for line `line` of text()."""
+    for path in DOCUMENTS:
+        count = len(path.read_text().splitlines())
+        if line <= count:
+            return f"{path.relative_to(ROOT)} line {line}"
+        line -= count
+    return f"line {line} past the documents"
 
 
 def tables() -> list[tuple[int, list[list[str]]]]:
@@ -40,7 +54,8 @@ def table(header: str, with_header: bool = False) -> list[list[str]]:
     header first, with_header)."""
     hits = [rows for _, rows in tables() if rows[0][0] == header]
     if len(hits) != 1:
-        raise AssertionError(f"README.md: expected one table headed {header!r}, found {len(hits)}")
+        raise AssertionError(f"README.md and notebooks/guide.md: expected one table headed "
+                             f"{header!r}, found {len(hits)}")
     return hits[0] if with_header else hits[0][1:]
 
 
@@ -48,7 +63,7 @@ def row(header: str, first_cell: str) -> list[str]:
     """The row of table `header` whose first cell starts with `first_cell`."""
     hits = [r for r in table(header) if r[0].startswith(first_cell)]
     if len(hits) != 1:
-        raise AssertionError(f"README.md table {header!r}: expected one row starting "
+        raise AssertionError(f"table {header!r} (README.md, notebooks/guide.md): expected one row starting "
                              f"{first_cell!r}, found {len(hits)}")
     return hits[0]
 

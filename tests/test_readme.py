@@ -1,7 +1,9 @@
-"""The README is tested: its commands parse and name files that exist, the cheap ones run,
-its Python example runs, the demo prints what the README shows, every module, file and make
-target it names exists, and each of its tables is either read by a test (the numbers checked
-against a computation) or marked as a measurement with the command that remakes it.
+"""The README and the guide it points to (notebooks/guide.md) are tested: the README stays a
+front door (at most 300 lines), their commands parse and name files that exist, the cheap ones
+run, the Python example runs, the walkthrough runs pasted in an empty folder outside the
+checkout, the demo prints what the guide shows, every module, file and make target they name
+exists, and each table is either read by a test (the numbers checked against a computation) or
+marked as a measurement with the command that remakes it.
 
 The numbers of the identification and annual-energy tables are checked where they are
 computed (tests/studies/identify/test_flume_data.py, tests/waves/test_annual_energy_pins.py),
@@ -70,7 +72,19 @@ MODEL_TABLES = {"mbcontrol (method, dt, radiation tol)": ("measured", "benchmark
 
 
 def _mbcontrol_commands():
-    return [words[1:] for words in readme.commands() if words[0] == ".venv/bin/mbcontrol"]
+    """Every `mbcontrol ...` command line (as pasted after activation, or by its path)."""
+    return [words[1:] for words in readme.commands()
+            if words[0] in ("mbcontrol", ".venv/bin/mbcontrol")]
+
+
+def test_the_readme_is_a_front_door():
+    """Issue 40: 1,408 lines, the first device at line ~965. Now: what it is, the two commands,
+    your own device, a first controller and sweep, trust, Python, where next."""
+    text = readme.README.read_text()
+    assert len(text.splitlines()) <= 300
+    headings = [line for line in text.splitlines() if line.startswith("## ")]
+    assert headings[:2] == ["## Install: the two commands", "## Your own device in five minutes"]
+    assert "notebooks/guide.md" in text and "make docs" in text
 
 
 def test_every_table_is_checked_or_says_how_it_was_measured():
@@ -79,14 +93,14 @@ def test_every_table_is_checked_or_says_how_it_was_measured():
         header = rows[0]
         kind = TABLES.get(header[0]) if header[0] != "model" else MODEL_TABLES.get(header[2],
                                                                                   MODEL_TABLES.get(header[1]))
-        assert kind is not None, f"README.md line {start}: table {header[0]!r} is not classified"
+        assert kind is not None, f"{readme.where(start)}: table {header[0]!r} is not classified"
         what, where = kind
         if what == "test":                     # the test exists and reads this very table
             source = (ROOT / where).read_text()
             assert "readme.table(" in source or "readme.row(" in source, where
         elif what == "measured":               # the command that remakes it is named nearby
             context = "\n".join(lines[max(0, start - 40):start + len(rows) + 3])
-            assert where in context, f"README.md line {start}: {where} not named near the table"
+            assert where in context, f"{readme.where(start)}: {where} not named near the table"
 
 
 def test_commands_parse_and_name_what_exists():
@@ -103,7 +117,7 @@ def test_commands_parse_and_name_what_exists():
                 expanded += matches
             else:
                 expanded.append(word)
-        if expanded[:1] == ["--version"]:
+        if expanded[:1] in (["--version"], ["--help"]):
             continue
         args = build_parser().parse_args(expanded)        # SystemExit (fails) on a bad flag
         model = getattr(args, "model", None) or getattr(args, "name", None)
@@ -208,10 +222,13 @@ def test_the_walkthrough_runs_as_written(tmp_path):
     limits in N and mm. At most one message on stderr besides progress: the note that part of
     the sea lies above the BEM data."""
     (block,) = [b for b in readme.code_blocks("bash") if "cat > my_buoy/buoy.toml" in b]
-    script = block.replace(".venv/bin/mbcontrol", f"{sys.executable} -m mbcontrol")
-    done = subprocess.run(["bash", "-euo", "pipefail", "-c", script], capture_output=True,
+    # as the README's set-up leaves a shell: .venv/bin on the PATH (source .venv/bin/activate),
+    # the commands pasted as they stand in an empty folder outside the checkout
+    path = f"{os.path.dirname(sys.executable)}{os.pathsep}{os.environ.get('PATH', '')}"
+    assert not tmp_path.is_relative_to(ROOT)
+    done = subprocess.run(["bash", "-euo", "pipefail", "-c", block], capture_output=True,
                           text=True, cwd=tmp_path, timeout=900,
-                          env={**os.environ, "TQDM_DISABLE": "1"})
+                          env={**os.environ, "TQDM_DISABLE": "1", "PATH": path})
     assert done.returncode == 0, done.stderr[-3000:]
     assert (tmp_path / "my_buoy" / "run.png").stat().st_size > 10_000
     summary = json.loads(done.stdout[done.stdout.index("{"):])
@@ -220,3 +237,16 @@ def test_the_walkthrough_runs_as_written(tmp_path):
     assert 0.13 < pto["mean_power_W"] < 0.15, pto              # the README's "about 142 mW"
     messages = {line for line in done.stderr.splitlines() if line.startswith("mbcontrol:")}
     assert all("lies outside the hydro data" in m for m in messages), messages
+
+
+def test_every_relative_link_of_the_documents_resolves():
+    """The link check of the front door and the guide: each relative link names a file that
+    exists, read from the document's own folder (the site is built from the same files)."""
+    broken = []
+    for path in readme.DOCUMENTS:
+        for target in re.findall(r"\]\(([^)\s]+)\)", path.read_text()):
+            if re.match(r"[a-z]+://|#|mailto:", target):
+                continue
+            if not (path.parent / target.split("#")[0]).exists():
+                broken.append(f"{path.relative_to(ROOT)}: {target}")
+    assert not broken, broken

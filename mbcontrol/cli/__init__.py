@@ -191,8 +191,9 @@ def _add_reference_commands(sub) -> None:
 
     p = sub.add_parser("keys", help="every key a scene file takes, by section: value, unit, "
                                      "default, meaning (Markdown, from the parser itself)")
-    p.add_argument("--readme", nargs="?", const="README.md", metavar="FILE",
-                   help="write the reference into FILE's scene-keys section (default README.md)")
+    p.add_argument("--readme", nargs="?", const="notebooks/guide.md", metavar="FILE",
+                   help="write the reference into FILE's scene-keys section (default "
+                        "notebooks/guide.md, the guide)")
     p.set_defaults(run=run_keys)
 
 
