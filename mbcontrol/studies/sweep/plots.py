@@ -67,11 +67,11 @@ def _matrix(fig, ax, ds, table, period, spread=None):
         for (i, j), v in np.ndenumerate(table.values):
             if np.isfinite(v):
                 ax.text(x[j], y[i], _label(v, spreads[i, j]), ha="center", va="center",
-                        fontsize=6, color="w")
+                        fontsize=8, color="w")
     for (i, j), n in _invalid_cells(ds, table, period).items():   # shown, never averaged
         ax.add_patch(plt.Rectangle((xe[j], ye[i]), xe[j + 1] - xe[j], ye[i + 1] - ye[i],
                                    fill=False, hatch="xx", edgecolor="C3", lw=0))
-        ax.text(x[j], y[i], f"{n} invalid", ha="center", va="center", fontsize=6, color="C3",
+        ax.text(x[j], y[i], f"{n} invalid", ha="center", va="center", fontsize=8, color="C3",
                 bbox={"facecolor": "white", "edgecolor": "none", "pad": 1})
     fig.colorbar(image, ax=ax, label="mean power, kW")
     ax.set_xlabel("peak period Tp, s")
@@ -90,7 +90,7 @@ def _scattered(fig, ax, ds, spread=None):
     for tp, hs, v, e in zip(ds["tp"].values[ok], ds["hs"].values[ok], power.values[ok],
                             spread[ok]):
         ax.annotate(_label(v, e), (tp, hs), textcoords="offset points", xytext=(0, 5),
-                    ha="center", fontsize=5.5)
+                    ha="center", fontsize=7)
     if (~ok).any():
         ax.scatter(ds["tp"].values[~ok], ds["hs"].values[~ok], marker="x", color="C3", s=30,
                    label="invalid (left out)")
@@ -101,10 +101,22 @@ def _scattered(fig, ax, ds, spread=None):
     ax.grid(alpha=0.3)
 
 
+def _controller(summary: dict, designed: bool) -> str:
+    """The law the sweep ran, for a title: "passive (damping 4e+05)", "mpc designed per sea"."""
+    made_by = summary.get("provenance") or {}
+    name = made_by.get("controller") or "the scene's PTO laws"
+    settings = {k: v for k, v in (made_by.get("settings") or {}).items()
+                if isinstance(v, (int, float)) and not isinstance(v, bool)}
+    if designed:
+        return f"{name} designed per sea"
+    shown = ", ".join(f"{k} {v:.3g}" for k, v in list(settings.items())[:2])
+    return f"{name} ({shown})" if shown else name
+
+
 def plot_sweep(ds, summary: dict, path=None):
     """Panels on the same axes, peak period Tp (s) across and Hs (m) up: the power
     matrix (mean power, kW, cells on the real Hs and Tp values, a colourbar), capture width
-    (or its ratio) against Tp coloured by Hs, for a weighted list each sea state's
+    (or its ratio) against Tp, a line per Hs, for a weighted list each sea state's
     annual energy (MWh) as a bubble at its Hs and Tp, and for a --design sweep each sea's
     mean power as a share of its bound inside the envelope (%). Returns the figure, written to path when
     given."""
@@ -125,7 +137,8 @@ def plot_sweep(ds, summary: dict, path=None):
         else:                       # a site's scattered list: each sea state where it lies
             _scattered(fig, axes[0], ds, spread)
         n_bad = summary.get("invalid_cases", 0)
-        axes[0].set_title(f"{ds.attrs.get('model')}: mean power by sea state, kW"
+        law = _controller(summary, designed)
+        axes[0].set_title(f"{ds.attrs.get('model')}, {law}: mean power by sea state, kW"
                           + (" (± 95 % spread)" if spread is not None
                              and np.isfinite(spread).any() else "")
                           + (f"\n{n_bad} invalid cases left out (red crosses / hatched)"
@@ -136,8 +149,18 @@ def plot_sweep(ds, summary: dict, path=None):
     ax = axes[1]
     ratio = "capture_width_ratio" if "capture_width_ratio" in ds else "capture_width_m"
     values = ds[ratio].mean([d for d in ds[ratio].dims if d != "sea"])
-    dots = ax.scatter(ds["tp"].values, values, c=ds["hs"].values, cmap="viridis", s=18)
-    fig.colorbar(dots, ax=ax, label="Hs, m")
+    # a marker per Hs, largest first: a linear law's capture width does not depend on Hs,
+    # and equal points would hide each other
+    heights = np.unique(ds["hs"].values)
+    colours = plt.cm.viridis(np.linspace(0, 0.9, len(heights)))
+    for k, (hs, colour) in enumerate(zip(heights, colours)):
+        at = ds["hs"].values == hs
+        order = np.argsort(ds["tp"].values[at])
+        ax.plot(ds["tp"].values[at][order], values.values[at][order], "o-", color=colour, lw=0.8,
+                ms=max(10 - 8 * k / max(len(heights) - 1, 1), 2), label=f"Hs {hs:.3g} m")
+    if len(heights) <= 8:
+        ax.legend(fontsize=8, title=None if len(heights) < 2 else "(equal for a linear law)",
+                  title_fontsize=7)
     ax.set_xlabel("peak period Tp, s")
     ax.set_ylabel("capture width ratio, -" if ratio == "capture_width_ratio"
                   else "capture width, m")
