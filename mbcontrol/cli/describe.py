@@ -47,7 +47,7 @@ def parameter_unit(plant, name: str) -> str:
 
 def _per(kind: str, c: str) -> str:
     force = "N m" if c == "rad" else "N"
-    return {"damping": f"{force} s/{c}", "stiffness": f"{force}/{c}"}.get(kind, "")
+    return {"damping": f"{force} s/{c}", "stiffness": f"{force}/{c}", "preload": force}.get(kind, "")
 
 
 def _coordinates(plant) -> dict:

@@ -100,10 +100,13 @@ def _print_design(plant, wave, result, command) -> None:
     limits = f"|F| <= {b['force_max']:.4g} {F}, |x| <= {b['stroke_max']:.4g} {X}"
     constrained = (_power(b["constrained_W"]) if b["constrained_W"] is not None
                    else f"n/a ({b['constrained_reason']})")
-    if b.get("constrained_kind") == "reference":        # not a bound on what was simulated
-        constrained += f" - a REFERENCE, not a bound: {b['constrained_kind_reason']}"
+    reference = b.get("constrained_kind") == "reference"   # not a bound on what was simulated
+    if reference:
+        constrained += " (a reference, not a bound: see below)"
     print(f"  bounds: complex-conjugate {_power(b['complex_conjugate_W'])}; constrained "
           f"({limits}) {constrained}")
+    if reference:
+        print(f"    why a reference: {b['constrained_kind_reason']}")
     if b.get("electrical_W") is not None:
         within = ("within the force and stroke limits" if b.get("electrical_within_limits")
                   else "no limits")
