@@ -205,7 +205,7 @@ def load_hydro_data(scene: Scene, dofs) -> tuple[str, xr.Dataset]:
     if h.file and Path(h.file).exists():
         source = h.file
         data = read_netcdf(source)
-    elif h.source:
+    elif h.source and (Path(h.source).is_file() or not h.file):
         if h.omega:
             status(f"{scene.name}: [hydro] source {Path(h.source).name} is used; [hydro] omega "
                    f"(BEM frequencies for Capytaine) is not (remove one of them)", __name__)
@@ -227,6 +227,8 @@ def _missing_file(scene: Scene) -> str:
     path = Path(scene.hydro.file)
     text = (f"{scene.path}: [hydro] file {path.name!r} (read as {path}, relative to the scene's "
             f"folder): no such file. ")
+    if scene.hydro.source:
+        text += f"Its [hydro] source {scene.hydro.source} is not there either. "
     shipped = catalogue_dir() / path.name
     if shipped.exists() and shipped != path:
         text += (f"The catalogue has one of that name, for its own geometry: copy it beside "

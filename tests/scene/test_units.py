@@ -96,3 +96,4 @@ def test_a_copied_scene_names_its_missing_hydro_file_and_the_remedy(tmp_path):
     assert text.startswith(f"{path}: [hydro] file 'sphere_hydro.nc'")
     assert f"cp {catalogue_dir() / 'sphere_hydro.nc'} {tmp_path}/" in text
     assert "[hydro] omega" in text
+    assert "Its [hydro] source" in text and "sphere.out is not there either" in text
