@@ -14,11 +14,12 @@ def run_design(args) -> int:
     plant = _plant(args)
     if args.wave == "none":
         raise InputError("design needs a wave: --wave regular|jonswap|pm")
-    wave = _wave(args, plant, args.duration or 600.0)
+    repeat = args.duration or 600.0          # a sea's repeat period, s (its components' spacing)
+    wave = _wave(args, plant, repeat)
     result = design(plant, wave, args.controller, pto=args.pto, simulate_s=args.duration,
                     dt=args.dt, bounds={"auto": True, "full": "full", "off": False}[args.bounds],
                     limits=not args.unconstrained, robust=args.robust)
-    command = _simulate_command(args, result, args.duration or 600.0)
+    command = _simulate_command(args, result, repeat)
     if args.json:
         print(json.dumps({**result.to_dict(), "model": plant.name, "wave": wave.describe(),
                           "simulate_command": command}, indent=2, allow_nan=False))

@@ -90,7 +90,7 @@ def _scattered(fig, ax, ds, spread=None):
     for tp, hs, v, e in zip(ds["tp"].values[ok], ds["hs"].values[ok], power.values[ok],
                             spread[ok]):
         ax.annotate(_label(v, e), (tp, hs), textcoords="offset points", xytext=(0, 5),
-                    ha="center", fontsize=7)
+                    ha="center", fontsize=6)
     if (~ok).any():
         ax.scatter(ds["tp"].values[~ok], ds["hs"].values[~ok], marker="x", color="C3", s=30,
                    label="invalid (left out)")
@@ -152,15 +152,19 @@ def plot_sweep(ds, summary: dict, path=None):
     # a marker per Hs, largest first: a linear law's capture width does not depend on Hs,
     # and equal points would hide each other
     heights = np.unique(ds["hs"].values)
-    colours = plt.cm.viridis(np.linspace(0, 0.9, len(heights)))
-    for k, (hs, colour) in enumerate(zip(heights, colours)):
-        at = ds["hs"].values == hs
-        order = np.argsort(ds["tp"].values[at])
-        ax.plot(ds["tp"].values[at][order], values.values[at][order], "o-", color=colour, lw=0.8,
-                ms=max(10 - 8 * k / max(len(heights) - 1, 1), 2), label=f"Hs {hs:.3g} m")
-    if len(heights) <= 8:
+    if len(heights) <= 8 and len(heights) < ds["hs"].size:       # a grid: a line per Hs
+        colours = plt.cm.viridis(np.linspace(0, 0.9, len(heights)))
+        for k, (hs, colour) in enumerate(zip(heights, colours)):
+            at = ds["hs"].values == hs
+            order = np.argsort(ds["tp"].values[at])
+            ax.plot(ds["tp"].values[at][order], values.values[at][order], "o-", color=colour,
+                    lw=0.8, ms=max(10 - 8 * k / max(len(heights) - 1, 1), 2),
+                    label=f"Hs {hs:.3g} m")
         ax.legend(fontsize=8, title=None if len(heights) < 2 else "(equal for a linear law)",
                   title_fontsize=7)
+    else:                                  # a site's list: one point per sea, coloured by Hs
+        dots = ax.scatter(ds["tp"].values, values, c=ds["hs"].values, cmap="viridis", s=18)
+        fig.colorbar(dots, ax=ax, label="Hs, m")
     ax.set_xlabel("peak period Tp, s")
     ax.set_ylabel("capture width ratio, -" if ratio == "capture_width_ratio"
                   else "capture width, m")
