@@ -19,6 +19,7 @@ from .analysis import (frequency_domain_response, linearize, regular_wave_amplit
                        statespace_response, summary)
 from .plant import build_plant
 from .sim import simulate
+from .textsafe import md_text
 
 MODEL = "hinged_barge"
 NO_COULOMB = {"hinge_friction__coulomb": 0.0}
@@ -178,9 +179,11 @@ def validate(plant, sys, out: Path) -> dict:
 
 
 def markdown(report: dict) -> str:
-    lines = [f"# {report['model']}: demo summary", ""]
+    """summary.md: the report's numbers; names and run labels through `md_text` (a '|' or a
+    newline in one would add a table column or row)."""
+    lines = [f"# {md_text(report['model'])}: demo summary", ""]
     p = report["plant"]
-    lines += [f"- plant: {p['states']} states, hydro DOFs {', '.join(p['hydro_dofs'])}; "
+    lines += [f"- plant: {p['states']} states, hydro DOFs {md_text(', '.join(p['hydro_dofs']))}; "
               f"radiation {p['radiation_states']} states, fit error "
               f"{p['radiation_fit_error']:.2%}",
               f"- linear model stable: {report['linear']['stable']}",
@@ -194,7 +197,7 @@ def markdown(report: dict) -> str:
     bound = report["design"]["complex_conjugate_bound_W"]
     for label, r in report["closed_loop"].items():
         pto = r["ptos"]["hinge_pto"]
-        lines.append(f"| {label} | {pto['mean_power_W'] * 1e3:.3f} | "
+        lines.append(f"| {md_text(label)} | {pto['mean_power_W'] * 1e3:.3f} | "
                      f"{100 * pto['mean_power_W'] / bound:.1f} | {pto['max_force']:.3f} | "
                      f"{pto['max_stroke']:.4f} |")
     return "\n".join(lines) + "\n"

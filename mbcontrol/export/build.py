@@ -1,7 +1,11 @@
 """Writing an exported controller: C sources with a documented header, a Makefile, the built
 shared library, and the FMI 2.0 co-simulation FMU (modelDescription.xml, the sources, the
 binary for this platform). Everything is written to a temporary folder and renamed into place,
-so an interrupted export leaves the old one or none."""
+so an interrupted export leaves the old one or none.
+
+Every name or text from a scene or a plant passes `mbcontrol.textsafe` on its way into C,
+XML or a Makefile, even though the scene's name rule already refuses hostile names: an
+export is code that a compiler runs and a library that ctypes loads."""
 from __future__ import annotations
 
 import hashlib
@@ -12,11 +16,11 @@ import zipfile
 from datetime import datetime, timezone
 from importlib import resources
 from pathlib import Path
-from xml.sax.saxutils import escape
 
 import casadi as ca
 import numpy as np
 
+from ..textsafe import c_comment, c_identifier, c_string, make_word, xml_attr
 from .spec import ControllerSpec
 
 CFLAGS = ("-O3", "-std=c99", "-fPIC", "-Wall", "-Wno-unused-variable", "-Wno-unused-function")
@@ -46,15 +50,16 @@ def c_array(ctype: str, name: str, values) -> str:
 
 
 def identifier(model: str, name: str) -> str:
-    """A C identifier for the export: <model>_<controller>, other characters as '_'."""
-    raw = f"{model}_{name}"
-    out = "".join(ch if ch.isalnum() or ch == "_" else "_" for ch in raw)
-    return out if not out[0].isdigit() else f"m_{out}"
+    """A C identifier (and file stem) for the export: <model>_<controller> as it is when it is
+    one, else mapped by `textsafe.c_identifier` (other characters as '_', a hash appended)."""
+    return c_identifier(f"{model}_{name}")
 
 
 def header(spec: ControllerSpec, ident: str) -> str:
-    """mbc_controller.h: the documented fixed-size API of one exported controller."""
-    lines = [f"/* {ident}: the {spec.name} controller exported by mbcontrol.",
+    """mbc_controller.h: the documented fixed-size API of one exported controller. Names,
+    units and descriptions enter the comment through `c_comment` (one line, no '*/')."""
+    ident = c_identifier(ident)          # unchanged when it came from `identifier`
+    lines = [f"/* {ident}: the {c_comment(spec.name)} controller exported by mbcontrol.",
              " *",
              " * Call init(ctx, params) once (params NULL: the designed values below), then",
              " * step(ctx, measurements, t, force) at every sample of the control loop, t in s",
@@ -64,11 +69,12 @@ def header(spec: ControllerSpec, ident: str) -> str:
              " * init (it points into itself).",
              " *",
              " * measurements (SI units, as mbcontrol names them):"]
-    lines += [f" *   [{i}] {n}" for i, n in enumerate(spec.inputs)]
+    lines += [f" *   [{i}] {c_comment(n)}" for i, n in enumerate(spec.inputs)]
     lines += [" * force (N or N m, the PTO's whole force command):"]
-    lines += [f" *   [{i}] {n}" for i, n in enumerate(spec.outputs)]
+    lines += [f" *   [{i}] {c_comment(n)}" for i, n in enumerate(spec.outputs)]
     lines += [" * params:"]
-    lines += [f" *   [{i}] {p.name} = {p.value!r} {p.unit}: {p.description}"
+    lines += [f" *   [{i}] {c_comment(p.name)} = {p.value!r} {c_comment(p.unit)}: "
+              f"{c_comment(p.description)}"
               for i, p in enumerate(spec.parameters)]
     lines += [" */", "#ifndef MBC_CONTROLLER_H", "#define MBC_CONTROLLER_H", ""]
     lines += ["#include <math.h>"]
@@ -81,7 +87,7 @@ def header(spec: ControllerSpec, ident: str) -> str:
               "#define MBC_CAT(a, b) MBC_CAT2(a, b)", "#define MBC_FN(name) MBC_CAT(MBC_PREFIX, name)",
               f"#define MBC_CTX {ident}_ctx", f"#define MBC_N_IN {len(spec.inputs)}",
               f"#define MBC_NU {len(spec.outputs)}", f"#define MBC_N_PARAMS {len(spec.parameters)}",
-              f'#define MBC_GUID "{guid(spec, ident)}"']
+              f"#define MBC_GUID {c_string(guid(spec, ident))}"]
     for key, value in spec.defines.items():
         if key != "MBC_NU":
             lines.append(f"#define {key} {value}")
@@ -130,6 +136,7 @@ def guid(spec: ControllerSpec, ident: str) -> str:
 
 def write_sources(spec: ControllerSpec, ident: str, folder: Path) -> list[Path]:
     """The C sources of the controller (no FMU wrapper) in `folder`; returns the .c files."""
+    ident = c_identifier(ident)          # unchanged when it came from `identifier`
     folder.mkdir(parents=True, exist_ok=True)
     (folder / "mbc_controller.h").write_text(header(spec, ident))
     (folder / "mbc_data.c").write_text(data_source(spec, ident))
@@ -157,11 +164,15 @@ def generate_casadi(functions, folder: Path, filename: str) -> Path:
 
 
 def makefile(ident: str, sources: list[str]) -> str:
-    return (f"# Builds lib{ident}.so from the generated sources (no Python needed).\n"
+    """The Makefile of the C sources: one rule for lib<ident>.so and `clean`. Every word from
+    outside passes `make_word` (unchanged for an identifier and the generated file names)."""
+    library = make_word(f"lib{ident}.so")
+    files = " ".join(make_word(s) for s in sources)
+    return (f"# Builds {library} from the generated sources (no Python needed).\n"
             f"CC ?= gcc\nCFLAGS ?= {' '.join(CFLAGS)}\n\n"
-            f"lib{ident}.so: {' '.join(sources)} mbc_controller.h\n"
-            f"\t$(CC) $(CFLAGS) -shared -o $@ {' '.join(sources)} -lm\n\n"
-            f"clean:\n\trm -f lib{ident}.so\n")
+            f"{library}: {files} mbc_controller.h\n"
+            f"\t$(CC) $(CFLAGS) -shared -o $@ {files} -lm\n\n"
+            f"clean:\n\trm -f {library}\n")
 
 
 def compile_library(sources: list[Path], target: Path, extra_flags=()) -> None:
@@ -193,9 +204,12 @@ def zip_fmu(staging: Path, target: Path) -> None:
 
 
 def variable(name, vr, causality, variability, description, start=None, initial=None) -> str:
-    attrs = (f'name="{escape(name)}" valueReference="{vr}" causality="{causality}" '
-             f'variability="{variability}"' + (f' initial="{initial}"' if initial else "")
-             + f' description="{escape(description)}"')
+    """One ScalarVariable of modelDescription.xml; every attribute value through `xml_attr`
+    (saxutils.escape leaves quotes alone, which ends an attribute)."""
+    attrs = (f'name="{xml_attr(name)}" valueReference="{int(vr)}" '
+             f'causality="{xml_attr(causality)}" variability="{xml_attr(variability)}"'
+             + (f' initial="{xml_attr(initial)}"' if initial else "")
+             + f' description="{xml_attr(description)}"')
     real = "<Real/>" if start is None else f'<Real start="{_xml_number(start)}"/>'
     return f"    <ScalarVariable {attrs}>{real}</ScalarVariable>"
 
@@ -209,22 +223,24 @@ def _xml_number(value: float) -> str:
 
 def model_description(ident: str, guid_text: str, description: str, variables: list[str],
                       output_indices: list[int], step: float) -> str:
+    """modelDescription.xml of an FMI 2.0 co-simulation FMU; `variables` from `variable`."""
+    ident, guid_text = xml_attr(c_identifier(ident)), xml_attr(guid_text)
     now = datetime.now(timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
     from importlib.metadata import PackageNotFoundError, version
     try:
         __version__ = version("mbcontrol")
     except PackageNotFoundError:
         __version__ = "unknown"
-    outputs = "\n".join(f'      <Unknown index="{i}"/>' for i in output_indices)
+    outputs = "\n".join(f'      <Unknown index="{int(i)}"/>' for i in output_indices)
     return f"""<?xml version="1.0" encoding="UTF-8"?>
 <fmiModelDescription fmiVersion="2.0" modelName="{ident}" guid="{guid_text}"
-  description="{escape(description)}" generationTool="mbcontrol {__version__}"
+  description="{xml_attr(description)}" generationTool="mbcontrol {xml_attr(__version__)}"
   generationDateAndTime="{now}" variableNamingConvention="structured" numberOfEventIndicators="0">
   <CoSimulation modelIdentifier="{ident}" canHandleVariableCommunicationStepSize="true"
     canBeInstantiatedOnlyOncePerProcess="false" canNotUseMemoryManagementFunctions="false"
     canGetAndSetFMUstate="false" canSerializeFMUstate="false"
     providesDirectionalDerivative="false"/>
-  <DefaultExperiment startTime="0.0" stepSize="{step!r}"/>
+  <DefaultExperiment startTime="0.0" stepSize="{_xml_number(step)}"/>
   <ModelVariables>
 {chr(10).join(variables)}
   </ModelVariables>

@@ -18,6 +18,7 @@ import casadi as ca
 import numpy as np
 
 from ..plant import controlled_params
+from ..textsafe import c_string
 from .build import (FMU_FILES, c_array, c_number, compile_library, csrc, generate_casadi,
                     identifier, model_description, platform_folder, variable, zip_fmu)
 
@@ -28,7 +29,9 @@ def plant_parameters(plant) -> np.ndarray:
 
 
 def export_plant(plant, wave, out_dir, *, dt: float, model: str | None = None) -> Path:
-    """Write out_dir/<model>_plant.fmu: the plant in `wave` (None: still water), RK4 at dt s."""
+    """Write out_dir/<model>_plant.fmu: the plant in `wave` (None: still water), RK4 at dt s.
+    Names reach the FMU only through `build`'s escaping writers (`identifier`, `variable`,
+    `model_description`)."""
     from mbcontrol.sim import rk4_step, wave_terms
     ident = identifier(model or plant.name, "plant")
     out_dir = Path(out_dir).resolve()
@@ -57,7 +60,7 @@ def export_plant(plant, wave, out_dir, *, dt: float, model: str | None = None) -
             f"#define PLANT_NX {plant.nx}", f"#define PLANT_NU {len(plant.inputs)}",
             f"#define PLANT_NY {len(plant.outputs)}", f"#define PLANT_NW {nw}",
             f"#define PLANT_NCOMP {omega.size}", f"#define PLANT_RAMP {c_number(ramp)}",
-            f"#define PLANT_DT {c_number(dt)}", f'#define PLANT_GUID "{guid_text}"',
+            f"#define PLANT_DT {c_number(dt)}", f"#define PLANT_GUID {c_string(guid_text)}",
             f"#define PLANT_IW {max(step.sz_iw(), out.sz_iw(), 1)}",
             f"#define PLANT_W {max(step.sz_w(), out.sz_w(), 1)}",
             f"#define PLANT_SZ_ARG {max(step.sz_arg(), out.sz_arg())}",

@@ -6,7 +6,6 @@ exact solutions refined by Newton steps (`CatenaryLine.force_function`).
 """
 from __future__ import annotations
 
-import re
 import warnings
 from dataclasses import dataclass
 
@@ -14,6 +13,7 @@ import casadi as ca
 import numpy as np
 
 from ..scene import Mooring, catenary_geometry
+from ..textsafe import c_identifier
 from .catenary import SYMBOLIC_OPS, CatenarySolution, shape_terms, solve_catenary
 
 
@@ -137,7 +137,7 @@ class CatenaryLine:
     def _function(self, table: tuple, steps: int) -> ca.Function:
         """The force Function from a `_table` and `steps` Newton steps (see `force_table`)."""
         L, EA, w, cb, a = self.length, self.EA, self.weight, self.friction, self.anchor
-        ident = re.sub(r"[\W_]+", "_", self.name).strip("_") or "line"   # valid CasADi name
+        ident = c_identifier(self.name)   # a valid CasADi name, distinct for distinct names
         xs, zs, HV = table
         # CasADi orders values with the output index fastest, then the first grid axis;
         # "exact" lookup finds the cell of a uniform grid arithmetically, but accepts only

@@ -1,7 +1,8 @@
 """Field-level reading and whole-scene checks for scene files.
 
 `Reader` wraps one TOML table and knows where it sits ("joint[2].axis" in "file.toml"), so
-every SceneError names the file, the field and what was expected.
+every SceneError names the file, the field and what was expected. Every name obeys
+`textsafe.NAME_RULE` (`Reader.name`, `names.check_names`); messages show names by `shown`.
 """
 from __future__ import annotations
 
@@ -13,6 +14,8 @@ from dataclasses import replace
 import numpy as np
 
 from ..errors import SceneError
+from ..textsafe import shown
+from .names import check_names, name_refusal
 from .units import SI_UNIT, UnitError, to_si
 
 _REQUIRED = object()
@@ -94,10 +97,10 @@ class Reader:
         return value
 
     def name(self) -> str:
+        """The table's `name`, checked against NAME_RULE; 'ground' (the world) is reserved."""
         value = self.string("name")
-        if not value or "." in value or "__" in value or value == "ground" or " " in value:
-            self.fail("name", f"expected a name without dots, spaces or '__' (and not "
-                              f"'ground'), got {value!r}")
+        if refusal := name_refusal(value, reserved=("ground",)):
+            self.fail("name", refusal)
         return value
 
     def boolean(self, key: str, default=_REQUIRED) -> bool:
@@ -248,12 +251,11 @@ def check_topology(scene, top: Reader):
     Returns the scene with defaults that need other tables filled in (free-joint points).
     """
     where = top.file
+    check_names(scene, top)
     bodies = {b.name: b for b in scene.bodies}
-    _unique(where, "body", [b.name for b in scene.bodies])
-    _unique(where, "joint", [j.name for j in scene.joints])
-    for kind, items in (("pto", scene.ptos), ("friction", scene.frictions),
-                        ("mooring", scene.moorings), ("drag", scene.drags),
-                        ("end_stop", scene.end_stops)):
+    for kind, items in (("body", scene.bodies), ("joint", scene.joints), ("pto", scene.ptos),
+                        ("friction", scene.frictions), ("mooring", scene.moorings),
+                        ("drag", scene.drags), ("end_stop", scene.end_stops)):
         _unique(where, kind, [x.name for x in items])
 
     parent_of: dict[str, str] = {}
@@ -261,15 +263,15 @@ def check_topology(scene, top: Reader):
     for i, joint in enumerate(scene.joints):
         field = f"joint[{i}]"
         if joint.parent != "ground" and joint.parent not in bodies:
-            raise SceneError(f"{where}: {field}.parent: unknown body {joint.parent!r}; expected "
+            raise SceneError(f"{where}: {field}.parent: unknown body {shown(joint.parent)}; expected "
                              f"'ground' or one of {', '.join(bodies)}")
         if joint.child not in bodies:
-            raise SceneError(f"{where}: {field}.child: unknown body {joint.child!r}; expected "
+            raise SceneError(f"{where}: {field}.child: unknown body {shown(joint.child)}; expected "
                              f"one of {', '.join(bodies)}")
         if joint.child == joint.parent:
             raise SceneError(f"{where}: {field}: a body cannot be jointed to itself")
         if joint.child in parent_of:
-            raise SceneError(f"{where}: {field}.child: body {joint.child!r} already has a "
+            raise SceneError(f"{where}: {field}.child: body {shown(joint.child)} already has a "
                              f"parent joint; joints must form a tree (or forest)")
         if joint.type == "free" and joint.parent != "ground":
             raise SceneError(f"{where}: {field}.parent: a free joint must connect to 'ground'")
@@ -296,9 +298,9 @@ def check_topology(scene, top: Reader):
     for i, pto in enumerate(scene.ptos):
         if pto.between_points:
             if pto.body not in bodies:
-                raise SceneError(f"{where}: pto[{i}].body: unknown body {pto.body!r}")
+                raise SceneError(f"{where}: pto[{i}].body: unknown body {shown(pto.body)}")
             if pto.parent != "ground" and pto.parent not in bodies:
-                raise SceneError(f"{where}: pto[{i}].parent: unknown body {pto.parent!r}; "
+                raise SceneError(f"{where}: pto[{i}].parent: unknown body {shown(pto.parent)}; "
                                  f"expected 'ground' or a body")
             if np.linalg.norm(np.subtract(pto.point, pto.parent_point)) < 1e-9:
                 raise SceneError(f"{where}: pto[{i}].point: expected a point apart from "
@@ -312,11 +314,11 @@ def check_topology(scene, top: Reader):
                 known = ", ".join(one_dof) or "none"
                 raise SceneError(f"{where}: {kind}[{i}].joint: expected a joint with one "
                                  f"coordinate (revolute, prismatic, or free with one dof); "
-                                 f"got {item.joint!r}; candidates: {known}")
+                                 f"got {shown(item.joint)}; candidates: {known}")
     for kind, items in (("mooring", scene.moorings), ("drag", scene.drags)):
         for i, item in enumerate(items):
             if item.body not in bodies:
-                raise SceneError(f"{where}: {kind}[{i}].body: unknown body {item.body!r}")
+                raise SceneError(f"{where}: {kind}[{i}].body: unknown body {shown(item.body)}")
     given = scene.hydro.file is not None or scene.hydro.source is not None
     if not given or scene.hydro.hydrostatics == "large_angle":
         for i, body in enumerate(scene.bodies):
@@ -333,7 +335,7 @@ def _unique(where: str, kind: str, names: list[str]) -> None:
     seen = set()
     for i, name in enumerate(names):
         if name in seen:
-            raise SceneError(f"{where}: {kind}[{i}].name: duplicate name {name!r}")
+            raise SceneError(f"{where}: {kind}[{i}].name: duplicate name {shown(name)}")
         seen.add(name)
 
 

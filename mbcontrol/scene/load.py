@@ -9,6 +9,10 @@ from ..errors import SceneError
 from .model import Scene
 from .parse import parse_scene
 
+# The catalogue's largest scene is 8 kB; a scene file is a page of text, never megabytes (a
+# repeat block makes large devices from a few lines).
+MAX_SCENE_BYTES = 1 << 20
+
 
 def catalogue_dir() -> Path:
     return Path(str(resources.files("mbcontrol.models")))
@@ -40,7 +44,16 @@ def load_scene(path_or_name: str | Path, parameters: dict | None = None) -> Scen
     """
     path = resolve(path_or_name)
     try:
+        size = path.stat().st_size
+        if not path.is_file():
+            raise SceneError(f"{path}: not a file; expected a TOML scene file (see models/*.toml)")
+        if size > MAX_SCENE_BYTES:
+            raise SceneError(f"{path}: {size} bytes; expected a scene file of at most "
+                             f"{MAX_SCENE_BYTES} bytes (a [[body]] repeat = \"i = 1..N\" makes "
+                             f"many bodies from a few lines)")
         data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except OSError as exc:
+        raise SceneError(f"{path}: cannot read the scene file: {exc.strerror or exc}") from None
     except UnicodeDecodeError as exc:
         raise SceneError(f"{path}: not a text scene file: byte {exc.object[exc.start]:#04x} at "
                          f"offset {exc.start} is not UTF-8; expected a TOML scene "

@@ -7,9 +7,11 @@ from pathlib import Path
 import numpy as np
 
 from .. import defaults
+from ..errors import SceneError
 from .checks import Reader, catenary_geometry, check_topology
 from .model import (DOF_NAMES, JOINT_TYPES, Body, Drag, Drivetrain, EndStop, Friction, Geometry,
                     HydroSettings, Joint, Mooring, Obstacle, Pto, Scene, Water)
+from .names import name_from_stem
 from .shapes import displaced_mass, read_profile
 from .template import expand
 from .units import JOINT_DIMENSIONS
@@ -20,6 +22,9 @@ def parse_scene(data: dict, path: Path, parameters: dict | None = None) -> Scene
 
     [parameters] and `repeat` entries are expanded first (:mod:`mbcontrol.scene.template`).
     """
+    if not isinstance(data, dict):
+        raise SceneError(f"{path}: top level: expected a table of scene keys, got "
+                         f"{type(data).__name__}")
     data, used = expand(data, str(path), parameters)
     top = Reader(data, str(path), "")
     top.allow("name", "description", "water", "body", "joint", "pto", "friction", "mooring",
@@ -31,7 +36,7 @@ def parse_scene(data: dict, path: Path, parameters: dict | None = None) -> Scene
     hydro = _hydro(top.table("hydro", required=False), path)
     obstacles = _obstacles(top, path, bodies, hydro)
     scene = Scene(
-        name=top.string("name", default=path.stem),
+        name=_scene_name(top, path),
         path=str(path),
         description=top.string("description", default=""),
         water=water, bodies=bodies, joints=joints,
@@ -46,6 +51,13 @@ def parse_scene(data: dict, path: Path, parameters: dict | None = None) -> Scene
         obstacles=obstacles,
     )
     return check_topology(scene, top)
+
+
+def _scene_name(top, path: Path) -> str:
+    """The scene's `name`, or its file's stem made a name (my-buoy.toml: my_buoy): a file name
+    is the user's to choose, a scene name is not (it reaches C and signal names)."""
+    name = top.string("name", default=path.stem)
+    return name if "name" in top.data else name_from_stem(name)
 
 
 def _water(r: Reader) -> Water:

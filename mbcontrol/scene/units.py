@@ -39,6 +39,17 @@ SI_UNIT = {
     "inductance": "H", "power": "W",
 }
 
+# The largest magnitude (SI) a finite value of each dimension may take: far past any device (the
+# largest floating structures weigh ~6e8 kg; the deepest sea is 11 km), so only a slip of
+# units or orders of magnitude, or a hostile file, is refused, by the field that holds it
+# rather than later as a "diverged: try a smaller time step". Infinity stays for the fields
+# that mean "none" by it (depth = inf: deep water).
+PHYSICAL_MAX = {
+    "length": 1e5, "mass": 1e10, "angle": 1e3, "time": 1e7, "frequency": 1e4, "density": 1e5,
+    "acceleration": 1e3, "inertia": 1e16, "coordinate": 1e5, "force": 1e11, "moment": 1e13,
+    "current": 1e6, "voltage": 1e7, "resistance": 1e9, "inductance": 1e6, "power": 1e10,
+}
+MAX_QUANTITY_CHARS = 64      # "1.2345e+06 kg*m^2" is 17; a longer string is not a quantity
 _QUANTITY = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(\S.*?)?\s*$")
 
 
@@ -53,11 +64,32 @@ def to_si(value, dimension: str | None) -> float:
     dimensionless number or one whose unit the scene format does not name (e.g. N*s/m):
     then only plain numbers are accepted.
     """
+    return _in_range(_si(value, dimension), dimension, value)
+
+
+def _in_range(number: float, dimension: str | None, given) -> float:
+    limit = PHYSICAL_MAX.get(dimension or "")
+    if limit is not None and math.isfinite(number) and abs(number) > limit:
+        raise UnitError(f"{given!r} is beyond the physical range of {_article(dimension)} "
+                        f"{dimension} (at most {limit:g} {SI_UNIT[dimension]} in size); check "
+                        f"the value and its unit")
+    return number
+
+
+def _article(word: str) -> str:
+    return "an" if word[0] in "aeiou" else "a"
+
+
+def _si(value, dimension: str | None) -> float:
     if isinstance(value, bool):
         raise UnitError(f"expected a number, got the boolean {value!r}")
     if isinstance(value, (int, float)):
         return float(value)
     if isinstance(value, str):
+        if len(value) > MAX_QUANTITY_CHARS:
+            raise UnitError(f"expected a number or '<number> <unit>' of at most "
+                            f"{MAX_QUANTITY_CHARS} characters, got {len(value)} characters "
+                            f"{value[:40]!r}...")
         match = _QUANTITY.match(value)
         if not match:
             raise UnitError(f"expected a number or '<number> <unit>', got {value!r}")
@@ -69,7 +101,7 @@ def to_si(value, dimension: str | None) -> float:
             if dimension is None:
                 raise UnitError(f"expected a plain SI number here, got a unit in {value!r}")
             raise UnitError(
-                f"expected {'an' if dimension[0] in 'aeiou' else 'a'} {dimension} in one of "
+                f"expected {_article(dimension)} {dimension} in one of "
                 f"{sorted(table)}, got {value!r}")
         return number * table[unit]
     raise UnitError(f"expected a number, got {type(value).__name__} {value!r}")

@@ -14,6 +14,7 @@ import math
 import numpy as np
 
 from ...results import jsonable
+from ...textsafe import plain_text
 from .costs import harmonic, whole_periods
 
 
@@ -147,15 +148,17 @@ def summary(model: str, problem, result, fit_rows, validation_rows=None) -> dict
 
 
 def parameter_table(problem, result) -> str:
-    """Plain-text table: parameter, initial, identified +- sigma, bounds."""
+    """Plain-text table: parameter, initial, identified +- sigma, bounds. Names pass
+    `plain_text` (a newline or an escape sequence in one would forge a row or reach a
+    terminal raw)."""
     lines = [f"{'parameter':36s} {'initial':>11s} {'identified':>11s} {'+- sigma':>10s}  bounds"]
     for p in problem.fit:
         v, s = result.values[p.name], result.std.get(p.name, math.nan)
         side = result.at_bound.get(p.name)
         sigma = f"{'at ' + side:>10s}" if side else f"{s:10.3g}"
-        lines.append(f"{p.name:36s} {p.initial:11.4g} {v:11.4g} {sigma}  "
+        lines.append(f"{plain_text(p.name):36s} {p.initial:11.4g} {v:11.4g} {sigma}  "
                      f"[{p.lo:.3g}, {p.hi:.3g}]{' log' if p.log else ''}")
-    lines.append(f"sigma: {result.uncertainty_method}")
+    lines.append(f"sigma: {plain_text(result.uncertainty_method)}")
     lines.append(f"cost (1/2 |r|^2, {problem.cost}): {result.cost_initial:.4g} -> {result.cost:.4g}"
                  f"; {result.simulations} simulations, {result.wall_time_s:.1f} s")
     return "\n".join(lines)
@@ -163,15 +166,16 @@ def parameter_table(problem, result) -> str:
 
 def error_table(rows: list[dict], label: str) -> str:
     """Per channel: RMS error (unit) and RMS relative error over the runs, and beside it the
-    repeated runs' own spread (`repeatability`; "-" where no run was repeated)."""
-    floor = repeatability(rows)
+    repeated runs' own spread (`repeatability`; "-" where no run was repeated). Channel names
+    and the label pass `plain_text`."""
+    floor, label = repeatability(rows), plain_text(label)
     lines = [f"{label}: {'channel':8s} {'runs':>4s} {'rms error':>12s} {'rms relative':>13s}"
              f" {'repeat spread':>14s}"]
     for channel, e in channel_errors(rows).items():
         unit = next(r["unit"] for r in rows if r["channel"] == channel)
         f = floor.get(channel)
         spread = f"{100 * f['rms_relative_spread']:5.1f}% ({f['sets']})" if f else "-"
-        lines.append(f"{'':{len(label) + 2}s}{channel:8s} {e['runs']:4d} "
+        lines.append(f"{'':{len(label) + 2}s}{plain_text(channel):8s} {e['runs']:4d} "
                      f"{e['rms_error']:10.3g} {unit:3s} {100 * e['rms_relative_error']:10.1f}%"
                      f" {spread:>14s}")
     return "\n".join(lines)
