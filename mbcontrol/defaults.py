@@ -44,11 +44,16 @@ _REGISTRY: dict[str, Default] = {
     "sim.method": Default("rk4", "", "integration method of simulate() (mbcontrol.sim.METHODS)",
                           str),
     "sim.rtol": Default(1e-8, "", "relative tolerance of the adaptive methods (cvodes, adams)"),
+    "stats.min_periods": Default(10, "", "wave periods (a sea's peak periods) a result's "
+                                         "statistics window must hold after the ramp and any "
+                                         "warm-up, or the result is INVALID", int),
     "sweep.duration": Default(600.0, "s", "simulated time of each sweep case"),
     "sweep.dt": Default(0.05, "s", "time step of sweep cases"),
     "sweep.method": Default("rk4", "", "fixed-step method of sweep cases", str),
     "sweep.workers": Default(-1, "", "local Dask workers of a sweep: -1 one per core, "
                                      "0 serial in this process", int),
+    "dask.host": Default("127.0.0.1", "", "address local Dask clusters (sweeps, co-design) "
+                                          "and their web server listen on", str),
     "identify.dt": Default(0.01, "s", "simulation step of identification runs"),
     "identify.method": Default("gauss-newton", "", "optimiser: gauss-newton or nelder-mead",
                                str),

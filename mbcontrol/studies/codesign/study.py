@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from ...atomic import write_text
+from ...cache import read_entry
 from ...errors import InputError
 from .objectives import Spec, evaluate
 
@@ -56,9 +57,12 @@ class Store:
     def get(self, key: str):
         if key in self.memory:
             return self.memory[key]
-        if self.folder is not None and (self.folder / f"{key}.json").exists():
-            self.memory[key] = json.loads((self.folder / f"{key}.json").read_text())
-            return self.memory[key]
+        if self.folder is not None:    # an unreadable record is moved aside: evaluated again
+            record = read_entry(self.folder / f"{key}.json", lambda p: json.loads(p.read_text()),
+                                what="co-design point record", then="evaluating the point again")
+            if record is not None:
+                self.memory[key] = record
+            return record
         return None
 
     def put(self, key: str, record: dict) -> None:
@@ -147,9 +151,10 @@ def _grid(grid, run, spec, roles, text, cache, workers, scheduler, progress) -> 
     """Every grid point: those not stored yet on Dask (workers > 0 or a scheduler), else here."""
     todo = [p for p in grid if cache.get(point_key(spec, p, text)) is None]
     if todo and (workers or scheduler):
-        from dask.distributed import Client, LocalCluster
-        cluster = None if scheduler else LocalCluster(n_workers=workers, threads_per_worker=1,
-                                                      processes=True)
+        from dask.distributed import Client
+
+        from ..cluster import local_cluster
+        cluster = None if scheduler else local_cluster(workers)
         with Client(scheduler or cluster) as client:
             futures = client.map(_evaluate_record, [spec] * len(todo), todo,
                                  [roles] * len(todo), pure=False)

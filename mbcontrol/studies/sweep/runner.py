@@ -339,14 +339,14 @@ class _ClusterStarter:
     def _run(self):
         try:
             import dask
-            from dask.distributed import Client, LocalCluster
+            from dask.distributed import Client
+
+            from ..cluster import local_cluster
             config = {f"distributed.nanny.pre-spawn-environ.{k}": v
                       for k, v in WORKER_MALLOC.items()}
             config["distributed.worker.multiprocessing-method"] = self.method
             with dask.config.set(config):       # a worker restarted later is spawned
-                self.cluster = LocalCluster(n_workers=self.n, threads_per_worker=1,
-                                            processes=True, dashboard_address=None,
-                                            silence_logs=40)
+                self.cluster = local_cluster(self.n, silence_logs=40)
             self.client = Client(self.cluster)
             self.client.run(_warm, *self.warm)
         except Exception as exc:           # reported by the caller, which runs on serially
