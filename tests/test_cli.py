@@ -76,11 +76,13 @@ def test_errors_are_clear(capsys):
                        "--controller", "passive", "--set", "damping=1.5x")
     assert code == 1 and "--set damping: expected a number, true/false or none, got '1.5x'" in err
     # booleans and none parse as such (an MPC's soft_stroke, a limit left to the scene)
+    # (60 s: the settings are parsed and described; too short to be valid, as it says)
     code, out, err = run(capsys, "simulate", "sphere", "--wave", "jonswap", "--hs", "1",
                          "--tp", "8", "--duration", "60", "--dt", "0.1", "--controller", "mpc",
                          "--set", "soft_stroke=false", "--set", "force_max=none",
-                         "--set", "forecast=model", "--json")
+                         "--set", "forecast=model", "--json", "--allow-invalid")
     assert code == 0, err
+    assert "fewer than the 10" in json.loads(out)["invalid_reasons"][0]
     described = json.loads(out)["controller"]
     assert described["soft_stroke"] is False and described["forecast"] == "model"
 
@@ -115,7 +117,7 @@ def test_simulate_issue3_models(capsys, model):
     (the tank-scale wavestar in a proportionate wave of its own band)."""
     height, period = ("0.0625", "1.412") if model == "wavestar" else ("2.5", "8")
     code, out, _ = run(capsys, "simulate", model, "--wave", "regular", "--height", height,
-                       "--period", period, "--duration", "40", "--json")
+                       "--period", period, "--duration", "100", "--json")   # 2 T ramp + 10 T
     assert code == 0
     result = json.loads(out)
     pto = next(iter(result["ptos"].values()))
@@ -227,7 +229,7 @@ def test_help_names_every_registered_controller(capsys, command):
 
 def test_simulate_text_gives_units(capsys):
     code, out, err = run(capsys, "simulate", "hinged_barge", "--wave", "regular", "--height",
-                         "0.02", "--period", "1.0", "--duration", "5")
+                         "0.02", "--period", "1.0", "--duration", "12")   # 2 T ramp + 10 T
     assert code == 0, err
     line = next(l for l in out.splitlines() if "hinge_pto:" in l)
     assert " W, max force " in line and " N m, max stroke " in line and line.endswith(" rad")
@@ -239,7 +241,7 @@ def test_quiet_and_verbose(tmp_path):
     import os
     import subprocess
     import sys
-    args = ["simulate", "sphere", "--height", "1", "--period", "8", "--duration", "10"]
+    args = ["simulate", "sphere", "--height", "1", "--period", "8", "--duration", "96"]
 
     def stderr(*flags, cache):
         env = {**os.environ, "MBCONTROL_CACHE": str(tmp_path / cache)}

@@ -55,10 +55,12 @@ def test_simulate_takes_its_step_and_method_from_the_registry():
     plant = build_plant("sphere")
     wave = waves.regular(1.0, 9.0)
     with defaults.override(sim_dt=0.1, sim_method="rk3"):   # stable below 0.15 s
-        ds = simulate(plant, wave, duration=5.0)
+        with pytest.warns(RuntimeWarning, match="before its statistics window would start"):
+            ds = simulate(plant, wave, duration=5.0)      # 5 s: still inside the 18 s ramp
     assert ds.attrs["dt_s"] == 0.1 and ds.attrs["method"] == "rk3"
     assert np.allclose(np.diff(ds.time), 0.1)
-    ds = simulate(plant, wave, duration=5.0, dt=0.05)         # an argument wins
+    with pytest.warns(RuntimeWarning, match="simulate at least 108 s"):
+        ds = simulate(plant, wave, duration=5.0, dt=0.05)     # an argument wins
     assert ds.attrs["dt_s"] == 0.05 and ds.attrs["method"] == "rk4"
 
 

@@ -19,6 +19,7 @@ import math
 
 import numpy as np
 
+from .. import defaults
 from ..errors import InputError
 from ..results import record, run_info
 
@@ -26,6 +27,12 @@ from ..results import record, run_info
 _BODY_KEYS = {"Surge": "surge_amplitude_m", "Sway": "sway_amplitude_m",
               "Heave": "heave_amplitude_m", "Roll": "roll_amplitude_rad",
               "Pitch": "pitch_amplitude_rad", "Yaw": "yaw_amplitude_rad"}
+
+
+# A window holds at least "stats.min_periods" wave periods (a regular wave's period, a sea's
+# peak period; 10 by default): a regular wave's steady state is read over its last 10 periods,
+# and a sea's mean power over fewer peak periods than that scatters by tens of percent between
+# seeds.
 
 
 def analysis_window(ds) -> np.ndarray:
@@ -36,37 +43,68 @@ def analysis_window(ds) -> np.ndarray:
     mask = t >= start - 1e-9
     if mask.sum() < 2:
         raise InputError(f"the record ({t[-1]:.4g} s) is too short for the metrics window "
-                         f"starting at {start:.4g} s ({info['note']}); simulate longer")
+                         f"starting at {start:.4g} s ({info['note']}); simulate at least "
+                         f"{info['shortest_duration_s']:.4g} s (--duration)")
     return mask
 
 
 def statistics_window(ds) -> dict:
-    """{"start_s", "note"}: where the statistics start (s) and why. Regular wave: the last 10
-    periods; a sea: after the ramp; either way not before the controller's warm-up ends
-    (the run record's controller, mbcontrol.results.RunInfo). A caller may set the start in
-    the record, ds.attrs["statistics_from_s"] with its reason in ds.attrs["statistics_note"]
-    (design scores a sea over its last whole repeat period, as the bounds it is compared
-    with)."""
+    """Where the statistics start and whether the window can be trusted:
+    {"start_s", "end_s", "periods" (wave periods in the window, None without a period),
+    "note" (why there), "problem" (None, or why the window cannot give steady statistics),
+    "shortest_duration_s" (the shortest run whose window would do)}.
+
+    The window never starts before the wave's ramp has ended nor before the controller's
+    warm-up has (the run record's controller, mbcontrol.results.RunInfo). A regular wave: its
+    last "stats.min_periods" periods; a sea: the record after the ramp. A caller may set the start,
+    ds.attrs["statistics_from_s"] with its reason in ds.attrs["statistics_note"] (design scores
+    a sea over its last whole repeat period, as the bounds it is compared with). A window that
+    overlaps the ramp or the warm-up, or holds fewer than "stats.min_periods" periods, has a
+    "problem": `validity.assess` marks the result invalid with it."""
     t = ds["time"].values
+    end = float(t[-1])
     run = run_info(ds)
     wave = record(ds.attrs, "wave", {})
+    ramp, warm_up = float(wave.get("ramp_s", 0.0) or 0.0), float(run.warm_up_s or 0.0)
+    n_periods = int(defaults.get("stats.min_periods"))
+    earliest = max(ramp, warm_up)
+    period = _wave_period(wave)
     if run.statistics_from_s is not None:
-        start = run.statistics_from_s
-        note = str(run.statistics_note or "set by the caller")
+        start, note = run.statistics_from_s, str(run.statistics_note or "set by the caller")
     elif wave.get("type") == "regular":
-        start = float(t[-1] - 10 * wave["period"])
-        note = "the last 10 wave periods"
+        start, note = max(end - n_periods * period, earliest), f"the last {n_periods} wave periods"
     else:
-        start = float(wave.get("ramp_s", 0.0) or 0.0)
-        note = f"after the wave's ramp ({start:.4g} s)" if start > 0 else "the whole record"
-    warm_up = run.warm_up_s
+        start = earliest
+        note = f"after the wave's ramp ({ramp:.4g} s)" if ramp > 0 else "the whole record"
     if warm_up:
-        note += f", and after the controller's warm-up ({float(warm_up):.4g} s)"
-        if float(warm_up) > start:
-            start = float(warm_up)
-            if wave.get("type") == "regular":
-                note += ": fewer than 10 periods"
-    return {"start_s": start, "note": f"statistics over t >= {start:.4g} s: {note}"}
+        note += f", and after the controller's warm-up ({warm_up:.4g} s)"
+    periods = None if not period else (end - start) / period
+    shortest = earliest + n_periods * (period or 0.0)
+    problem = None
+    if end <= start:
+        problem = (f"the record ends at {end:.4g} s, before its statistics window would start "
+                   f"({start:.4g} s: the wave's ramp and any warm-up come first)")
+    elif start < earliest - 1e-9:
+        problem = (f"the statistics window starts at {start:.4g} s, before the "
+                   f"{'ramp' if ramp >= warm_up else 'controller warm-up'} ends at "
+                   f"{earliest:.4g} s")
+    elif periods is not None and periods < n_periods * (1 - 1e-6):
+        problem = (f"the statistics window ({start:.4g} s to {end:.4g} s, after the ramp and "
+                   f"any warm-up) holds {periods:.3g} wave periods of {period:.4g} s, fewer "
+                   f"than the {n_periods} steady statistics need (stats.min_periods)")
+    return {"start_s": start, "end_s": end, "periods": periods,
+            "note": f"statistics over t >= {start:.4g} s: {note}", "problem": problem,
+            "shortest_duration_s": max(shortest, start + n_periods * (period or 0.0))}
+
+
+def _wave_period(wave: dict) -> float | None:
+    """The period (s) a window is counted in: a regular wave's, else a sea's peak period, else
+    None (a measured record, a spectrum given without one)."""
+    for key in ("period", "tp"):
+        value = wave.get(key)
+        if isinstance(value, (int, float)) and value > 0:
+            return float(value)
+    return None
 
 
 def signal_stats(values) -> dict:

@@ -27,6 +27,7 @@ from ..plant import controlled_params, provenance
 from ..results import jsonable
 from . import diagnose, integrators, sampled
 from .held import HeldStepper
+from .methods import time_steps
 from .moorings import mooring_report
 from .protocol import estimation_report, uses_state
 
@@ -51,10 +52,8 @@ def simulate(plant, wave=None, *, duration: float, dt: float | None = None, cont
     """
     dt, method = defaults.resolve("sim.dt", dt), defaults.resolve("sim.method", method)
     rtol = defaults.resolve("sim.rtol", rtol)
-    if duration <= 0 or dt <= 0 or dt > duration:
-        raise InputError(f"expected 0 < dt <= duration, got dt={dt}, duration={duration}")
+    n = time_steps(duration, dt)
     spec = integrators.method(method)
-    n = int(round(duration / dt))
     t = np.arange(n + 1) * dt
     p = _parameters(plant, params, controller)
     x0 = plant.x0() if x0 is None else np.asarray(x0, float)

@@ -67,12 +67,32 @@ class Wave:
                 "ramp_s": self.ramp_time, "n_components": int(self.omega.size)}
 
 
+# A wave steeper than this breaks (Michell 1893: H/L = 0.142 in deep water); no sea holds one,
+# and linear theory, which every model here builds on, holds only far below it.
+BREAKING_STEEPNESS = 1 / 7
+
+
+def check_steepness(height: float, period: float, what: str) -> None:
+    """Refuse a wave (or a sea's Hs over its peak wavelength) steeper than BREAKING_STEEPNESS,
+    measured against the deep-water wavelength g T^2 / (2 pi): in finite depth the wave is
+    shorter and steeper still, so this refuses only what cannot exist anywhere."""
+    if not (math.isfinite(height) and math.isfinite(period)):
+        raise WaveError(f"{what}: expected finite numbers, got {height} m, {period} s")
+    wavelength = 9.80665 * period ** 2 / (2 * math.pi)
+    if height > BREAKING_STEEPNESS * wavelength:
+        raise WaveError(f"{what}: {height:g} m over a {period:g} s period is steeper than a "
+                        f"wave can be (it breaks at H/L = 1/7; the deep-water wavelength is "
+                        f"{wavelength:.4g} m, so at most {BREAKING_STEEPNESS * wavelength:.4g} m); "
+                        f"expected a smaller height or a longer period")
+
+
 def regular(height: float, period: float, *, phase: float = 0.0, direction: float = 0.0,
             ramp_time: float | None = None) -> Wave:
     """A regular wave of height H (m, crest to trough) and period T (s); ramp 2 T by default."""
-    if height < 0 or period <= 0:
+    if not height >= 0 or not period > 0:
         raise WaveError(f"regular wave: expected height >= 0 and period > 0, got "
                         f"H={height}, T={period}")
+    check_steepness(height, period, "regular wave: --height against --period")
     ramp_time = 2 * period if ramp_time is None else ramp_time
     return Wave("regular", np.array([2 * np.pi / period]), np.array([height / 2]),
                 np.array([phase]), direction, ramp_time,
@@ -129,8 +149,9 @@ def irregular(hs: float, tp: float, *, gamma: float = 3.3, seed: int = 0,
     `direction`; settings record the spreading (`Spreading.describe`) and, with a sector
     narrower than the circle, "spreading_outside" (the largest share of D cut off).
     """
-    if hs <= 0 or tp <= 0 or gamma < 1:
+    if not (hs > 0 and tp > 0 and gamma >= 1) or not math.isfinite(gamma):
         raise WaveError(f"{kind}: expected hs > 0, tp > 0, gamma >= 1; got {hs}, {tp}, {gamma}")
+    check_steepness(hs, tp, f"{kind} sea: --hs against --tp")
     gamma_used = gamma if kind == "jonswap" else 1.0
     kept = band_limits(tp, data_band, band, what=f"a {kind} sea")
     wp = 2 * np.pi / tp

@@ -92,7 +92,7 @@ def test_default_set_drops_what_the_runs_cannot_see(capsys):
 
 def test_identified_values_go_back_into_simulate(capsys):
     code, out, err = run(capsys, "simulate", "flume_section", "--height", "0.024", "--period",
-                         "1.2", "--duration", "5", "--dt", "0.01",
+                         "1.2", "--duration", "14.4", "--dt", "0.01",   # 2 T ramp + 10 T
                          "--param", "section__Roll__added_mass_scale=0.86",
                          "--param", "viscous__Roll_linear=0.19", "--json")
     assert code == 0, err

@@ -13,7 +13,7 @@ from mbcontrol.studies.sweep.cases import read_seas
 from mbcontrol.studies.sweep.uncertainty import read_identified
 
 H = 8766 / 1e6          # MWh per W over a year
-SHORT = dict(duration=120.0, dt=0.1, progress=False, workers=0)
+SHORT = dict(duration=150.0, dt=0.1, progress=False, workers=0)   # 2 Tp + 10 Tp of 12 s
 
 
 def test_budget_sums_by_hand():
