@@ -43,13 +43,16 @@ def run_models(args) -> int:
 
 def _what_was_read(data) -> dict | None:
     """A third-party BEM file's conversion: the file, the readers' notes (what they found and
-    repaired) and their repairs in detail; None for data made by mbcontrol's own BEM run."""
+    repaired), their repairs and physical checks in detail, and how its bodies were matched to
+    the scene's (BEM body -> {"scene_body", "by", "distance_m"}); None for data made by
+    mbcontrol's own BEM run."""
     from ..results import record
     if "converted_from" not in data.attrs:
         return None
     return {"file": str(data.attrs["converted_from"]),
             "notes": [str(n) for n in record(data.attrs, "notes", [])],
-            "repairs": jsonable(record(data.attrs, "cleaning", {}))}
+            "repairs": jsonable(record(data.attrs, "cleaning", {})),
+            "body_mapping": jsonable(record(data.attrs, "body_mapping", {}))}
 
 
 def run_hydro(args) -> int:
@@ -79,6 +82,10 @@ def run_hydro(args) -> int:
         if report["read"]:
             print(f"  read from {report['read']['file']}, as the readers found it:")
             print("\n".join(f"    - {note}" for note in report["read"]["notes"]))
+            for body, match in report["read"]["body_mapping"].items():
+                if "distance_m" not in match:     # by position: in the notes already
+                    print(f"    - BEM body {body!r} is scene body {match['scene_body']!r} (by "
+                          f"{match['by']})")
         print(f"  radiation model: {rad.order} states, slowest pole real part {report['max_pole_real_part']:.3g} 1/s")
         if rep.get("response_worst"):
             rw = rep["response_worst"]

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from ..cache import cache_dir
+from ..cache import cache_dir, rebuilt_once
 from ..console import status
 from ..errors import HydroError
 from ..scene import DOF_NAMES, Scene
@@ -29,6 +29,8 @@ from .fit.radiation import RadiationModel, coupled_groups
 from .fit.response_error import Device
 from .fit.store import FITS_SERVED, cached_fit, fit_band_limit, model_from_arrays, shipped_fits_dir  # noqa: F401 (the model's face)
 from .fit.ssforms import modal_blocks
+from .readers.physical import DAMPING_EIG_TOL, check_physical
+from .readers.layout import force_first, kind_scales
 from .source import converted_source
 
 
@@ -202,6 +204,7 @@ def load_hydro_data(scene: Scene, dofs) -> tuple[str, xr.Dataset]:
     a (cached) Capytaine run on [hydro] omega. A scene with both source and omega uses the source
     and says so; one whose file is missing, with neither, is told what to do."""
     h = scene.hydro
+    supplied = True
     if h.file and Path(h.file).exists():
         source = h.file
         data = read_netcdf(source)
@@ -209,15 +212,63 @@ def load_hydro_data(scene: Scene, dofs) -> tuple[str, xr.Dataset]:
         if h.omega:
             status(f"{scene.name}: [hydro] source {Path(h.source).name} is used; [hydro] omega "
                    f"(BEM frequencies for Capytaine) is not (remove one of them)", __name__)
-        source, data = converted_source(scene)
+        # its cache entry, if unreadable, is set aside by read_netcdf: converted again, once
+        source, data = rebuilt_once(lambda: converted_source(scene))
     elif h.file and not h.omega:
         raise HydroError(_missing_file(scene))
     else:
         source, data = _run_bem(scene, dofs)
+        supplied = False
+    # every source passes the same physical gate (module readers.physical); a cut at an
+    # interaction radius is non-passive by construction (module bem.neighbours records by how much)
+    check_physical(data, f"{source} ([hydro] of {scene.path})", eig_tol=(
+        DAMPING_EIG_TOL if h.interaction_radius == np.inf or supplied else np.inf))
+    if supplied:
+        _check_interaction(scene, data, source)
     _check_dofs(data, dofs, source)
     if scene.hydro.axisymmetric:           # one heading serves all (module headings)
         data = axisymmetric_headings(data, f"{scene.path}: [hydro] axisymmetric: {source}")
     return source, data
+
+
+COUPLING_ZERO = 1e-9   # scaled |A_ij|, |B_ij| below this between two bodies: no coupling (exact zeros when solved apart)
+
+
+def _check_interaction(scene: Scene, data: xr.Dataset, source: str) -> None:
+    """Refuse supplied data ([hydro] file or source) that couple bodies the scene says do not
+    interact ([hydro] interaction = false, or farther apart than interaction_radius, horizontal
+    distance of the geometry centres as in module bem.neighbours). The data cannot be uncoupled
+    after the fact: a coupled BEM solve's excitation holds the waves the other bodies scatter,
+    and each body's own A, B hold its neighbours' reflections, so zeroing the cross blocks would
+    leave half a coupled model. A Capytaine run on [hydro] omega solves the bodies as asked."""
+    h = scene.hydro
+    if h.interaction and h.interaction_radius == np.inf:
+        return
+    dofs = [str(d) for d in data["radiating_dof"].values]
+    bodies = [d.split("__")[0] for d in dofs]
+    centres = {b.name: np.asarray(b.geometry.center if b.geometry else b.cog, float)[:2]
+               for b in scene.bodies}
+    strength = np.zeros((len(dofs), len(dofs)))
+    for var in ("added_mass", "radiation_damping", "added_mass_inf"):
+        x = np.abs(force_first(data[var])).reshape(-1, len(dofs), len(dofs))
+        if not np.all(np.isfinite(x)):
+            continue
+        s = np.sqrt(kind_scales(dofs, np.diagonal(x, axis1=1, axis2=2).max(0)))
+        strength = np.maximum(strength, (x / np.outer(s, s)).max(0))
+    for i, j in zip(*np.nonzero(strength > COUPLING_ZERO)):
+        a, b = bodies[i], bodies[j]
+        if a == b or (h.interaction and a in centres and b in centres
+                      and np.hypot(*(centres[a] - centres[b])) <= h.interaction_radius * (1 + 1e-9)):
+            continue
+        setting = ("interaction = false" if not h.interaction
+                   else f"interaction_radius = {h.interaction_radius:g} m")
+        raise HydroError(
+            f"{scene.path}: [hydro] {setting}, but the hydro data {source} couple bodies {a!r} and {b!r} "
+            f"(radiation between {dofs[i]} and {dofs[j]}, {strength[i, j]:.3g} of the diagonal scale). "
+            "Supplied BEM data cannot be uncoupled afterwards (their excitation and each body's own "
+            "coefficients include the other bodies' waves). Remove the [hydro] interaction setting to "
+            "use the coupled data as they are, or remove [hydro] file/source and give [hydro] omega "
+            "so that Capytaine solves the bodies as asked")
 
 
 def _missing_file(scene: Scene) -> str:

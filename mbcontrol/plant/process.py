@@ -10,7 +10,6 @@ CoG); parameters p (PTO, friction, mooring, drag coefficients) stay symbolic.
 """
 from __future__ import annotations
 
-import warnings
 from dataclasses import dataclass, field
 
 import casadi as ca
@@ -24,6 +23,7 @@ from . import checks, loads
 from .mechanical import dof_selector, mechanical_matrices
 from .ownership import linear_params
 from .pieces import plant_parts
+from .rest import preloads
 
 
 @dataclass(frozen=True, eq=False)      # identity semantics: derived data is kept per plant
@@ -127,10 +127,13 @@ def assemble_plant(scene: Scene | str, hydro: HydroModel | None = None, *,
     if hydro_force is not None:
         tau += hydro_force
     tau, potential, pto_signals, tensions = _body_loads(tau, scene, topo, hydro, q, s, u, params)
-    tau += _preloads(scene, topo, q, s, u, w, chi, tau, pto_signals, params)
+    extra, balance = preloads(scene, topo, (q, s, u, w, chi, tau), pto_signals, params,
+                              hydro.buoyancy(scene.water) if hydro else {})
+    tau += extra
 
     M = tree.mass_matrix(q, added_mass)
     notes = checks.rest_checks(scene, topo, q, s, u, w, chi, tau, M, params)
+    notes["rest_balance"] = balance        # weight against buoyancy, what preloads hold (plant.rest)
     s_dot = ca.solve(M, tau)
     x = ca.vertcat(q, s, chi)
     x_dot = ca.vertcat(ca.mtimes(tree.K(q), s), s_dot, chi_dot)
@@ -200,49 +203,6 @@ def _body_loads(tau, scene, topo, hydro, q, s, u, params):
     if scene.hydro.hydrostatics == "linear":
         tau += loads.static_loads(scene, topo, q, hydro.buoyancy(scene.water) if hydro else {})
     return tau, potential, pto_signals, tensions
-
-
-def _preloads(scene, topo, q, s, u, w, chi, tau, pto_signals, params):
-    """Constant PTO forces that make rest an equilibrium (PTOs with preload = "balance").
-
-    The static generalised load at rest does not depend on the parameters (every
-    parametrised load vanishes at rest), so the preloads are solved once, here, and kept as
-    parameters (<pto>__preload, N or N m) that identification may change. Warns, naming the
-    coordinates, when rest is still not an equilibrium.
-    """
-    tree = topo.tree
-    rest = ca.Function("rest", [q, s, u, w, chi, params.vector], [tau])
-    n_p = len(params.names)
-    args = [np.zeros(tree.n_q), np.zeros(tree.n_s), np.zeros(u.shape[0]), np.zeros(w.shape[0]),
-            np.zeros(chi.shape[0]), np.array(params.values) if n_p else np.zeros(0)]
-    residual = np.asarray(rest(*args)).ravel()
-    balancing = [p for p in scene.ptos if p.preload == "balance"]
-    extra = ca.SX.zeros(tree.n_s)
-    if balancing:
-        d_fun = ca.Function("d", [q], [ca.horzcat(*[pto_signals[p.name][3] for p in balancing])])
-        D = np.asarray(d_fun(np.zeros(tree.n_q)))
-        f0, *_ = np.linalg.lstsq(D, -residual, rcond=None)
-        for pto, value, column in zip(balancing, f0, range(len(balancing))):
-            sym = params.add(f"{pto.name}__preload", float(value))
-            extra += pto_signals[pto.name][3] * sym
-        residual = residual + D @ f0
-    scale = max(1.0, float(np.max(np.abs(np.asarray(args[0])))))
-    if np.max(np.abs(residual), initial=0.0) > 1e-9 * scale * max(1.0, _load_scale(scene)):
-        worst = np.argsort(-np.abs(residual))[:3]
-        weight = sum(b.mass for b in scene.bodies) * scene.water.g
-        listing = ", ".join(f"{tree.coordinate_names[i]}: {residual[i]:.4g}" for i in worst)
-        warnings.warn(f"{scene.path}: rest is not an equilibrium; static generalised loads "
-                      f"{listing} (N or N m; the largest is {abs(residual[worst[0]]) / weight:.2%} "
-                      f"of the bodies' weight, {weight:.4g} N). Buoyancy (the hydro data's "
-                      f"displaced volume) and weight, or their centres, do not balance: a mesh "
-                      f"that lost volume, a mass or CoG that is not the floating one. Correct "
-                      f"them, or give the PTO preload = \"balance\" (a constant PTO force that "
-                      f"holds rest)", RuntimeWarning, stacklevel=3)
-    return extra
-
-
-def _load_scale(scene) -> float:
-    return max(b.mass for b in scene.bodies) * scene.water.g
 
 
 def _hydro_scales(params, dofs) -> dict:

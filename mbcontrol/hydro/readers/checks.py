@@ -21,6 +21,7 @@ from ...errors import HydroError
 from ..data.frames import split_dof
 from .damping import repair_negative_damping
 from .layout import MAT, HydroCleaningWarning, fmt_omega, force_first, kind_scales, set_force_first
+from .physical import check_physical
 
 # Defaults of clean(); documented there.
 ASYM_TOL = 1e-3
@@ -228,7 +229,8 @@ def clean(ds: xr.Dataset, *, source: str, asym_tol: float = ASYM_TOL, force_symm
 
     1. Structure: the layout's variables and dimensions; DOF names ``<body>__<Dof>`` with a rigid
        Dof; the same DOFs radiating and influenced ("wrong DOF count" otherwise); every body listed.
-       ``dofs`` (optional) keeps only those DOFs (bodies left without DOFs are dropped).
+       ``dofs`` (optional) keeps only those DOFs (bodies left without DOFs are dropped); a callable
+       is given the structured dataset and returns them.
     2. Frequencies: ω = 0 / ∞ entries move to ``added_mass_zero`` / ``added_mass_inf``; the rest must
        be finite, > 0 and distinct (duplicates: error); unsorted ω (or headings) are sorted, with a note.
        ``omega_range = (lo, hi)`` (rad/s, optional) drops the frequencies outside it, e.g. those the
@@ -249,6 +251,10 @@ def clean(ds: xr.Dataset, *, source: str, asym_tol: float = ASYM_TOL, force_symm
        rows/columns set to 0 (the B -> 0 limit); otherwise error. ``"project"`` also accepts the
        rest by taking the nearest positive semi-definite matrix; ``"error"`` repairs nothing.
        Every repair warns (HydroCleaningWarning) and is listed in ``attrs["cleaning"]``.
+    6. Physics, after the repairs (module physical): positive added-mass diagonals (A(∞) always,
+       A(ω) at both ends of the range; a dip between them is a resonance, noted), passive
+       damping, C33 = ρ g Awp ≥ 0, V ≥ 0, buoyancy centre not above the surface. What cannot be
+       true is an error, never repaired; what was measured is ``attrs["cleaning"]["physical"]``.
 
     Returns a new dataset; ``attrs["notes"]`` lists every conversion and repair.
     """
@@ -259,6 +265,8 @@ def clean(ds: xr.Dataset, *, source: str, asym_tol: float = ASYM_TOL, force_symm
     notes = list(ds.attrs.get("notes", []))
     record = dict(ds.attrs.get("cleaning", {}))
     ds = _check_structure(ds, src)
+    if callable(dofs):   # a choice that depends on the file's bodies (module hydro.source)
+        dofs = dofs(ds)
     if dofs is not None:
         ds = _select_dofs(ds, src, list(dofs), notes)
     ds = _check_omega(ds, src, notes)
@@ -268,6 +276,12 @@ def clean(ds: xr.Dataset, *, source: str, asym_tol: float = ASYM_TOL, force_symm
     _symmetry(ds, src, record, notes, tol=float(asym_tol), force=bool(force_symmetric))
     ds = repair_negative_damping(ds, src, record, notes, diag_tol=float(diag_tol), eig_tol=float(eig_tol),
                                  max_run=int(max_interp_run), end_zero_tol=float(end_zero_tol), mode=negative_damping)
+    ds.attrs.setdefault("source", src)   # rho, g, frame: set by the reader's layout
+    record["physical"] = check_physical(ds, src)
+    for band in record["physical"]["resonance_bands"]:
+        notes.append(f"{band['entry']} < 0 over {band['omega'][0]:.4g}..{band['omega'][1]:.4g} rad/s (down to "
+                     f"{band['min_scaled']:.3g} of its scale) and > 0 on both sides: accepted as a resonance "
+                     "(gap, moonpool, submerged body); check that the body has one there")
     ds.attrs["notes"] = notes
     ds.attrs["cleaning"] = record
     ds.attrs.setdefault("source", src)
