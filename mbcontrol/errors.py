@@ -45,3 +45,10 @@ class UnknownName(MbcontrolError, KeyError):
 
     def __str__(self):                # KeyError quotes its message; this one is a sentence
         return str(self.args[0]) if self.args else ""
+
+
+class EnvironmentProblem(MbcontrolError, OSError):
+    """The machine, not the input, stopped the work: a full disk, a folder without write
+    permission, a read-only file system, a cache entry unreadable even when made again.
+    Names the path and what to do. An OSError, so code that handled the raw OSError before
+    still handles it."""

@@ -18,7 +18,10 @@ Examples:
 
 Exit status: 0 done; 1 bad input (the message names the file, the field and what was
 expected); 2 a bad command line; 3 a result (simulate) or sweep cases failed their physics
-checks: printed INVALID with a remedy (--allow-invalid: 0); 4 sweep cases failed to run.
+checks: printed INVALID with a remedy (--allow-invalid: 0); 4 sweep cases failed to run;
+5 the machine stopped the command (a full disk, no permission, a read-only file system, a
+cache entry unreadable even when made again): the message names the path and what to do.
+An error is one line, "mbcontrol: error: ..."; -v adds its traceback.
 """
 from __future__ import annotations
 
@@ -26,6 +29,7 @@ import argparse
 import contextlib
 import os
 import sys
+import traceback
 import warnings
 
 from .. import defaults
@@ -39,6 +43,7 @@ from .codesign import add_parser as add_codesign_parser
 from .export import add_parser as add_export_parser
 from .helptext import BENCH_HELP, DESIGN_HELP, SIMULATE_HELP
 from .identify import add_parser as add_identify_parser
+from .messages import refusal
 from .sweep import add_parser as add_sweep_parser
 
 
@@ -106,9 +111,16 @@ def _main(argv) -> int:
             with _stdout_for_json_only():
                 return args.run(args) or 0
         return args.run(args) or 0
-    except MbcontrolError as exc:       # bad input, named; anything else is a bug: its traceback
-        print(f"mbcontrol: error: {exc}", file=sys.stderr)
-        return 1
+    except (MbcontrolError, OSError) as exc:
+        # bad input or the machine's refusal, named in one line (-v: with its traceback);
+        # anything else is a bug and keeps its traceback
+        status, line = refusal(exc)
+        if status is None:
+            raise
+        if args.verbose:
+            traceback.print_exc()
+        print(f"mbcontrol: error: {line}", file=sys.stderr)
+        return status
 
 
 @contextlib.contextmanager
@@ -157,7 +169,8 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"mbcontrol {_version()}")
     loudness = parser.add_mutually_exclusive_group()
     loudness.add_argument("-v", "--verbose", action="store_true",
-                          help="more messages (the 'mbcontrol' logger at DEBUG)")
+                          help="more messages (the 'mbcontrol' logger at DEBUG), and an "
+                               "error's traceback")
     loudness.add_argument("-q", "--quiet", action="store_true",
                           help="only warnings and errors: no status lines, no progress bars")
     sub = parser.add_subparsers(title="commands", metavar="COMMAND")

@@ -1,7 +1,16 @@
-"""How the CLI says that a result is INVALID: what failed on one line, what to do on the next."""
+"""How the CLI says that a result is INVALID (what failed on one line, what to do on the
+next), and that a command could not run (one line and its exit status)."""
 from __future__ import annotations
 
+import errno
 import re
+
+from ..atomic import ENVIRONMENT_ERRNOS, environment_problem
+from ..cache import EntrySetAside
+from ..errors import EnvironmentProblem, MbcontrolError
+
+BAD_INPUT = 1        # the exit statuses of the command's docstring (mbcontrol --help)
+ENVIRONMENT = 5
 
 _REMEDY = re.compile(r"\. Remedy: ([^;]*)")
 
@@ -21,3 +30,23 @@ def invalid_lines(reasons, indent: str = "  ") -> list[str]:
 def without_remedies(joined: str) -> tuple[str, list[str]]:
     """A sweep case's reasons ("; "-joined) without their remedies, and the remedies."""
     return _REMEDY.sub("", joined), _REMEDY.findall(joined)
+
+
+def refusal(exc: BaseException) -> tuple[int | None, str]:
+    """(exit status, one line) for an error a user can act on: bad input (mbcontrol's own
+    errors: 1) or the machine's refusal (EnvironmentProblem, or an OSError of a full disk,
+    missing permission or a read-only file system that no writer named, a cache entry
+    set aside: 5); (None, "") for
+    anything else, a bug, which keeps its traceback."""
+    if isinstance(exc, (EnvironmentProblem, EntrySetAside)):
+        return ENVIRONMENT, str(exc)
+    if isinstance(exc, MbcontrolError):
+        return BAD_INPUT, str(exc)
+    if not isinstance(exc, OSError) or exc.errno not in ENVIRONMENT_ERRNOS:
+        return None, ""
+    if exc.filename:
+        return ENVIRONMENT, str(environment_problem(exc, exc.filename, "using"))
+    return ENVIRONMENT, (f"{exc.strerror or exc} ({errno.errorcode.get(exc.errno, exc.errno)}); "
+                         f"free some space, or fix the permissions of the folders the command "
+                         f"writes, or write elsewhere (for the cache: "
+                         f"MBCONTROL_CACHE=/another/folder)")

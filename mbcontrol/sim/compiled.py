@@ -3,12 +3,16 @@
 The cache key is the generated C source itself (plus flags, CasADi version, the compiler and
 its version, the platform and the CPU), so code is reused across processes whenever the
 structure is the same; parameters that stay symbolic (PTO, friction, ...) do not enter the key.
-Without a compiler, the interpreted Function is returned, with one warning.
+Without a compiler, the interpreted Function is returned, with one warning; so it is when the
+compiler fails (exits with an error, makes no library, or makes one the loader refuses: one
+warning per compiler and flags, naming what failed and to set CC). A full disk or a cache
+folder that cannot be written is an EnvironmentProblem naming the folder.
 
 Every library is checked before it is loaded: its size and SHA-256, recorded beside it
 (`.sha256`) when it was built, must match. A truncated or foreign file (a full disk, a cache
 shared over a network file system) would otherwise crash the process in the loader with no
-message (a bus error); a mismatch is rebuilt, with a warning. Build folders left by a killed
+message (a bus error); a mismatch is moved aside (mbcontrol.cache.set_aside) and rebuilt,
+with a warning. Build folders left by a killed
 compile are removed once they are an hour old (a concurrent compile's are younger). Concurrent
 compiles of one function are safe: each builds in its own folder and renames into place; and
 where fcntl exists a per-library lock makes the second process wait for the first's library
@@ -27,8 +31,8 @@ from pathlib import Path
 
 import casadi as ca
 
-from ..atomic import write_text
-from ..cache import cache_dir, exclusive
+from ..atomic import guarded, write_text
+from ..cache import cache_dir, exclusive, reason_of, set_aside
 from ..console import status
 
 # -O3 for this CPU, and reassociation so that the radiation model's dense products vectorise;
@@ -42,6 +46,7 @@ FLAGS = ("-O3", "-march=native", "-fno-math-errno", "-fassociative-math", "-fno-
 # 60 s, stays optimised: -O0 made those 15x slower.)
 PLAIN_FLAGS = ("-O0", "-shared", "-fPIC")
 _warned = False
+_warned_cc = False
 
 
 def _cpu_tag() -> str:
@@ -73,8 +78,9 @@ def _digest(path: Path) -> str:
 
 
 def _verified(library: Path) -> bool:
-    """True if the library matches its recorded size and hash; a damaged or unrecorded one is
-    removed (with a warning when it was damaged) so that it is rebuilt."""
+    """True if the library matches its recorded size and hash. A damaged one is moved aside
+    (mbcontrol.cache.set_aside: kept as .corrupt-*, with a warning) and an unrecorded one
+    removed, so that either is rebuilt."""
     record = library.with_suffix(".sha256")
     try:
         expected = record.read_text().strip()
@@ -84,8 +90,8 @@ def _verified(library: Path) -> bool:
     if expected is not None and found == expected:
         return True
     if expected is not None:
-        warnings.warn(f"compiled cache entry {library} is damaged (size and SHA-256 {found!r}, "
-                      f"recorded {expected!r}); rebuilding it", RuntimeWarning, stacklevel=3)
+        set_aside(library, f"size and SHA-256 {found!r}, recorded {expected!r}",
+                  what="compiled cache entry")
     library.unlink(missing_ok=True)
     record.unlink(missing_ok=True)
     return False
@@ -102,9 +108,17 @@ def _remove_stale_builds(folder: Path) -> None:
 
 
 def compiler() -> str | None:
-    """The C compiler to use ($CC, else gcc, else cc), or None."""
-    for name in (os.environ.get("CC"), "gcc", "cc"):
+    """The C compiler to use ($CC, else gcc, else cc), or None. A $CC that is not a command
+    here is said once, and gcc or cc used instead."""
+    global _warned_cc
+    wanted = os.environ.get("CC")
+    for name in (wanted, "gcc", "cc"):
         if name and shutil.which(name):
+            if wanted and name != wanted and not _warned_cc:
+                warnings.warn(f"CC={wanted!r} is not a command here; compiling with {name} "
+                              f"instead (unset CC, or set it to an installed C compiler)",
+                              RuntimeWarning, stacklevel=3)
+                _warned_cc = True
             return name
     return None
 
@@ -123,7 +137,8 @@ def compile_function(fun: ca.Function, enabled: bool = True, optimise: bool = Tr
             _warned = True
         return fun
     folder = cache_dir() / "compiled"
-    folder.mkdir(parents=True, exist_ok=True)
+    with guarded(folder, "creating"):
+        folder.mkdir(parents=True, exist_ok=True)
     generator = ca.CodeGenerator(f"{fun.name()}.c", {"with_header": False})
     generator.add(fun)
     source = generator.dump()
@@ -132,30 +147,30 @@ def compile_function(fun: ca.Function, enabled: bool = True, optimise: bool = Tr
                           + _cpu_tag()).encode())
     library = folder / f"{fun.name()}_{key.hexdigest()[:20]}.so"
     if library.exists() and _verified(library):
-        return ca.external(fun.name(), str(library))
+        return _load(fun, library, cc, flags)
     with exclusive(library):   # a second process needing this code waits and loads it
         if library.exists() and _verified(library):     # another process just built it
-            return ca.external(fun.name(), str(library))
-        return _build(fun, source, flags, cc, folder, library, label or fun.name())
+            return _load(fun, library, cc, flags)
+        return _build(fun, source, (cc, flags), folder, library, label or fun.name())
 
 
-def _build(fun, source, flags, cc, folder: Path, library: Path, label: str) -> ca.Function:
-    """Compile `source` into `library` (see compile_function); the interpreted `fun` on a
-    compiler error, with a warning."""
+def _build(fun, source, how, folder: Path, library: Path, label: str) -> ca.Function:
+    """Compile `source` into `library` with how = (compiler, flags) (see compile_function);
+    the interpreted `fun` when the compiler fails, with a warning. A full disk or a folder
+    that cannot be written is an EnvironmentProblem naming the folder."""
+    cc, flags = how
     _remove_stale_builds(folder)
     started = time.perf_counter()
     status(f"compiling {label} ({len(source) // 1000} kB of C): typically 2-60 s, cached "
            f"afterwards (each distinct structure compiles once)", __name__)
-    with tempfile.TemporaryDirectory(prefix="build-", dir=folder) as tmp:
+    with guarded(folder, "compiling into"), \
+            tempfile.TemporaryDirectory(prefix="build-", dir=folder) as tmp:
         c_file = Path(tmp) / f"{fun.name()}.c"
         c_file.write_text(source)
         built = Path(tmp) / "out.so"
-        result = subprocess.run([cc, *flags, str(c_file), "-o", str(built), "-lm"],
-                                capture_output=True, text=True)
-        if result.returncode != 0:
-            warnings.warn(f"C compilation failed ({result.stderr[:300]}); using "
-                          f"interpreted CasADi code", RuntimeWarning, stacklevel=3)
-            return fun
+        failure = _compile([cc, *flags, str(c_file), "-o", str(built), "-lm"], built)
+        if failure:
+            return _interpreted(fun, how, failure)
         seconds = time.perf_counter() - started
         status(f"compiled {label} in {seconds:.1f} s", __name__)
         with open(folder / "builds.log", "a") as log:     # what the cache cost, one line a build
@@ -164,7 +179,44 @@ def _build(fun, source, flags, cc, folder: Path, library: Path, label: str) -> c
         # the record first, then the library: a library is never there without its record
         write_text(library.with_suffix(".sha256"), _digest(built) + "\n")
         os.replace(built, library)        # atomic: readers never see half a library
-    return ca.external(fun.name(), str(library))
+    return _load(fun, library, cc, flags)
+
+
+def _compile(command: list, built: Path) -> str | None:
+    """Run the compiler; None if it made `built`, else what went wrong (one line)."""
+    try:
+        result = subprocess.run(command, capture_output=True, text=True)
+    except OSError as exc:                            # not executable, gone meanwhile
+        return f"{command[0]} could not be run: {exc.strerror or exc}"
+    if result.returncode != 0:
+        said = " ".join(result.stderr.split())[:300]
+        return f"{command[0]} exited with status {result.returncode}" + (f": {said}" if said else "")
+    if not built.is_file() or built.stat().st_size == 0:
+        return f"{command[0]} reported success but made no library"
+    return None
+
+
+def _load(fun, library: Path, cc: str, flags) -> ca.Function:
+    """The compiled Function in `library`; one the loader refuses (made by a broken compiler)
+    is moved aside and `fun` runs interpreted."""
+    try:
+        return ca.external(fun.name(), str(library))
+    except RuntimeError as exc:
+        set_aside(library, reason_of(exc), what="compiled cache entry", then="not using it")
+        library.with_suffix(".sha256").unlink(missing_ok=True)
+        return _interpreted(fun, (cc, flags), f"its library does not load: {reason_of(exc)}")
+
+
+_FAILED: set = set()        # (compiler, flags) that failed here: said once, not per function
+
+
+def _interpreted(fun, how, why: str) -> ca.Function:
+    if how not in _FAILED:
+        _FAILED.add(how)
+        warnings.warn(f"C compilation failed ({why}); using interpreted CasADi code (correct, "
+                      f"slower). To compile, set CC to a working C compiler (e.g. CC=gcc)",
+                      RuntimeWarning, stacklevel=4)
+    return fun
 
 
 _TAGS: dict = {}

@@ -349,13 +349,18 @@ def test_atomic_write_leaves_nothing_on_failure(tmp_path, monkeypatch):
     assert sorted(os.listdir(tmp_path)) == ["ok.nc"]
 
 
-def test_corrupt_cache_raises(tmp_path):
+def test_a_corrupt_cache_entry_is_set_aside_and_rebuilt(tmp_path):
+    """A damaged cache file is named, kept beside as .corrupt-*, and solved again (it used to
+    fail every later run)."""
+    from mbcontrol.cache import CacheWarning
     bodies = _barges(h=0.3, dofs=("Heave",))
     kw = dict(rho=RHO, g=G, depth=np.inf, omegas=[1.0], headings=(0.0,), lid=True)
     path = tmp_path / f"bem_{bem.cache_key(bodies, **kw)[:16]}.nc"
     path.write_bytes(b"not a netCDF file")
-    with pytest.raises(HydroError, match=str(path.name)):
-        compute(bodies, **kw, cache_dir=tmp_path, progress=False)
+    with pytest.warns(CacheWarning, match=f"{path.name} is damaged or unreadable"):
+        ds = compute(bodies, **kw, cache_dir=tmp_path, progress=False)
+    assert list(tmp_path.glob(path.name + ".corrupt-*"))
+    assert ds.attrs["cache_key"][:16] in path.name and np.all(np.isfinite(ds["added_mass"]))
 
 
 # ------------------------------------------------------------------ bad input

@@ -23,7 +23,7 @@ import xarray as xr
 
 from mbcontrol.errors import HydroError
 
-from ...cache import exclusive
+from ...cache import load_or_make
 
 from ...console import progress_bar
 from ..data import netcdf
@@ -288,17 +288,21 @@ def compute(bodies: list[BemBody], *, rho: float, g: float, depth: float, omegas
     if cache_dir is None:
         return _solve_bem(bodies, rho, g, depth, omegas, headings, lid, progress, n_jobs, key)
     path = Path(cache_dir) / f"bem_{key[:16]}.nc"
-    with exclusive(path):       # a second process asking for the same solve waits and loads it
-        if path.exists():
-            ds = netcdf.read_netcdf(path, required=REQUIRED_VARS)
-            if ds.attrs.get("cache_key") != key:
-                raise HydroError(f"{path}: cache_key attribute {ds.attrs.get('cache_key')!r} does "
-                                 f"not match the inputs ({key}); expected the dataset of these "
-                                 f"inputs — delete the file")
-            return ds
+
+    def read(path):
+        ds = netcdf.read_netcdf(path, required=REQUIRED_VARS)
+        if ds.attrs.get("cache_key") != key:
+            raise HydroError(f"cache_key attribute {ds.attrs.get('cache_key')!r} does not match "
+                             f"the inputs ({key}): another solve's dataset")
+        return ds
+
+    def solve(path):
         ds = _solve_bem(bodies, rho, g, depth, omegas, headings, lid, progress, n_jobs, key)
         netcdf.write_netcdf_atomic(ds, path)
-        return ds
+
+    # a second process asking for the same solve waits on the entry's lock and loads it; an
+    # unreadable or foreign entry is moved aside and solved again (mbcontrol.cache)
+    return load_or_make(path, read, solve, what="BEM cache entry")
 
 
 def _solve_bem(bodies, rho, g, depth, omegas, headings, lid, progress, n_jobs, key) -> xr.Dataset:

@@ -10,6 +10,7 @@ import xarray as xr
 
 from mbcontrol.errors import HydroError
 
+from ...cache import EntrySetAside, in_cache, reason_of, set_aside
 from ...results import DataFileError, read_dataset, write_dataset
 
 
@@ -24,16 +25,29 @@ def read_netcdf(path: str | Path, *, required: tuple[str, ...] = ()) -> xr.Datas
     """Read a file written by :func:`write_netcdf_atomic`, fully into memory.
 
     Raises HydroError naming the file if it cannot be opened or lacks a ``required`` variable.
+    A file of the cache folder (a converted [hydro] source, a BEM run) that cannot be read is
+    moved aside instead, with a warning, and `mbcontrol.cache.EntrySetAside` raised: the code
+    that made it makes it again (`mbcontrol.cache.rebuilt_once`).
     """
     path = Path(path)
     if not path.is_file():
         raise HydroError(f"{path}: no such file (expected a hydrodynamic netCDF dataset)")
+    seen = path.stat()         # what was read: a rebuild by another process is not set aside
     try:
         ds = read_dataset(path)
     except DataFileError as exc:
+        if in_cache(path):
+            _set_aside(path, reason_of(exc.__cause__ or exc), seen)
         raise HydroError(f"{exc}; expected a dataset written by mbcontrol.hydro — delete it to "
                          "recompute") from exc.__cause__
     missing = [v for v in required if v not in ds.variables]
+    if missing and in_cache(path):
+        _set_aside(path, f"missing variable(s) {missing}", seen)
     if missing:
         raise HydroError(f"{path}: missing variable(s) {missing}; expected a complete mbcontrol.hydro dataset")
     return ds
+
+
+def _set_aside(path: Path, reason: str, seen):
+    raise EntrySetAside(path, set_aside(path, reason, what="hydrodynamic cache entry", seen=seen),
+                        reason)

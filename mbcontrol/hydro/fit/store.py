@@ -17,7 +17,7 @@ import xarray as xr
 
 from ... import defaults
 from ...atomic import atomic_path
-from ...cache import cache_dir
+from ...cache import UNREADABLE, cache_dir, read_entry, reason_of
 from ...console import status
 from ...errors import HydroError
 from . import (array_fit, array_passivity, fit_error, group_fit, kernel, passive_order, passivity, radiation,
@@ -88,32 +88,39 @@ def cached_fit(data: xr.Dataset, dofs, tol, source: str, omega_max: float = np.i
 
 def _load_fit(name: str) -> RadiationModel | None:
     """The fit called ``name``, shipped (models/radiation_fits, made by generate_hydro.py) or
-    cached; None if neither has it (a stale or foreign cache file is removed)."""
+    cached; None if neither has it. An unreadable cache file (truncated, foreign) is moved
+    aside with a warning (mbcontrol.cache.read_entry) so that the fit is made again."""
     shipped = shipped_fits_dir() / name
     if shipped.exists():
-        with np.load(shipped, allow_pickle=False) as z:
-            return model_from_arrays(z)
-    path = cache_dir() / name
-    if path.exists():
         try:
-            with np.load(path, allow_pickle=False) as z:
-                return model_from_arrays(z)
-        except (OSError, ValueError, KeyError):
-            path.unlink(missing_ok=True)
-    return None
+            return _read_fit(shipped)
+        except (UNREADABLE + (HydroError,)) as exc:     # in the package: not ours to move
+            raise HydroError(f"{shipped}: shipped radiation fit unreadable ({reason_of(exc)}); "
+                             f"reinstall mbcontrol") from exc
+    return read_entry(cache_dir() / name, _read_fit, what="radiation fit cache entry")
+
+
+def _read_fit(path: Path, quiet: bool = False) -> RadiationModel:
+    with np.load(path, allow_pickle=False) as z:
+        return model_from_arrays(z, quiet=quiet)
 
 
 def _reused_fit(base: str, data, band, tol: float, device: Device) -> RadiationModel | None:
     """A fit of the same data, DOFs, tolerance and code, made for another device (a drivetrain or
     a spring changed, a DOF frozen), that meets ``tol`` in this one: it is as good a fit here as a
     new one, and takes milliseconds instead of a refit. Its report is this device's; the first
-    found that passes is used, shipped ones first."""
+    found that passes is used, shipped ones first (an unreadable cached one is moved aside)."""
     for folder in (shipped_fits_dir(), cache_dir()):
         for candidate in sorted(folder.glob(f"radiation_{base}_*.npz")):
-            try:
-                with np.load(candidate, allow_pickle=False) as z:
-                    model = model_from_arrays(z, quiet=True)
-            except (OSError, ValueError, KeyError):
+            if folder == cache_dir():
+                model = read_entry(candidate, lambda p: _read_fit(p, quiet=True),
+                                   what="radiation fit cache entry", then="not using it")
+            else:
+                try:
+                    model = _read_fit(candidate, quiet=True)
+                except UNREADABLE:
+                    model = None
+            if model is None:
                 continue
             worst = response_error.response_error_on(device, data, model, band)
             if worst["error"] <= tol:

@@ -95,12 +95,12 @@ def _parsed_csv(path: Path) -> tuple[list, np.ndarray]:
     import io
 
     from ...atomic import write_bytes
-    from ...cache import cache_dir
+    from ...cache import cache_dir, read_entry
     raw = path.read_bytes()
     cached = cache_dir() / "records" / f"csv_{hashlib.sha256(raw).hexdigest()[:24]}.npz"
-    if cached.exists():
-        with np.load(cached, allow_pickle=False) as stored:
-            return [str(h) for h in stored["header"]], stored["data"]
+    stored = read_entry(cached, _read_parsed, what="parsed-CSV cache entry")   # unreadable: aside
+    if stored is not None:
+        return stored
     opener = _OPENERS.get(path.suffix)
     # text mode either way: universal newlines, as open(path, "rt") gave
     with (opener(io.BytesIO(raw), "rt") if opener else io.TextIOWrapper(io.BytesIO(raw))) as fh:
@@ -111,6 +111,11 @@ def _parsed_csv(path: Path) -> tuple[list, np.ndarray]:
     cached.parent.mkdir(parents=True, exist_ok=True)
     write_bytes(cached, buffer.getvalue())
     return header, data
+
+
+def _read_parsed(cached: Path) -> tuple[list, np.ndarray]:
+    with np.load(cached, allow_pickle=False) as stored:
+        return [str(h) for h in stored["header"]], stored["data"]
 
 
 def read_netcdf(path, columns: dict | None = None, *, time: str = "time") -> Record:

@@ -12,7 +12,8 @@ import numpy as np
 import xarray as xr
 
 from ...atomic import write_text
-from ...errors import InputError
+from ...cache import read_entry
+from ...errors import EnvironmentProblem, InputError
 
 
 PROVENANCE_FILE = "provenance.json"
@@ -35,8 +36,18 @@ class CaseStore:
                 _check_inputs(Path(folder), inputs)
 
     def has(self, key: str) -> bool:
-        return key in self._memory or (self.folder is not None
-                                       and (self.folder / f"{key}.json").exists())
+        """Is the case's record here and readable? One that cannot be read (truncated,
+        damaged) is moved aside with a warning (mbcontrol.cache.read_entry): the case runs
+        again, the others are kept."""
+        if key in self._memory:
+            return True
+        if self.folder is None:
+            return False
+        record = read_entry(self.folder / f"{key}.json", _read_json,
+                            what="sweep case record", then="running the case again")
+        if record is not None:
+            self._memory[key] = record
+        return record is not None
 
     def write(self, key: str, record: dict) -> None:
         self._memory[key] = record
@@ -45,8 +56,9 @@ class CaseStore:
         _write_json(self.folder / f"{key}.json", record)
 
     def read(self, key: str) -> dict:
-        if key not in self._memory:
-            self._memory[key] = json.loads((self.folder / f"{key}.json").read_text())
+        if not self.has(key):
+            raise EnvironmentProblem(f"{self.folder / key}.json: the case's record is gone or "
+                                     f"unreadable since it was written; run the sweep again")
         return self._memory[key]
 
     def keys_on_disk(self) -> list[str]:
@@ -56,14 +68,13 @@ class CaseStore:
 def _check_inputs(folder: Path, inputs: dict) -> None:
     """Record the inputs in a new store; refuse a store made from other inputs."""
     path = folder / PROVENANCE_FILE
-    if not path.exists():
+    # unreadable: moved aside and written anew (the case keys hold the same hashes, so no
+    # other inputs' case can be taken for these)
+    stored = read_entry(path, _read_json, what="sweep store provenance",
+                        then="recording this sweep's inputs instead")
+    if stored is None:
         _write_json(path, inputs)
         return
-    try:
-        stored = json.loads(path.read_text())
-    except (OSError, ValueError) as exc:
-        raise InputError(f"{path}: unreadable store provenance ({exc}); expected the JSON "
-                         f"the sweep wrote") from None
     changed = [k for k in sorted(set(stored) | set(inputs)) if stored.get(k) != inputs.get(k)]
     if changed:
         detail = "; ".join(f"{k}: store {str(stored.get(k))[:16]}, now {str(inputs.get(k))[:16]}"
@@ -71,6 +82,10 @@ def _check_inputs(folder: Path, inputs: dict) -> None:
         raise InputError(f"{folder}: this store was made from other inputs ({detail}). Its "
                          f"cases are not this model's: use a new --store, or delete {folder} "
                          f"to recompute")
+
+
+def _read_json(path: Path):
+    return json.loads(path.read_text(encoding="utf-8"))
 
 
 def _write_json(path: Path, value) -> None:
