@@ -16,15 +16,23 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from .atomic import atomic_path
+from .errors import InputError
 from .lti import frequency_response
 from .results import record
 
 
 def save(fig, path) -> Path:
-    """Write a figure to a temporary file, then rename it into place."""
+    """Write a figure to a temporary file, then rename it into place; its format is the
+    suffix's (.png, .pdf, .svg, ...). An InputError names a path without one."""
     path = Path(path)
+    kind = path.suffix.lstrip(".").lower()
+    formats = fig.canvas.get_supported_filetypes()
+    if kind not in formats:
+        raise InputError(f"{path}: a figure's file name ends in the format to write, one of "
+                         f"{', '.join('.' + f for f in sorted(formats))}; got "
+                         f"{path.suffix or 'no suffix'}")
     with atomic_path(path, path.suffix) as tmp:
-        fig.savefig(tmp, dpi=120, bbox_inches="tight", format=path.suffix.lstrip(".") or None)
+        fig.savefig(tmp, dpi=120, bbox_inches="tight", format=kind)
     return path
 
 

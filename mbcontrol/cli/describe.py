@@ -147,9 +147,13 @@ def run_keys(args) -> int:
     from pathlib import Path
 
     from ..atomic import write_text
+    from ..errors import InputError
     from ..scene import scene_keys_in_readme, scene_keys_markdown
     if args.readme:
         path = Path(args.readme)
+        if not path.is_file():
+            raise InputError(f"--readme {path}: no such file; expected the README (or guide) "
+                             f"whose scene-keys section to rewrite")
         write_text(path, scene_keys_in_readme(path.read_text()))
         print(f"wrote the scene keys into {path}")
     else:
