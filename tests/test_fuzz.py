@@ -330,13 +330,17 @@ def _too_long(argv) -> bool:
 @settings(PROFILE, max_examples=150 * SCALE)
 @given(command_lines())
 # what the fuzzing found, kept: a figure path without a format (matplotlib's ValueError), a
-# --readme that is not there (FileNotFoundError), the cases
+# --readme that is not there (FileNotFoundError), a sea of 1e308 s, a period of 1e308 s
+# (OverflowError); and the cases
 @example(["linearize", "sphere", "--json", "--bode", "0"])
 @example(["keys", "--readme", "regular"])
 @example(["simulate", "sphere", "--wave", "regular", "--height", "2", "--period", "8",
           "--dt", "4", "--duration", "5"])
 @example(["simulate", "sphere", "--wave", "jonswap", "--hs", "1e6", "--tp", "8"])
 @example(["simulate", "sphere", "--duration", "1e9", "--dt", "0.01"])
+@example(["simulate", "sphere", "--wave", "jonswap", "--hs", "1", "--tp", "8", "--duration",
+          "1e308", "--dt", "0.1"])                     # numpy: maximum allowed size exceeded
+@example(["simulate", "sphere", "--wave", "regular", "--height", "1", "--period", "1e308"])
 def test_a_random_command_line_exits_with_a_documented_status(argv):
     from mbcontrol.cli import main
     if argv[0] == "simulate" and _too_long(argv):

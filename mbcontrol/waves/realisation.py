@@ -70,14 +70,19 @@ class Wave:
 # A wave steeper than this breaks (Michell 1893: H/L = 0.142 in deep water); no sea holds one,
 # and linear theory, which every model here builds on, holds only far below it.
 BREAKING_STEEPNESS = 1 / 7
+MAX_PERIOD_S = 1000.0       # ocean swell stays below 30 s; past 1000 s it is a tide, not a wave
+# A sea's components: 600 s of a Tp 8 s sea is 276, three hours 5,000; 1e5 is 60 hours, while
+# "--duration 1e308" would ask numpy for more than memory holds
+MAX_COMPONENTS = 100_000
 
 
 def check_steepness(height: float, period: float, what: str) -> None:
     """Refuse a wave (or a sea's Hs over its peak wavelength) steeper than BREAKING_STEEPNESS,
     measured against the deep-water wavelength g T^2 / (2 pi): in finite depth the wave is
     shorter and steeper still, so this refuses only what cannot exist anywhere."""
-    if not (math.isfinite(height) and math.isfinite(period)):
-        raise WaveError(f"{what}: expected finite numbers, got {height} m, {period} s")
+    if not (math.isfinite(height) and 0 < period <= MAX_PERIOD_S):
+        raise WaveError(f"{what}: expected a finite height and a period of at most "
+                        f"{MAX_PERIOD_S:g} s, got {height} m, {period} s")
     wavelength = 9.80665 * period ** 2 / (2 * math.pi)
     if height > BREAKING_STEEPNESS * wavelength:
         raise WaveError(f"{what}: {height:g} m over a {period:g} s period is steeper than a "
@@ -157,7 +162,12 @@ def irregular(hs: float, tp: float, *, gamma: float = 3.3, seed: int = 0,
     wp = 2 * np.pi / tp
     repeat = max(duration, 20 * tp)
     d_omega = 2 * np.pi / repeat
-    k = np.arange(math.ceil(kept[0] * wp / d_omega), math.floor(kept[1] * wp / d_omega) + 1)
+    first, last = math.ceil(kept[0] * wp / d_omega), math.floor(kept[1] * wp / d_omega)
+    if not math.isfinite(repeat) or last - first + 1 > MAX_COMPONENTS:
+        raise WaveError(f"{kind} sea: a repeat period of {repeat:g} s holds "
+                        f"{(kept[1] - kept[0]) * wp / d_omega:.3g} components, more than "
+                        f"{MAX_COMPONENTS}; expected a shorter --duration (or --repeat)")
+    k = np.arange(first, last + 1)
     omega = k * d_omega
     density = jonswap_spectrum(omega, hs, tp, gamma_used)
     if amplitudes not in ("deterministic", "random"):

@@ -28,3 +28,12 @@ def test_the_field_s_real_seas_are_far_inside_the_limit():
     # (Hs/Lp = 1/36); the README's tank sea 4 cm at 1.2 s (1/56)
     waves.irregular(6.13, 11.86, duration=100.0)
     waves.irregular(0.04, 1.2, duration=20.0)
+
+
+def test_a_sea_too_long_to_hold_or_a_period_past_waves_is_refused():
+    # --duration 1e308 asked numpy for 4.6e307 components; --period 1e308 overflowed
+    with pytest.raises(WaveError, match="holds 4.6.e\\+307 components, more than 100000"):
+        waves.irregular(1.0, 8.0, duration=1e308)
+    with pytest.raises(WaveError, match="a period of at most 1000 s"):
+        waves.regular(1.0, 1e308)
+    assert waves.irregular(1.0, 8.0, duration=3 * 3600.0).omega.size < 10_000   # 3 hours
