@@ -250,6 +250,10 @@ def _add_simulate(sub, controllers: str) -> None:
                    help="controller setting, repeatable (e.g. --set damping=2.0)")
     p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
                    help="plant parameter override, repeatable (e.g. hinge_pto__damping=3)")
+    p.add_argument("--initial", action="append", default=[], metavar="JOINT=VALUE",
+                   help="start with this joint coordinate set, repeatable: a free decay with\n"
+                        "--wave none (e.g. --initial heave=0.5 or --initial hinge='10 deg');\n"
+                        "along the joint's axis, SI or with a unit; NED: heave + is down")
     p.add_argument("--out", help="write the full result to this netCDF file (compressed)")
     p.add_argument("--out-float32", action="store_true",
                    help="--out in single precision (relative rounding 6e-8; about half the size)")

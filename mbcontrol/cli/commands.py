@@ -130,7 +130,7 @@ def _wave(args, plant, duration):
 
 def run_simulate(args) -> int:
     from ..analysis import summary
-    from ..sim import simulate
+    from ..sim import describe_initial, initial_state, simulate
     plant = _plant(args)
     duration = args.duration
     if args.wave != "none":
@@ -141,12 +141,14 @@ def run_simulate(args) -> int:
     wave = _wave(args, plant, args.repeat or duration)
     controller = _controller(args, wave)
     params = dict(_key_value(s, "--param") for s in args.param)
+    initial = dict(_key_value(s, "--initial", text=True) for s in args.initial)
     ds = simulate(plant, wave, duration=duration, dt=args.dt, controller=controller,
                   method=args.method, rtol=args.rtol, params=params or None,
-                  progress=not args.json)
+                  x0=initial_state(plant, initial) if initial else None, progress=not args.json)
     if args.window_from is not None:
         ds.attrs.update(_window(args.window_from, wave, duration))
     result = summary(ds, plant)             # checks the result; the verdict goes into ds.attrs
+    result["initial"] = describe_initial(plant, initial)
     if args.out:
         from ..results import save_dataset
         save_dataset(ds, args.out, precision="float32" if args.out_float32 else "float64",
@@ -360,6 +362,8 @@ def _key_value(item: str, flag: str, text: bool = False):
 def _print_summary(result: dict, plant) -> None:
     print(f"{result['model']}: {result['duration_s']:.4g} s simulated in "
           f"{result['wall_time_s']:.3g} s ({result['method']}, dt = {result['dt_s']} s)")
+    for name, start in result.get("initial", {}).items():
+        print(f"  from {name} = {start['value']:.4g} {start['unit']}, {start['direction']}")
     for body, values in result["bodies"].items():
         print(f"  {body}: heave amplitude {values['heave_amplitude_m']:.4g} m, pitch amplitude "
               f"{values['pitch_amplitude_rad']:.4g} rad")

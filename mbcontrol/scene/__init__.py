@@ -15,9 +15,11 @@ from .reference import in_readme as scene_keys_in_readme
 from .reference import markdown as scene_keys_markdown
 from .shapes import immersed_profile, immersed_volume, profile_problem
 from .template import evaluate as evaluate_expression
+from .units import UnitError, to_si
 
 __all__ = ["load_scene", "list_models", "catalogue_dir", "resolve", "parse_scene",
            "DOF_NAMES", "JOINT_TYPES", "Scene", "Water", "Geometry", "Body", "Joint", "Pto",
            "Friction", "Mooring", "EndStop", "Drag", "Drivetrain", "HydroSettings", "Obstacle",
            "immersed_profile", "immersed_volume", "profile_problem", "catenary_geometry",
-           "evaluate_expression", "scene_keys_markdown", "scene_keys_in_readme"]
+           "evaluate_expression", "scene_keys_markdown", "scene_keys_in_readme", "to_si",
+           "UnitError"]

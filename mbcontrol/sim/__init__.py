@@ -4,10 +4,11 @@
 `simulate` (the runner, energy audit, mooring report), `methods` (tableaux and the method
 registry), `integrators` (compiled stepping), `compiled` (the compiled-code cache), `batch`
 (many cases through one compiled function), `reference` (direct-convolution reference),
-`stability` (largest stable steps).
+`stability` (largest stable steps), `initial` (initial states of free decays).
 """
 from .batch import batch_states, simulate_batch
 from .compiled import compiler
+from .initial import describe_initial, initial_state
 from .integrators import outputs as plant_outputs
 from .integrators import prepare, rk4_step, wave_terms
 from .light import can_run as can_run_light
@@ -26,4 +27,4 @@ __all__ = ["simulate", "simulate_batch", "simulate_convolution", "energy_audit",
            "batch_states", "compiler", "plant_outputs", "prepare", "rk4_step", "wave_terms",
            "can_run_light", "simulate_arrays", "closed_loop_map", "sampled_verdict",
            "sensitivity_name", "sensitivity_plant", "Controller", "CONTROLLER_OPTIONAL", "period_of",
-           "uses_state", "estimation_report"]
+           "uses_state", "estimation_report", "initial_state", "describe_initial"]
