@@ -52,6 +52,14 @@ ENERGY_TOLERANCE = 0.05           # of the excitation's absolute work over the r
 ANGLE_MAX_RAD = math.radians(30.0)
 DRAFT_FACTOR = 1.0                # relative heave limit in mean drafts
 
+# [hydro] hydrostatics = "large_angle" in waves: said with every result it makes
+LARGE_ANGLE_IN_WAVES = (
+    "large-angle hydrostatics in waves pairs exact buoyancy (in calm water) with linear "
+    "Froude-Krylov forces (the incident pressure on the body at rest): not a consistent pair "
+    "once the motions are large, and in a published sphere case it moved the heave response "
+    "further from the nonlinear reference than the linear model did. It is right for free "
+    "decays (--wave none)")
+
 # every reason a result is INVALID ends with what to do about it, after REMEDY (the CLI prints
 # it on a line of its own; no ";" in a remedy: a sweep joins a case's reasons with "; ")
 REMEDY = ". Remedy: "
@@ -60,9 +68,10 @@ REMEDIES = {
              "`mbcontrol bench MODEL` shows each method's error",
     "energy": "a smaller time step (--dt) or another method (--method: `mbcontrol bench "
               "MODEL` compares them)",
-    "range": "a smaller sea, a stroke limit on the PTO (its stroke_max, or --set "
-             "stroke_max=...), large-angle hydrostatics ([hydro] hydrostatics = "
-             "\"large_angle\"), or --allow-invalid to see the number anyway",
+    "range": "a smaller sea, or a stroke limit on the PTO (its stroke_max, or --set "
+             "stroke_max=...), or --allow-invalid to see the number anyway. No model here "
+             "covers large motions in waves yet: large-angle hydrostatics alone (exact "
+             "buoyancy with linear Froude-Krylov forces) is not a consistent pair in waves",
 }
 
 
@@ -285,6 +294,9 @@ def assess(ds, plant, wave=None, *, mean_power_W: float | None = None) -> dict:
                             mean_power_W=power, energy=energy_record(plant, ds),
                             excursions=excursions(plant, ds, wave, mask))
     verdict["checks"]["window"] = _window_check(window)
+    if plant.scene.hydro.hydrostatics == "large_angle" and wave is not None and \
+            np.any(np.asarray(wave.amplitude) > 0):
+        verdict["warnings"].append(LARGE_ANGLE_IN_WAVES)
     if window["problem"] is not None:
         verdict["valid"] = False
         verdict["invalid_reasons"].append(_window_reason(window))

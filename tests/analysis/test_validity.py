@@ -178,6 +178,30 @@ def test_every_invalid_reason_says_what_to_do():
                                "relative_heave_share_beyond": 0.5}})
     reasons = verdict["invalid_reasons"]
     assert len(reasons) == 3 and not verdict["valid"]
-    for reason, remedy_word in zip(reasons, ("radiation_tol", "--method", "large_angle")):
+    for reason, remedy_word in zip(reasons, ("radiation_tol", "--method", "stroke_max")):
         what, remedy = split_remedy(reason)
         assert what and remedy and remedy_word in remedy and ";" not in remedy
+
+
+def test_large_angle_hydrostatics_in_waves_says_it_is_not_a_consistent_pair():
+    """Exact calm-water buoyancy with linear Froude-Krylov forces is inconsistent once motions
+    are large: every result in waves says so (a warning, and the INVALID remedy no longer
+    recommends it); a free decay, where it is right, does not."""
+    import tomllib
+
+    from mbcontrol.analysis.validity import LARGE_ANGLE_IN_WAVES, REMEDIES
+    from mbcontrol.scene import catalogue_dir, parse_scene
+    from mbcontrol.sim import initial_state
+    path = catalogue_dir() / "sphere.toml"
+    data = tomllib.loads(path.read_text())
+    data["hydro"].update(file=str(catalogue_dir() / "sphere_hydro.nc"), hydrostatics="large_angle")
+    data["body"][0]["geometry"] = {"type": "sphere", "radius": 5.0, "center": [0.0, 0.0, 0.0]}
+    data["body"][0]["mass"] = 1000.0 * 2 / 3 * np.pi * 5.0 ** 3     # floats at its centre
+    plant = build_plant(parse_scene(data, path))
+    wave = waves.regular(1.0, 8.0)
+    in_waves = assess(simulate(plant, wave, duration=100.0, dt=0.05), plant, wave)
+    assert LARGE_ANGLE_IN_WAVES in in_waves["warnings"]
+    decay = simulate(plant, None, duration=20.0, dt=0.05,
+                     x0=initial_state(plant, {"heave": 0.5}))
+    assert LARGE_ANGLE_IN_WAVES not in assess(decay, plant)["warnings"]
+    assert "large_angle" not in REMEDIES["range"]
