@@ -22,7 +22,7 @@ from ..waves import Wave, coefficient_series, excitation_series, interpolate_com
 from .data.netcdf import read_netcdf
 from .bem.solve import compute
 from .mesh.geometry import BemBody
-from .data.headings import axisymmetric_headings, excitation_over_headings, heading_matrix, headings_line
+from .data.headings import axisymmetric_headings, excitation_over_headings, heading_matrix, headings_remedy
 from .bem.isolated import compute_isolated
 from .bem.neighbours import compute_within
 from .fit.radiation import RadiationModel, coupled_groups
@@ -74,9 +74,8 @@ class HydroModel:
         i = int(np.argmin(np.abs(directions - direction)))
         if abs(directions[i] - direction) > 1e-6:
             raise HydroError(f"{self.source}: no excitation data for wave direction "
-                             f"{direction:.4g} rad; the data has {np.round(directions, 4)} "
-                             f"(to compute it, the scene's [hydro] table: "
-                             f"{headings_line([direction])})")
+                             f"{direction:.4g} rad; the data has {np.round(directions, 4)}: "
+                             f"{headings_remedy(self.source, directions, [direction])}")
         da = self.data["excitation_force"].isel(wave_direction=i)
         return da.sel(influenced_dof=list(self.dofs)).transpose("omega", "influenced_dof").values
 

@@ -43,7 +43,10 @@ def test_a_scene_reads_its_own_bem_file(tmp_path, name, source, caplog):
     shipped = read_netcdf(catalogue.hydro.file)
     for var in ("added_mass", "radiation_damping", "added_mass_inf", "excitation_force",
                 "hydrostatic_stiffness"):
-        xr.testing.assert_allclose(data[var], shipped[var], rtol=1e-12, atol=0)
+        # an axisymmetric scene (the sphere) serves every heading from the file's one
+        ours = data[var].sel(wave_direction=shipped.wave_direction) \
+            if "wave_direction" in data[var].dims else data[var]
+        xr.testing.assert_allclose(ours, shipped[var], rtol=1e-12, atol=0)
     assert record_notes(data) == record_notes(shipped)       # the same repairs, said the same way
     # converted once: the second scene reading the same file with the same bodies loads the cache
     caplog.clear()

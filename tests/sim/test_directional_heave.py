@@ -32,13 +32,13 @@ def test_bem_heave_excitation_of_a_body_of_revolution_ignores_the_heading():
 
 @pytest.fixture(scope="module")
 def sphere_all_headings(tmp_path_factory):
-    """The catalogue sphere declared `[hydro] axisymmetric = true`: its heading-0 WAMIT data
+    """The catalogue sphere, declared `[hydro] axisymmetric = true`: its heading-0 WAMIT data
     serve every direction (a body of revolution at the origin: the test above), the radiation
     data its own (so its shipped radiation fit serves)."""
     folder = tmp_path_factory.mktemp("sphere")
     text = (MODELS / "sphere.toml").read_text()
-    text = text.replace('file = "sphere_hydro.nc"',
-                        f'file = "{MODELS / "sphere_hydro.nc"}"\naxisymmetric = true')
+    assert "axisymmetric = true" in text
+    text = text.replace('file = "sphere_hydro.nc"', f'file = "{MODELS / "sphere_hydro.nc"}"')
     (folder / "sphere.toml").write_text(text)
     plant = build_plant(load_scene(folder / "sphere.toml"))
     assert np.allclose(plant.hydro.data["wave_direction"].values, HEADINGS)

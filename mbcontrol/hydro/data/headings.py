@@ -13,8 +13,9 @@ on the OSWEC (15 deg headings, cos-2s sigma 30 deg) straight lines put the expec
 below the periodic trapezoid over the data's headings, the spline within 0.1 %. Error grows
 with the plane wave's own phase k (x cos b + y sin b) over a step: the catalogue bodies sit
 near the n-frame origin; a body far from it needs k r db small. A direction outside the data's
-headings is refused, naming the source, its headings and the `[hydro] headings` line to add.
-"""
+headings is refused, naming the source, its headings and what gives data there
+(`headings_remedy`: the `[hydro] headings` line where Capytaine computes the data, another BEM
+run where a file supplies them, `[hydro] axisymmetric` where one heading can serve all)."""
 from __future__ import annotations
 
 import math
@@ -87,6 +88,28 @@ def headings_line(headings) -> str:
                                       for h in headings) + "]"
 
 
+def headings_remedy(source: str, have, wanted) -> str:
+    """What gives excitation data at the headings `wanted` (rad) when the data from `source`
+    hold only `have` (rad). `[hydro] headings` is read only when Capytaine computes the data
+    from the scene's geometry (module model: its source then starts "BEM"); a supplied file
+    (WAMIT, BEMIO, Capytaine, or the catalogue's converted .nc) holds the headings its own run
+    solved, so the remedy there is another run. With one heading, `[hydro] axisymmetric = true`
+    (axisymmetric_headings) serves every direction where the bodies allow it."""
+    line = headings_line(wanted)
+    if str(source).startswith(("BEM ", "BEM,")):
+        text = f"compute them: in the scene's [hydro] table, {line}"
+    else:
+        text = (f"the file holds the headings its BEM run solved, so these need another run: "
+                f"yours at these headings, given as [hydro] source (a WAMIT .out, BEMIO .h5 or "
+                f"Capytaine .nc file), or Capytaine's from the bodies' geometry ([hydro] omega "
+                f"and {line}, without [hydro] file and source)")
+    if np.size(have) == 1:
+        text = ("if every body is a body of revolution about the n-frame z axis moving in heave "
+                "only, its one heading serves every direction: [hydro] axisymmetric = true; "
+                "otherwise " + text)
+    return text + "; mbcontrol.hydro.headings_for_spread gives the headings a spread sea needs"
+
+
 def _layout(headings):
     """(h0, r, periodic): the first heading, the others' offsets from it in [0, 2 pi), sorted,
     and whether the data cover the circle (the gap across the wrap no wider than the widest
@@ -136,9 +159,8 @@ def heading_matrix(headings, direction, source: str) -> np.ndarray:
         raise HydroError(
             f"{source}: wave directions {worst.min():.4g}..{worst.max():.4g} deg "
             f"({int(bad.sum())} of {d.size} components) lie outside the excitation data's "
-            f"headings {np.round(shown, 2).tolist()} deg and cannot be interpolated; compute "
-            f"the headings the sea needs: in the scene's [hydro] table, "
-            f"{headings_line(covering_headings(d))} (or mbcontrol.hydro.headings_for_spread)")
+            f"headings {np.round(shown, 2).tolist()} deg and cannot be interpolated; "
+            f"{headings_remedy(source, headings, covering_headings(d))}")
     n = len(headings)
     basis = np.zeros((ext.size, n))
     basis[np.arange(ext.size), idx] = 1.0
