@@ -241,15 +241,25 @@ def large_angle_hydrostatics(scene: Scene, topo: Topology, q):
 
 
 def static_loads(scene: Scene, topo: Topology, q, buoyancy: dict):
-    """Constant loads at rest that linear hydrostatics leave out (ERRATA section 3, F0).
+    """Constant loads at rest that linear hydrostatics leave out (ERRATA section 3, F0), and
+    their potential (J, zero at rest).
 
     A hydro body whose weight m g differs from its buoyancy rho g V, or whose CoG is not above
-    its centre of buoyancy, carries a net static load: (m g - rho g V) down through its CoG
-    and, at rest, the couple of buoyancy about the CoG. They enter as constant n-frame loads
-    at the body, so their geometric stiffness (d2 z_c / dq2 terms) is exact.
+    its centre of buoyancy, carries a net static load: F0 = (m g - rho g V) down through its
+    CoG and, at rest, the couple C of buoyancy about the CoG (n axes). Their potential is
+    V = -F0 . (r_c(q) - r_c(0)) - C . phi(q), with phi the n-frame rotation vector of the body
+    from rest, and the load is -K^T dV/dq, conservative by construction (the energy audit
+    balances). F0 is a constant n-frame force at a body point, so its geometric stiffness
+    F0 d2z_c/dq2 is exact (ERRATA section 3). C does the work C . a theta about a fixed axis a,
+    as a constant couple does, so hinges to the ground and sliders see the same load as a
+    constant couple at every angle and the linear model is unchanged; only rotations about
+    changing axes differ from a constant couple, which is not conservative there (rotations do
+    not commute), by the antisymmetric part of its stiffness (|C| per rad), which no potential
+    holds.
     buoyancy: body -> (rho g V (N), centre of buoyancy at rest, n-frame, m).
     """
-    tree, tau = topo.tree, ca.SX.zeros(topo.tree.n_s)
+    tree, potential = topo.tree, ca.SX(0)
+    q_rest = ca.DM.zeros(tree.n_q)
     for body in scene.bodies:
         if not body.hydro or body.name not in buoyancy:
             continue
@@ -258,13 +268,32 @@ def static_loads(scene: Scene, topo: Topology, q, buoyancy: dict):
         net = body.mass * scene.water.g - lift
         arm = np.asarray(centre) - np.asarray(body.cog)
         couple = np.cross(arm, [0.0, 0.0, -lift])            # n axes, about the CoG
-        wrench_n = ca.vertcat(ca.DM([0.0, 0.0, net]), ca.DM(couple))
         if abs(net) < 1e-9 * max(lift, 1.0) and np.linalg.norm(couple) < 1e-9 * max(lift, 1.0):
             continue
-        R = tree.rotation(q, k)                             # body -> n
-        wrench_b = ca.vertcat(ca.mtimes(R.T, wrench_n[:3]), ca.mtimes(R.T, wrench_n[3:]))
-        tau += tree.generalized_force(q, k, wrench_b)
-    return tau
+        potential -= net * (tree.cog(q, k)[2] - tree.cog(q_rest, k)[2])
+        turned = ca.mtimes(tree.rotation(q, k), ca.DM(tree.rotation(q_rest, k)).T)
+        potential -= ca.dot(ca.DM(couple), rotation_vector(turned))
+    if potential.is_zero():
+        return ca.SX.zeros(tree.n_s), 0
+    return -ca.mtimes(tree.K(q).T, ca.gradient(potential, q)), potential
+
+
+# Below sin^2(theta) = 1e-4 (theta < 0.01 rad) theta / sin(theta) is its series in sin^2: the
+# first term left out, 35/1152 sin^8, is 3e-18; atan2 takes over above, where 1 / sin is well
+# conditioned (and the series' derivatives stay finite at rest, where atan2(s, c) / s has 0/0).
+_SERIES_BELOW = 1e-4
+
+
+def rotation_vector(R):
+    """The rotation vector theta a (rad, |theta| < pi) of a rotation matrix R = exp(theta S(a)):
+    theta / sin(theta) times the axial vector of (R - R^T) / 2, which is sin(theta) a."""
+    v = 0.5 * ca.vertcat(R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1])
+    cosine, sin2 = 0.5 * (R[0, 0] + R[1, 1] + R[2, 2] - 1.0), ca.dot(v, v)
+    series = 1.0 + sin2 / 6.0 + 3.0 * sin2**2 / 40.0 + 5.0 * sin2**3 / 112.0   # asin(s) / s
+    sine = ca.sqrt(ca.fmax(sin2, _SERIES_BELOW))
+    ratio = ca.if_else(ca.logic_and(sin2 < _SERIES_BELOW, cosine > 0), series,
+                       ca.atan2(sine, cosine) / sine)
+    return ratio * v
 
 
 def gravity_forces(scene: Scene, topo: Topology, q):

@@ -181,8 +181,10 @@ def _hydro_loads(hydro, radiation, scale, select, P, s, w, chi):
 
 
 def _body_loads(tau, scene, topo, hydro, q, s, u, params):
-    """tau plus hydrostatics, PTOs, friction, drag, moorings, end stops, gravity (in this order:
-    the compiled code stays the same); the potential (J), PTO signals, mooring tensions."""
+    """tau plus hydrostatics, PTOs, friction, drag, moorings, end stops, gravity, static loads
+    (in this order: the compiled code stays the same); the potential (J: hydrostatic with the
+    static loads' own, drivetrain springs, moorings, end stops, gravity), PTO signals, mooring
+    tensions."""
     if scene.hydro.hydrostatics == "large_angle":
         restoring, potential = loads.large_angle_hydrostatics(scene, topo, q)
     else:
@@ -201,7 +203,10 @@ def _body_loads(tau, scene, topo, hydro, q, s, u, params):
         tau += conservative[0]
         potential += conservative[1]
     if scene.hydro.hydrostatics == "linear":
-        tau += loads.static_loads(scene, topo, q, hydro.buoyancy(scene.water) if hydro else {})
+        tau_static, static_energy = loads.static_loads(scene, topo, q, hydro.buoyancy(scene.water)
+                                                       if hydro else {})
+        tau += tau_static
+        potential += static_energy
     return tau, potential, pto_signals, tensions
 
 

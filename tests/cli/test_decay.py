@@ -82,3 +82,13 @@ def test_an_angle_past_a_turn_is_refused(capsys):
     code = main(["-q", "simulate", "hinged_barge", "--wave", "none", "--initial", "hinge=4",
                  "--duration", "5"])
     assert code == 1 and "within +-pi rad" in capsys.readouterr().err
+
+
+def test_the_oswec_decays_from_the_command_line_with_its_audit_on(capsys):
+    """Its static loads had no potential: a 10 deg decay read -24.4 kJ against +97.6 kJ and
+    stopped as 'diverged' (tests/plant/test_static_load_energy.py checks the energy itself)."""
+    code = main(["-q", "simulate", "oswec", "--wave", "none", "--initial", "hinge=10 deg",
+                 "--duration", "30", "--dt", "0.02", "--json"])
+    out = json.loads(capsys.readouterr().out)
+    assert code == 0 and out["valid"]
+    assert out["initial"]["hinge"]["value"] == pytest.approx(math.radians(10))
