@@ -29,12 +29,6 @@ _BODY_KEYS = {"Surge": "surge_amplitude_m", "Sway": "sway_amplitude_m",
               "Pitch": "pitch_amplitude_rad", "Yaw": "yaw_amplitude_rad"}
 
 
-# A window holds at least "stats.min_periods" wave periods (a regular wave's period, a sea's
-# peak period; 10 by default): a regular wave's steady state is read over its last 10 periods,
-# and a sea's mean power over fewer peak periods than that scatters by tens of percent between
-# seeds.
-
-
 def analysis_window(ds) -> np.ndarray:
     """Boolean mask over time of the window the metrics use (see `statistics_window`)."""
     t = ds["time"].values
@@ -66,6 +60,9 @@ def statistics_window(ds) -> dict:
     run = run_info(ds)
     wave = record(ds.attrs, "wave", {})
     ramp, warm_up = float(wave.get("ramp_s", 0.0) or 0.0), float(run.warm_up_s or 0.0)
+    # periods a window holds at least (a regular wave's, a sea's peak period; 10 by default):
+    # a regular wave's steady state is read over its last 10 periods, and a sea's mean power
+    # over fewer peak periods than that scatters by tens of percent between seeds
     n_periods = int(defaults.get("stats.min_periods"))
     earliest = max(ramp, warm_up)
     period = _wave_period(wave)

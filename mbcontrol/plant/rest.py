@@ -156,6 +156,12 @@ def _say_once(message: str) -> None:
         status(message, __name__)
 
 
+def _buoyancy_source(scene) -> str:
+    if scene.hydro.hydrostatics == "large_angle":
+        return "the immersed volume of each body's geometry"
+    return "the hydro data's displaced volume"
+
+
 def _warn_left(scene, tree, residual):
     weight = sum(b.mass for b in scene.bodies) * scene.water.g
     floor = EQUILIBRIUM_TOL * max(1.0, max(b.mass for b in scene.bodies) * scene.water.g)
@@ -165,8 +171,8 @@ def _warn_left(scene, tree, residual):
     listing = ", ".join(f"{tree.coordinate_names[i]}: {residual[i]:.4g}" for i in worst)
     warnings.warn(f"{scene.path}: rest is not an equilibrium; static generalised loads "
                   f"{listing} (N or N m; the largest is {abs(residual[worst[0]]) / weight:.2%} "
-                  f"of the bodies' weight, {weight:.4g} N). Buoyancy (the hydro data's "
-                  f"displaced volume) and weight, or their centres, do not balance: a mesh "
+                  f"of the bodies' weight, {weight:.4g} N). Buoyancy ({_buoyancy_source(scene)}) "
+                  f"and weight, or their centres, do not balance: a mesh "
                   f"that lost volume, a mass or CoG that is not the floating one. Correct "
                   f"them, or give the PTO preload = \"balance\" (a constant PTO force that "
                   f"holds rest)", RuntimeWarning, stacklevel=4)
