@@ -157,6 +157,7 @@ def test_make_targets_files_and_modules_named_in_the_readme_exist():
     ["simulate", "hinged_barge", "--wave", "regular", "--height", "0.02", "--period", "1.0",
      "--json"],
     ["linearize", "hinged_barge", "--bode", "out/bode.png", "--json"],
+    ["simulate", "sphere", "--wave", "none", "--initial", "heave=0.5", "--duration", "40"],
     ["--help"],
     ["design", "sphere", "--controller", "reactive", "--wave", "jonswap", "--hs", "2", "--tp", "8"],
     ["sweep", "sphere", "--hs", "1", "2", "3", "--tp", "7", "9", "11", "--controller", "passive",
