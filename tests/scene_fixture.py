@@ -51,6 +51,23 @@ damping = 2.0
 """
 
 
+# a dry box on a free joint: no buoyancy, no restoring; it falls (tests/plant)
+TUMBLER = """
+name = "tumbler"
+[[body]]
+name = "box"
+mass = 1.0
+inertia = [0.1, 0.2, 0.3]
+cog = [0.0, 0.0, 0.0]
+hydro = false
+[[joint]]
+name = "float"
+type = "free"
+parent = "ground"
+child = "box"
+"""
+
+
 def variant(*edits: tuple[str, str], base: str = VALID) -> str:
     """VALID with each (old, new) applied; old must occur exactly once, so edits stay precise."""
     text = base

@@ -16,6 +16,7 @@ from mbcontrol.errors import SimulationError
 from mbcontrol.plant import build_plant
 from mbcontrol.scene import catalogue_dir, parse_scene
 from mbcontrol.sim import simulate
+from scene_fixture import TUMBLER
 
 G = 9.81
 PENDULUM = """
@@ -119,22 +120,6 @@ def test_free_dof_without_restoring_warns_naming_body_and_dof():
     with warnings.catch_warnings():
         warnings.simplefilter("error")             # the moored raft: no warning
         assert build_plant("hinged_raft").notes["free_dofs_without_restoring"] == []
-
-
-TUMBLER = """
-name = "tumbler"
-[[body]]
-name = "box"
-mass = 1.0
-inertia = [0.1, 0.2, 0.3]
-cog = [0.0, 0.0, 0.0]
-hydro = false
-[[joint]]
-name = "float"
-type = "free"
-parent = "ground"
-child = "box"
-"""
 
 
 @pytest.mark.filterwarnings("ignore:.*rest is not an equilibrium")   # it falls: no buoyancy

@@ -23,7 +23,7 @@ from mbcontrol.multibody import build_topology
 from mbcontrol.plant import build_plant, loads, mechanical_matrices
 from mbcontrol.scene import parse_scene
 from mbcontrol.sim import simulate
-from scene_fixture import VALID
+from scene_fixture import TUMBLER, VALID
 
 DEG10 = np.deg2rad(10.0)
 
@@ -185,22 +185,6 @@ def test_catalogue_static_loads_are_the_constant_wrench_to_first_order():
                 pose = rng.uniform(-0.5, 0.5, topo.tree.n_q)
                 now, then, _ = (np.asarray(v) for v in J(pose))
                 assert np.max(np.abs(now - then)) <= 1e-12 * scale, name
-
-
-TUMBLER = """
-name = "tumbler"
-[[body]]
-name = "box"
-mass = 1.0
-inertia = [0.1, 0.2, 0.3]
-cog = [0.0, 0.0, 0.0]
-hydro = false
-[[joint]]
-name = "float"
-type = "free"
-parent = "ground"
-child = "box"
-"""
 
 
 @pytest.mark.parametrize("text", [VALID, TUMBLER], ids=["hinges_y_then_z", "free_body"])
