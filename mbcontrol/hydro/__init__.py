@@ -39,6 +39,10 @@ from .data.headings import SECTOR_SIGMAS
 from .fit.response_error import Device, response_error_on
 from .fit.ssforms import state_blocks
 from .mesh.large_angle import buoyancy
+from .mesh.large_angle import potential as buoyancy_potential
+from .mesh.panels import Panels, body_panels, hydrostatic_pressure, pressure_wrench
+from .mesh.axisymmetric import AxisymmetricFK
+from .mesh.axisymmetric import from_geometry as axisymmetric_fk
 from .model import FITS_SERVED, obstacle_bodies, shipped_fits_dir
 from .source import converted_source
 
@@ -52,5 +56,7 @@ __all__ = [
     "heading_matrix", "axisymmetric_headings",
     "HydroModel", "load_hydro_model", "load_hydro_data", "fit_hydro_model", "fit_method", "geometry_dict",
     "compute_isolated", "SECTOR_SIGMAS", "Device", "response_error_on", "state_blocks", "buoyancy",
+    "buoyancy_potential", "Panels", "body_panels", "hydrostatic_pressure", "pressure_wrench",
+    "AxisymmetricFK", "axisymmetric_fk",
     "FITS_SERVED", "obstacle_bodies", "shipped_fits_dir", "converted_source",
 ]

@@ -73,7 +73,11 @@ def coefficient_offsets(wave: Wave, coeffs, n: int, dt: float, offsets) -> np.nd
         if sub is not None and wave.omega.size > 16 else None
     for j, c in enumerate(offsets):
         if period is not None:             # periodic in its length: longer records wrap
-            out[:, j] = period[(int(round(c * sub)) + sub * np.arange(n)) % period.shape[0]]
+            first = int(round(c * sub))
+            if first + sub * (n - 1) < period.shape[0]:     # a strided view: no index arrays
+                out[:, j] = period[first:first + sub * (n - 1) + 1:sub]
+            else:
+                out[:, j] = np.take(period, first + sub * np.arange(n), axis=0, mode="wrap")
         else:
             out[:, j] = _synthesise_uniform(wave, weights, n, dt, c * dt)
         t = (np.arange(n) + c) * dt
