@@ -34,6 +34,7 @@ ROOT = readme.ROOT
 TABLES = {
     "model": None,      # two tables share this header: resolved by line below
     "N barges": ("measured", "benchmarks/scaling.py"),
+    "case": ("reference", "which pressure model applies when (mbcontrol.plant.nonlinear)"),
     "sphere, H 2.5 m, T 9.67 s": ("measured", "notebooks/controllers_sphere.ipynb"),
     "QP path": ("measured", "benchmarks/mpc.py"),
     "sea (Hs m, Tp s, γ)": ("measured", "benchmarks/wecccomp.py"),
@@ -68,7 +69,8 @@ TABLES = {
 MODEL_TABLES = {"mbcontrol (method, dt, radiation tol)": ("measured", "benchmarks/speed.py"),
                 "C step median / p99 / max (us)": ("measured", "benchmarks/export_step.py"),
                 "components x nodes": ("measured", "benchmarks/stepping.py"),
-                "what it is": ("reference", "the catalogue (tests/test_catalogue.py builds each)")}
+                "what it is": ("reference", "the catalogue (tests/test_catalogue.py builds each)"),
+                "real-time factor": ("measured", "benchmarks/nonlinear_fk.py")}
 
 
 def _mbcontrol_commands():

@@ -58,7 +58,8 @@ LARGE_ANGLE_IN_WAVES = (
     "Froude-Krylov forces (the incident pressure on the body at rest): not a consistent pair "
     "once the motions are large, and in a published sphere case it moved the heave response "
     "further from the nonlinear reference than the linear model did. It is right for free "
-    "decays (--wave none)")
+    "decays (--wave none). The consistent pair: [hydro] hydrostatics = \"nonlinear\" and "
+    "froude_krylov = \"nonlinear\"")
 
 # every reason a result is INVALID ends with what to do about it, after REMEDY (the CLI prints
 # it on a line of its own; no ";" in a remedy: a sweep joins a case's reasons with "; ")
@@ -68,10 +69,11 @@ REMEDIES = {
              "`mbcontrol bench MODEL` shows each method's error",
     "energy": "a smaller time step (--dt) or another method (--method: `mbcontrol bench "
               "MODEL` compares them)",
-    "range": "a smaller sea, or a stroke limit on the PTO (its stroke_max, or --set "
-             "stroke_max=...), or --allow-invalid to see the number anyway. No model here "
-             "covers large motions in waves yet: large-angle hydrostatics alone (exact "
-             "buoyancy with linear Froude-Krylov forces) is not a consistent pair in waves",
+    "range": "the model that covers large motions: [hydro] hydrostatics = \"nonlinear\" and "
+             "froude_krylov = \"nonlinear\" in the scene (the incident pressure over the "
+             "instantaneous wetted surface: mbcontrol.plant.nonlinear), or a smaller sea, or a "
+             "stroke limit on the PTO (its stroke_max, or --set stroke_max=...), or "
+             "--allow-invalid to see the number anyway",
 }
 
 
@@ -155,6 +157,7 @@ def assess_values(plant, wave, params, *, window, mean_power_W: float, energy=No
                 f"{exc:.4g} J of work and the device gained {gained:.4g} J"
                 f"{REMEDY}{REMEDIES['energy']}")
     warnings = []
+    nonlinear = plant.scene.hydro.froude_krylov == "nonlinear"
     for body, e in (excursions or {}).items():
         limits = (("relative heave", "relative_heave", e.get("relative_heave_limit_m"), "m", 1.0),
                   ("roll", "roll", ANGLE_MAX_RAD, "deg", 180 / math.pi),
@@ -164,7 +167,13 @@ def assess_values(plant, wave, params, *, window, mean_power_W: float, energy=No
                 continue
             limit = DRAFT_FACTOR * limit if key == "relative_heave" else limit
             where = "beyond its mean draft" if key == "relative_heave" else "beyond"
-            if e[f"{key}_significant"] > limit:
+            if e[f"{key}_significant"] > limit and nonlinear:
+                warnings.append(
+                    f"body {body!r}: significant {what} {e[f'{key}_significant'] * scale:.3g} "
+                    f"{unit}, {where} ({limit * scale:.3g} {unit}): hydrostatics and "
+                    f"Froude-Krylov forces are nonlinear here, radiation and diffraction "
+                    f"linear (approximate at such motions)")
+            elif e[f"{key}_significant"] > limit:
                 reasons.append(
                     f"body {body!r}: significant {what} {e[f'{key}_significant'] * scale:.3g} "
                     f"{unit}, {where} ({limit * scale:.3g} {unit}): linear hydrodynamics do "

@@ -9,7 +9,10 @@ model, exactly what `build_plant(scene)` returns):
   the excitation, diffraction by the neighbours included, is kept;
 - freeze: DOFs of free (or composite) joints removed, e.g. sway, roll and yaw in head seas;
 - kinematics="linear": the exact linearisation about rest, with the quadratic energy-audit
-  outputs kept to second order so the audit still closes.
+  outputs kept to second order so the audit still closes;
+- pressure="linear": linear hydrostatics and Froude-Krylov forces where the scene asks for
+  nonlinear ones ([hydro] hydrostatics = froude_krylov = "nonlinear"), so `auto` measures
+  what the nonlinear pressure changes in the user's waves.
 
 `plant_for(scene, fidelity, waves=...)` builds the plant of one choice; `auto(scene, waves, tol)`
 simulates the full model and simplified candidates in the user's waves, and picks the cheapest
@@ -44,13 +47,18 @@ class Fidelity:
         prismatic joints to block (as a test rig does), or "auto" (free-joint DOFs the waves
         cannot excite; needs waves, see `freeze_report`).
     kinematics : "exact" (the nonlinear plant) or "linear" (its linearisation about rest).
+    pressure : "scene" (hydrostatics and Froude-Krylov forces as the scene says) or "linear".
     """
     radiation_tol: float | None = None
     couplings: str = "keep"
     freeze: tuple[str, ...] | str = ()
     kinematics: str = "exact"
+    pressure: str = "scene"
 
     def __post_init__(self):
+        if self.pressure not in ("scene", "linear"):
+            raise FidelityError(f"Fidelity.pressure: expected 'scene' or 'linear', got "
+                                f"{self.pressure!r}")
         if self.radiation_tol is not None and not (np.isfinite(self.radiation_tol)
                                                    and 0 < self.radiation_tol < 1):
             raise FidelityError(f"Fidelity.radiation_tol: expected None or a number in (0, 1), "
@@ -91,6 +99,8 @@ class Fidelity:
                                       else "(" + ", ".join(self.freeze) + ")"))
         if self.kinematics != "exact":
             parts.append(f"kinematics={self.kinematics}")
+        if self.pressure != "scene":
+            parts.append(f"pressure={self.pressure}")
         return ", ".join(parts) or "full"
 
     def as_dict(self) -> dict:
@@ -100,6 +110,14 @@ class Fidelity:
 
 
 # ----------------------------------------------------------------------------- plant_for
+
+def linear_pressure_scene(scene: Scene) -> Scene:
+    """The scene with linear hydrostatics and Froude-Krylov forces (the hydro data's)."""
+    if scene.hydro.hydrostatics == "linear":
+        return scene
+    return dataclasses.replace(scene, hydro=dataclasses.replace(
+        scene.hydro, hydrostatics="linear", froude_krylov="linear"))
+
 
 def plant_for(scene: Scene | str, fidelity: Fidelity | None = None, *, waves=None,
               hydro: HydroModel | None = None, reference: ProcessPlant | None = None,
@@ -125,6 +143,8 @@ def plant_for(scene: Scene | str, fidelity: Fidelity | None = None, *, waves=Non
         notes["freeze"] = freeze_report(reference, wave_list, freeze_threshold)
         fidelity = dataclasses.replace(fidelity, freeze=tuple(
             d for d, row in notes["freeze"].items() if row["frozen"]))
+    if fidelity.pressure == "linear":
+        scene = linear_pressure_scene(scene)
     frozen = frozen_scene(scene, fidelity.freeze)
     if fidelity.couplings == "keep" and not fidelity.freeze and hydro is None:
         plant = assemble_plant(scene, radiation_tol=fidelity.radiation_tol,

@@ -19,7 +19,7 @@ from ..errors import UnknownName
 from ..hydro import Device, HydroModel, RadiationModel, load_hydro_model
 from ..multibody import Topology, build_topology
 from ..scene import DOF_NAMES, Scene, load_scene
-from . import checks, loads
+from . import checks, loads, nonlinear
 from .mechanical import dof_selector, mechanical_matrices
 from .ownership import linear_params
 from .pieces import plant_parts
@@ -42,6 +42,9 @@ class ProcessPlant:
     h: ca.Function = field(repr=False)
     notes: dict = field(default_factory=dict)   # build-time findings (plant.checks.rest_checks)
     parts: dict | None = field(default=None, repr=False)    # f's pieces (module plant.pieces)
+    # nonlinear hydrostatics and Froude-Krylov bodies (module plant.nonlinear); their field
+    # rows follow the excitation in w
+    pressure: tuple = field(default=(), repr=False)
     # derived data and compiled code, freed with the plant (module plant.workspace)
     workspace: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
@@ -79,10 +82,28 @@ class ProcessPlant:
         return p
 
     def excitation(self, wave, t) -> np.ndarray:
-        """Excitation w(t) (len(t), n_w) of a wave on this plant's hydro DOFs."""
+        """Excitation w(t) (len(t), n_w) of a wave on this plant's hydro DOFs (and the wave
+        field's rows, with nonlinear Froude-Krylov forces)."""
         if self.hydro is None:
             return np.zeros((np.size(t), 0))
-        return self.hydro.excitation(wave, t)
+        if not self.wave_rows:
+            return self.hydro.excitation(wave, t)
+        from ..waves import coefficient_series
+        return coefficient_series(wave, self.wave_coefficients(wave), np.atleast_1d(t))
+
+    @property
+    def wave_rows(self) -> int:
+        """Rows of w that carry the incident field (nonlinear Froude-Krylov), after the
+        excitation's."""
+        return sum(b.n_rows for b in self.pressure)
+
+    def wave_coefficients(self, wave) -> np.ndarray:
+        """(n_components, n_w) complex rows of w per unit amplitude, exp(-i omega t): the BEM
+        excitation on the hydro DOFs, less the surface model's linear Froude-Krylov force when
+        that force is nonlinear (the plant computes it), then the wave field's rows."""
+        if self.wave_rows:
+            return nonlinear.wave_coefficients(self, wave)
+        return self.hydro.excitation_at(wave.omega, wave.direction)
 
 
 def assemble_plant(scene: Scene | str, hydro: HydroModel | None = None, *,
@@ -115,18 +136,22 @@ def assemble_plant(scene: Scene | str, hydro: HydroModel | None = None, *,
         hydro = hydro.restricted(hydro_dofs)
     n_w = len(hydro_dofs)
     n_r = hydro.radiation.A.shape[0] if hydro and radiation else 0
-    w, chi = ca.SX.sym("w", n_w), ca.SX.sym("chi", n_r)
+    pressure = nonlinear.pressure_bodies(scene, topo, hydro)
+    w = ca.SX.sym("w", n_w + sum(b.n_rows for b in pressure))
+    chi = ca.SX.sym("chi", n_r)
 
     params = loads.Parameters()
     P = tree.P(q)
     select = dof_selector(topo, hydro_dofs)                  # 6N -> hydro DOFs
     scale = _hydro_scales(params, hydro_dofs) if hydro and hydro_corrections else None
     added_mass, hydro_force, chi_dot, power, radiation_apart = _hydro_loads(
-        hydro, radiation, scale, select, P, s, w, chi)
+        hydro, radiation, scale, select, P, s, w[:n_w], chi)
     tau = -tree.bias(q, s, added_mass)
     if hydro_force is not None:
         tau += hydro_force
-    tau, potential, pto_signals, tensions = _body_loads(tau, scene, topo, hydro, q, s, u, params)
+    tau, potential, pto_signals, tensions, wave_power = _body_loads(
+        tau, scene, topo, hydro, (q, s, u, w[n_w:]), params, pressure)
+    power["excitation_power"] += wave_power
     extra, balance = preloads(scene, topo, (q, s, u, w, chi, tau), pto_signals, params,
                               hydro.buoyancy(scene.water) if hydro else {})
     tau += extra
@@ -145,13 +170,13 @@ def assemble_plant(scene: Scene | str, hydro: HydroModel | None = None, *,
     coords = list(tree.coordinate_names)
     states = coords + [f"{c}__vel" for c in coords] + [f"radiation_{i}" for i in range(n_r)]
     inputs = [f"u__{pto.name}" for pto in scene.ptos]
-    disturbances = [f"w__{d}" for d in hydro_dofs]
+    disturbances = [f"w__{d}" for d in hydro_dofs] + nonlinear.field_names(pressure)
     f = ca.Function("f", [x, u, w, p], [x_dot], ["x", "u", "w", "p"], ["xdot"])
     h = ca.Function("h", [x, u, w, p], [y], ["x", "u", "w", "p"], ["y"])
     return ProcessPlant(scene, topo, hydro, tuple(states), tuple(inputs), tuple(disturbances),
                         tuple(output_names), tuple(params.names), np.array(params.values),
                         f, h, notes, plant_parts([x, u, w, p], M, tau, x_dot[:tree.n_q], chi_dot,
-                                                 radiation_apart))
+                                                 radiation_apart), pressure)
 
 
 def _hydro_loads(hydro, radiation, scale, select, P, s, w, chi):
@@ -180,12 +205,17 @@ def _hydro_loads(hydro, radiation, scale, select, P, s, w, chi):
             {"radiated_power": ca.dot(nu_h, mu_h), "excitation_power": ca.dot(nu_h, w_h)}, apart)
 
 
-def _body_loads(tau, scene, topo, hydro, q, s, u, params):
+def _body_loads(tau, scene, topo, hydro, symbols, params, pressure):
     """tau plus hydrostatics, PTOs, friction, drag, moorings, end stops, gravity, static loads
     (in this order: the compiled code stays the same); the potential (J: hydrostatic with the
     static loads' own, drivetrain springs, moorings, end stops, gravity), PTO signals, mooring
-    tensions."""
-    if scene.hydro.hydrostatics == "large_angle":
+    tensions, and the power of the nonlinear incident pressure beyond calm water's (W)."""
+    q, s, u, rows = symbols
+    wave_power = 0
+    if scene.hydro.hydrostatics == "nonlinear":
+        restoring, potential, wave_power = nonlinear.pressure_loads(scene, topo, q, s, rows,
+                                                                    pressure)
+    elif scene.hydro.hydrostatics == "large_angle":
         restoring, potential = loads.large_angle_hydrostatics(scene, topo, q)
     else:
         restoring, potential = loads.restoring_forces(topo, q, hydro.stiffness_by_body() if hydro
@@ -207,7 +237,7 @@ def _body_loads(tau, scene, topo, hydro, q, s, u, params):
                                                        if hydro else {})
         tau += tau_static
         potential += static_energy
-    return tau, potential, pto_signals, tensions
+    return tau, potential, pto_signals, tensions, wave_power
 
 
 def _hydro_scales(params, dofs) -> dict:
@@ -310,7 +340,7 @@ def _coordinate_unit(plant, name: str) -> str:
 def _units(plant, signal: str) -> str:
     if signal in _ENERGY_UNITS:
         return _ENERGY_UNITS[signal]
-    if signal.startswith("radiation_"):
+    if signal.startswith("radiation_") or signal.startswith("w__field_"):
         return "internal"
     if signal.startswith("w__"):
         return _BODY_UNITS[signal.split("__")[-1]][1]

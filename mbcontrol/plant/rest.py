@@ -157,7 +157,7 @@ def _say_once(message: str) -> None:
 
 
 def _buoyancy_source(scene) -> str:
-    if scene.hydro.hydrostatics == "large_angle":
+    if scene.hydro.hydrostatics != "linear":
         return "the immersed volume of each body's geometry"
     return "the hydro data's displaced volume"
 

@@ -320,7 +320,7 @@ def check_topology(scene, top: Reader):
             if item.body not in bodies:
                 raise SceneError(f"{where}: {kind}[{i}].body: unknown body {shown(item.body)}")
     given = scene.hydro.file is not None or scene.hydro.source is not None
-    if not given or scene.hydro.hydrostatics == "large_angle":
+    if not given or scene.hydro.hydrostatics != "linear":
         for i, body in enumerate(scene.bodies):
             if body.hydro and body.geometry is None:
                 raise SceneError(f"{where}: body[{i}].geometry: body '{body.name}' takes "

@@ -248,7 +248,20 @@ class HydroSettings:
     source_options: dict = field(default_factory=dict)   # reader/cleaning options, see below
     interaction: bool = True                   # False: each body solved alone (hydro.bem.isolated)
     interaction_radius: float = math.inf       # m: couple bodies only within it (hydro.bem.neighbours)
-    hydrostatics: str = "linear"               # "linear" | "large_angle" (box, cylinder, sphere)
+    hydrostatics: str = "linear"               # "linear" | "nonlinear" (pressure over the
+                                               # instantaneous wetted surface) | "large_angle"
+                                               # (calm-water primitives, kept for old scenes)
+    froude_krylov: str = "linear"              # "linear" | "nonlinear" (incident pressure over
+                                               # the instantaneous wetted surface)
+    nonlinear_path: str = "auto"               # "auto" | "analytic" (bodies of revolution) |
+                                               # "panels" (any closed surface)
+    nonlinear_panel_size: float | None = None  # m: panel size of the nonlinear surface
+                                               # (None: the body's size / 12)
+    nonlinear_reach: float | None = None       # m: horizontal excursion the wave field covers
+                                               # (None: the body's half-width, at least 5 m)
+    nonlinear_direction: float = 0.0           # rad: the sea's direction the field is built for
+    nonlinear_omega_max: float | None = None   # rad/s: components above it stay linear (None:
+                                               # response_band's top, else 4 rad/s)
     axisymmetric: bool = False                 # bodies of revolution on the z axis, in heave:
                                                # one heading's excitation serves every direction
 

@@ -279,7 +279,9 @@ def _hydro(r: Reader, path: Path) -> HydroSettings:
         return HydroSettings()
     r.allow("file", "panel_size", "omega", "headings", "lid", "radiation_tol", "dofs",
             "source", "source_bodies", "source_options", "fit_omega_max", "response_band", "interaction",
-            "interaction_radius", "hydrostatics", "radiation_fit", "fit_judged_by", "axisymmetric")
+            "interaction_radius", "hydrostatics", "radiation_fit", "fit_judged_by", "axisymmetric",
+            "froude_krylov", "nonlinear_path", "nonlinear_panel_size", "nonlinear_reach",
+            "nonlinear_direction", "nonlinear_omega_max")
     band = r.finite_list("response_band", "frequency", default=()) or None
     if band is not None and not (len(band) == 2 and 0 <= band[0] < band[1]):
         r.fail("response_band", f"expected [low, high] in rad/s with 0 <= low < high, got {band}")
@@ -308,8 +310,28 @@ def _hydro(r: Reader, path: Path) -> HydroSettings:
         source_bodies=tuple(r.string_list("source_bodies", default=())),
         source_options=_source_options(r.table("source_options", required=False)),
         interaction=interaction, interaction_radius=radius,
-        hydrostatics=r.choice("hydrostatics", ("linear", "large_angle"), default="linear"),
-        axisymmetric=r.boolean("axisymmetric", default=False))
+        axisymmetric=r.boolean("axisymmetric", default=False), **_nonlinear(r))
+
+
+def _nonlinear(r: Reader) -> dict:
+    """[hydro] settings of the nonlinear hydrostatics and Froude-Krylov forces."""
+    out = {"hydrostatics": r.choice("hydrostatics", ("linear", "nonlinear", "large_angle"),
+                                    default="linear"),
+           "froude_krylov": r.choice("froude_krylov", ("linear", "nonlinear"), default="linear"),
+           "nonlinear_path": r.choice("nonlinear_path", ("auto", "analytic", "panels"),
+                                      default="auto"),
+           "nonlinear_panel_size": (r.positive("nonlinear_panel_size", "length")
+                                    if "nonlinear_panel_size" in r.data else None),
+           "nonlinear_reach": (r.positive("nonlinear_reach", "length")
+                               if "nonlinear_reach" in r.data else None),
+           "nonlinear_direction": r.finite("nonlinear_direction", "angle", default=0.0),
+           "nonlinear_omega_max": (r.positive("nonlinear_omega_max", "frequency")
+                                   if "nonlinear_omega_max" in r.data else None)}
+    if out["froude_krylov"] == "nonlinear" and out["hydrostatics"] != "nonlinear":
+        r.fail("froude_krylov", "expected hydrostatics = \"nonlinear\" with it: the incident "
+               "pressure and the buoyancy are one pressure over one wetted surface, and either "
+               "alone is inconsistent in waves (set both to \"nonlinear\")")
+    return out
 
 
 def _source_options(r: Reader) -> dict:

@@ -188,7 +188,18 @@ MEANING = {
     ("hydro", "fit_judged_by"): "\"response\": the radiation fit's order is set by the error it causes in "
                                 "the device's response; \"kernel\": by K(jω)'s own error",
     ("hydro", "response_band"): "[low, high]: limits where the fit's response error is judged",
-    ("hydro", "hydrostatics"): "`large_angle`: buoyancy of the immersed primitive at its pose",
+    ("hydro", "hydrostatics"): "`nonlinear`: the hydrostatic pressure over the instantaneous wetted "
+                               "surface (with `froude_krylov = \"nonlinear\"`: under the incident "
+                               "wave); `large_angle`: calm-water primitives only (older scenes)",
+    ("hydro", "froude_krylov"): "`nonlinear`: the incident-wave pressure (Wheeler-stretched) over the "
+                                "instantaneous wetted surface; needs hydrostatics = \"nonlinear\"",
+    ("hydro", "nonlinear_path"): "`analytic` (bodies of revolution, vertical axis), `panels` (any "
+                                 "closed surface) or `auto`",
+    ("hydro", "nonlinear_panel_size"): "panel size of the surface the nonlinear forces integrate over",
+    ("hydro", "nonlinear_reach"): "horizontal excursion from rest the incident field is expanded over",
+    ("hydro", "nonlinear_direction"): "the sea's direction the nonlinear field is built for",
+    ("hydro", "nonlinear_omega_max"): "wave components above it keep linear Froude-Krylov forces "
+                                      "(default: response_band's top, else 4 rad/s)",
     ("hydro", "axisymmetric"): "true: bodies of revolution on the z axis in heave; the data's "
                                "one heading serves every wave direction",
     ("hydro.omega", "min"): "first frequency",

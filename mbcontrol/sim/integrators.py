@@ -45,9 +45,16 @@ PLAIN_OUTPUTS_STATES = 200
 
 # --- one step -------------------------------------------------------------------------------
 
+def calls_f(plant) -> bool:
+    """Whether a step calls f rather than inlining it: a large plant, or one whose f holds a
+    panel surface (mbcontrol.plant.nonlinear: hundreds of points, each a series in the wave
+    field, would be copied into every stage)."""
+    return plant.nx > CALL_F_STATES or any(b.path == "panels" for b in plant.pressure)
+
+
 def _symbols(plant, n_nodes, n_theta: int = 0):
     nx, nu, nw, npar = plant.nx, len(plant.inputs), len(plant.disturbances), len(plant.p0)
-    sym = ca.MX.sym if nx > CALL_F_STATES else ca.SX.sym
+    sym = ca.MX.sym if calls_f(plant) else ca.SX.sym
     return (sym("x", nx), sym("u", nu), sym("W", nw, n_nodes), sym("p", npar + n_theta),
             sym("h"))
 
@@ -204,12 +211,14 @@ def prepare(plant, n: int, method_name: str = "rk4", law=None, compiled=True) ->
 
 def excitation_at_nodes(plant, wave, n: int, dt: float, nodes) -> np.ndarray:
     """Excitation (n, len(nodes), n_w) at t_i + c dt for every step i and node c."""
-    from ..errors import HydroError
+    from ..errors import HydroError, WaveError
     from ..waves import coefficient_offsets, excitation_at_offsets
     nw = len(plant.disturbances)
     if wave is None or nw == 0:
         return np.zeros((n, len(nodes), nw))
     try:
+        if plant.wave_rows:             # nonlinear Froude-Krylov: the field's rows too
+            return coefficient_offsets(wave, plant.wave_coefficients(wave), n, dt, nodes)
         if wave.directional:            # a spread sea: each component's own direction
             coeffs = plant.hydro.excitation_at(wave.omega, wave.direction)
             return coefficient_offsets(wave, coeffs, n, dt, nodes)
@@ -217,7 +226,7 @@ def excitation_at_nodes(plant, wave, n: int, dt: float, nodes) -> np.ndarray:
         coeffs = derived(plant, ("sim.excitation_coefficients", wave.direction),
                          lambda: plant.hydro.excitation_coefficients(wave.direction))
         return excitation_at_offsets(wave, plant.hydro.omega, coeffs, n, dt, nodes)
-    except HydroError:
+    except (HydroError, WaveError):
         raise
     except ValueError as exc:
         raise HydroError(f"{plant.hydro.source}: {exc}") from None
@@ -308,7 +317,8 @@ def _output_map(plant, compiled: bool, length: int) -> ca.Function:
     w, p_sym = ca.MX.sym("w", len(plant.disturbances), length), ca.MX.sym("p", len(plant.p0))
     y = plant.h.map(length)(x, u, w, ca.repmat(p_sym, 1, length))
     fun = ca.Function("outputs_chunk", [x, u, w, p_sym], [y])
-    return compile_function(fun, enabled=compiled, optimise=plant.nx <= PLAIN_OUTPUTS_STATES)
+    return compile_function(fun, enabled=compiled, optimise=plant.nx <= PLAIN_OUTPUTS_STATES
+                            and not calls_f(plant))
 
 
 def cvodes_integrator(plant, wave_terms, t_grid, rtol=1e-8, atol=1e-10,
@@ -337,6 +347,6 @@ def cvodes_integrator(plant, wave_terms, t_grid, rtol=1e-8, atol=1e-10,
 
 def wave_terms(plant, wave):
     """(omega, Fc, Fs, ramp) of the excitation: Re(a F e^{-i(wt+phi)}) = Fc cos wt + Fs sin wt."""
-    coeffs = plant.hydro.excitation_at(wave.omega, wave.direction)       # (m, nw)
+    coeffs = plant.wave_coefficients(wave)                                # (m, nw)
     c = (wave.amplitude * np.exp(-1j * wave.phase))[:, None] * coeffs
     return wave.omega, c.real.T, c.imag.T, wave.ramp_time

@@ -346,7 +346,9 @@ def _progress_bar(progress: bool, n: int):
 
 def _dataset(plant, t, X, U, W, Y, eta, *, wave, controller, method, dt, p, wall):
     data = {}
-    for names, values in ((plant.outputs, Y), (plant.inputs, U), (plant.disturbances, W)):
+    # the wave field's rows (nonlinear Froude-Krylov) are the plant's internals, not results
+    excitation = plant.disturbances[:len(plant.disturbances) - plant.wave_rows]
+    for names, values in ((plant.outputs, Y), (plant.inputs, U), (excitation, W)):
         data.update({name: ("time", values[:, i], {"units": plant.units(name)})
                      for i, name in enumerate(names)})
     data["eta"] = ("time", eta, {"units": "m", "long_name": "wave elevation at the origin, up"})

@@ -150,7 +150,7 @@ class FidelityReport:
 def auto(scene: Scene | str, waves, tol: float | None = None, *, duration: float | None = None,
          dt: float | None = None, signals=None, method: str = "rk4", params=None,
          radiation_tols=RADIATION_LADDER, options=("radiation_tol", "couplings", "freeze",
-                                                   "kinematics"),
+                                                   "kinematics", "pressure"),
          repeats: int = 3, progress: bool = False) -> FidelityReport:
     """The cheapest model of `scene` whose error in `waves` is at most `tol` (see module doc).
 
@@ -160,7 +160,8 @@ def auto(scene: Scene | str, waves, tol: float | None = None, *, duration: float
         to 3 times) until the full model's own step error, measured against dt/2, is below
         tol/10, so the errors are the models' and not the integrator's. radiation_tols : looser
         fit tolerances tried (those above the scene's; one giving an order already tried is
-        skipped). options : which simplifications to try. params : as simulate's.
+        skipped). options : which simplifications to try ("pressure": linear hydrostatics and
+        Froude-Krylov forces, when the scene's are nonlinear). params : as simulate's.
     Each option is tried alone, then the passing ones together (the loosest passing radiation
     tolerance); if that combination fails, passing options are added one at a time, cheapest
     first, keeping each that keeps the error within tol. Among the candidates within tol (the
@@ -175,10 +176,10 @@ def auto(scene: Scene | str, waves, tol: float | None = None, *, duration: float
         raise FidelityError("auto: waves: expected a Wave or a non-empty list of Waves")
     if not tol > 0:
         raise FidelityError(f"auto: tol: expected a positive error tolerance, got {tol!r}")
-    unknown = set(options) - {"radiation_tol", "couplings", "freeze", "kinematics"}
+    unknown = set(options) - {"radiation_tol", "couplings", "freeze", "kinematics", "pressure"}
     if unknown:
         raise FidelityError(f"auto: options: unknown {sorted(unknown)}; expected some of "
-                            f"radiation_tol, couplings, freeze, kinematics")
+                            f"radiation_tol, couplings, freeze, kinematics, pressure")
     periods = [_peak_period(w) for w in wave_list]
     t_start = max(w.ramp_time for w in wave_list)
     duration = t_start + 40 * max(periods) if duration is None else float(duration)
@@ -339,6 +340,8 @@ def _single_candidates(scene, full, options, radiation_tols):
         out.append(("freeze=auto", Fidelity(freeze="auto"), None))
     if "kinematics" in options:
         out.append(("kinematics=linear", Fidelity(kinematics="linear"), None))
+    if "pressure" in options and scene.hydro.hydrostatics != "linear" and full.hydro is not None:
+        out.append(("pressure=linear", Fidelity(pressure="linear"), None))
     return out
 
 

@@ -1,0 +1,109 @@
+"""Speed against accuracy of the nonlinear hydrostatics and Froude-Krylov paths (issue 56).
+
+The case of the issue's goals: the R = 5 m hemisphere in heave (tests/plant/sphere_nonlinear.toml),
+a 600 s JONSWAP sea (Hs 2.5 m, Tp 8 s) at dt 0.01 s, RK4; the PTO damper at 1e6 N s/m so the
+body moves apart from the wave. For each path and resolution: the wall time of `simulate`
+(compiled code ready: its first compile is reported apart), the real-time factor, and the
+heave error against a reference run: the panel path at the finest size given (the exact
+incident surface, no flat-waterline assumption). The linear plant (models/sphere.toml) is the
+baseline of both: how much the nonlinear pressure changes the answer, and what it costs.
+
+    python benchmarks/nonlinear_fk.py --out out/bench/nonlinear_fk [--sizes 3 2 1.4]
+
+Writes nonlinear_fk.json and nonlinear_fk.png (real-time factor against error).
+"""
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import time
+from pathlib import Path
+
+import numpy as np
+
+from mbcontrol import sim, waves
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+from mbcontrol.atomic import write_text
+from mbcontrol.plant import build_plant
+from mbcontrol.plotting import save
+from mbcontrol.scene import load_scene
+
+DURATION, DT, DAMPING = 600.0, 0.01, 1.0e6
+SCENE = Path(__file__).resolve().parents[1] / "tests" / "plant" / "sphere_nonlinear.toml"
+
+
+def _timed(plant, sea) -> tuple[np.ndarray, float, float]:
+    params = plant.params(pto__damping=DAMPING)
+    start = time.perf_counter()
+    sim.simulate(plant, sea, duration=20.0, dt=DT, params=params)        # compiles
+    compile_s = time.perf_counter() - start
+    best, ds = np.inf, None
+    for _ in range(3):
+        start = time.perf_counter()
+        ds = sim.simulate(plant, sea, duration=DURATION, dt=DT, params=params)
+        best = min(best, time.perf_counter() - start)
+    return ds["heave"].values, best, compile_s
+
+
+def run(sizes) -> dict:
+    sea = waves.irregular(2.5, 8.0, seed=1, duration=DURATION)
+    scene = load_scene(str(SCENE))
+    cases = [("linear", build_plant("sphere"), None),
+             ("analytic", build_plant(scene), None)]
+    for size in sizes:
+        hydro = dataclasses.replace(scene.hydro, nonlinear_path="panels",
+                                    nonlinear_panel_size=size)
+        plant = build_plant(dataclasses.replace(scene, hydro=hydro))
+        cases.append((f"panels {plant.pressure[0].model.n} points", plant, size))
+    rows = []
+    for label, plant, size in cases:
+        heave, wall, compile_s = _timed(plant, sea)
+        rows.append({"case": label, "panel_size_m": size, "wall_s": wall,
+                     "real_time_factor": DURATION / wall, "first_compile_s": compile_s,
+                     "field_rows": plant.wave_rows, "heave": heave})
+        print(f"{label:28s} {DURATION / wall:9.0f} x real time  (first run {compile_s:.1f} s)")
+    reference = rows[-1]["heave"]
+    scale = np.sqrt(np.mean(reference ** 2))
+    for row in rows:
+        row["heave_rms_error"] = float(np.sqrt(np.mean((row.pop("heave") - reference) ** 2))
+                                       / scale)
+    return {"case": "sphere_nonlinear, JONSWAP Hs 2.5 m Tp 8 s, 600 s, dt 0.01 s, rk4, "
+                    "PTO 1e6 N s/m", "reference": rows[-1]["case"], "rows": rows}
+
+
+def chart(result: dict, path: Path) -> None:
+    fig, ax = plt.subplots(figsize=(6.4, 4.2))
+    for row in result["rows"]:
+        if row["case"] == result["reference"]:
+            continue                     # its own error is zero: off a log scale
+        error = row["heave_rms_error"]
+        ax.loglog(row["real_time_factor"], error, "o")
+        ax.annotate(row["case"], (row["real_time_factor"], error), textcoords="offset points",
+                    xytext=(5, 4), fontsize=8)
+    ax.set_xlabel("real-time factor (600 s simulated / wall s)")
+    ax.set_ylabel(f"heave RMS error / RMS\nagainst {result['reference']}")
+    ax.set_title("Nonlinear hydrostatics + Froude-Krylov: speed against accuracy", fontsize=10)
+    ax.grid(True, which="both", alpha=0.3)
+    save(fig, path)
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--out", type=Path, default=Path("out/bench/nonlinear_fk"))
+    parser.add_argument("--sizes", type=float, nargs="+", default=[3.0, 2.0, 1.4],
+                        help="panel sizes (m); the last is the reference")
+    args = parser.parse_args(argv)
+    result = run(args.sizes)
+    args.out.mkdir(parents=True, exist_ok=True)
+    write_text(args.out / "nonlinear_fk.json", json.dumps(result, indent=2))
+    chart(result, args.out / "nonlinear_fk.png")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

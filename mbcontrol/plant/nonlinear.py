@@ -1,0 +1,285 @@
+"""Nonlinear hydrostatics and Froude-Krylov forces: the undisturbed incident pressure over each
+body's instantaneous wetted surface ([hydro] hydrostatics = froude_krylov = "nonlinear").
+
+The pressure is p = rho g z + p_dyn (Pa; NED, z down), p_dyn the linear incident-wave pressure
+taken to the instantaneous free surface by Wheeler stretching, so p vanishes on the incident
+surface and the wetted surface ends there. Radiation and diffraction stay linear: the
+disturbance w carries the BEM excitation minus the linear Froude-Krylov force of this same
+surface model, so for small waves the plant is the linear one (tests/plant/test_nonlinear_fk.py).
+
+Two paths (`[hydro] nonlinear_path`):
+  analytic  bodies of revolution with a vertical axis (mbcontrol.hydro.mesh.axisymmetric):
+            volume integrals in closed form, the local free surface flat across the body; a
+            sphere at any pose (its pressure forces pass through its centre), other bodies of
+            revolution only when they cannot rotate (their pressure moment is not modelled).
+  panels    any closed surface (mbcontrol.hydro.mesh.panels): the pressure at every panel
+            point, clipped at the instantaneous surface, compiled with the plant.
+  auto      analytic for a sphere, panels otherwise.
+
+The wave enters as rows of w (w__field_<body>_<i>): time series of Chebyshev coefficients of
+the incident field about the body's rest position (mbcontrol.waves.local_field), synthesised
+by the same FFT as the excitation, so the compiled step never sums wave components.
+Long-crested seas only, in the direction [hydro] nonlinear_direction.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+
+import casadi as ca
+import numpy as np
+
+from ..errors import HydroError, SceneError
+from ..hydro import axisymmetric_fk as axisymmetric_model
+from ..hydro import body_panels, geometry_dict, hydrostatic_pressure, pressure_wrench
+from ..hydro import buoyancy_potential as primitive_potential
+from ..waves import LocalField, wavenumber
+
+FIELD_TOL = 1e-3            # truncation of the field's series per unit amplitude (m of head)
+MAX_ORDER = 24              # Chebyshev terms per direction at most
+MIN_REACH_M = 5.0           # the field covers at least this horizontal excursion from rest
+FIXED_REACH_M = 1e-3        # ... and this little for a body whose CoG cannot move horizontally
+
+
+@dataclass(frozen=True, eq=False)
+class PressureBody:
+    """One body's nonlinear pressure model and its rows of w."""
+    body: str
+    path: str                       # "analytic" | "panels"
+    model: object                   # AxisymmetricFK (analytic) or Panels (panels)
+    field: LocalField | None        # panels in waves
+    n_rows: int                     # rows of w it reads (0: calm water)
+    cog: np.ndarray                 # CoG at rest, n-frame, m
+    centre: np.ndarray              # analytic: geometric centre at rest, n-frame, m
+    reach: float                    # m: horizontal excursion the field covers
+    omega_max: float = math.inf     # rad/s: components above it stay linear (zero rows)
+    linear_fk: np.ndarray | None = None   # (6, n_rows): wrench per row at rest (set after build)
+
+    def row_coefficients(self, omega) -> np.ndarray:
+        """(n_omega, n_rows) complex rows per unit amplitude, exp(-i omega t); zero above
+        omega_max, so those components' linear Froude-Krylov force is not removed either."""
+        omega = np.asarray(omega, float)
+        source = self.field if self.path == "panels" else self.model
+        rows = source.row_coefficients(omega)
+        rows[omega > self.omega_max * (1 + 1e-12)] = 0.0
+        return rows
+
+    def wrench(self, rows, R, r_cog, rho: float, g: float):
+        """(force, moment about the current CoG), n-frame axes, N and N m; CasADi SX."""
+        if self.path == "analytic":
+            centre = r_cog + ca.mtimes(R, ca.DM(self.centre - self.cog))
+            force, moment_c = self.model.wrench(rows, centre, rho, g)
+            return force, moment_c + ca.cross(centre - r_cog, force)
+        if self.field is None:
+            pressure = hydrostatic_pressure(rho, g)
+        else:
+            def pressure(x, y, z):
+                return self.field.pressure(rows, x, y, z, rho, g)
+        force, moment = pressure_wrench(self.model, R, r_cog, pressure)
+        return ca.vertcat(*[force[i] for i in range(3)]), ca.vertcat(*[moment[i] for i in range(3)])
+
+
+def pressure_bodies(scene, topo, hydro) -> tuple[PressureBody, ...]:
+    """The nonlinear pressure models of the scene's hydro bodies (empty for linear hydrostatics)."""
+    if scene.hydro.hydrostatics != "nonlinear":
+        return ()
+    waves = scene.hydro.froude_krylov == "nonlinear"
+    k_max = _k_max(scene)
+    out = []
+    for body in scene.bodies:
+        if not body.hydro:
+            continue
+        geometry = geometry_dict(body.geometry)
+        path = _path(scene, topo, body, geometry)
+        out.append(_build(scene, body, geometry, path, waves, k_max, _drifts(topo, body)))
+    return tuple(_with_linear_fk(b, scene.water) for b in out)
+
+
+DEFAULT_OMEGA_MAX = 4.0     # rad/s: without a response band, components above stay linear
+
+
+def omega_max(scene) -> float:
+    """rad/s: wave components above it keep linear Froude-Krylov forces (their field rows are
+    zero and their BEM excitation whole), so the series need not resolve short waves that
+    carry little of a sea's energy: [hydro] nonlinear_omega_max, else response_band's top."""
+    settings = scene.hydro
+    if settings.nonlinear_omega_max is not None:
+        return settings.nonlinear_omega_max
+    return settings.response_band[1] if settings.response_band else DEFAULT_OMEGA_MAX
+
+
+def _k_max(scene) -> float:
+    return float(wavenumber(omega_max(scene), scene.water.depth, scene.water.g))
+
+
+def _path(scene, topo, body, geometry) -> str:
+    chosen = scene.hydro.nonlinear_path
+    if chosen == "auto":
+        return "analytic" if geometry["type"] == "sphere" else "panels"
+    if chosen == "analytic" and geometry["type"] != "sphere":
+        tree, k = topo.tree, topo.body_index(body.name)
+        q = ca.SX.sym("q", tree.n_q)
+        if ca.depends_on(ca.vec(tree.rotation(q, k)), q):
+            raise SceneError(f"{scene.path}: [hydro] nonlinear_path = \"analytic\": body "
+                             f"'{body.name}' can rotate, and the analytic path models the "
+                             f"pressure moment of a sphere only; use nonlinear_path = \"panels\" "
+                             f"(or \"auto\")")
+    return chosen
+
+
+def _drifts(topo, body) -> bool:
+    """Whether the body's CoG can move horizontally (else the field needs no reach)."""
+    tree, k = topo.tree, topo.body_index(body.name)
+    q = ca.SX.sym("q", tree.n_q)
+    return bool(ca.depends_on(tree.cog(q, k)[:2], q))
+
+
+def _extent(points: np.ndarray) -> tuple[float, float]:
+    """(horizontal half-width, vertical extent) of body points about the CoG, m."""
+    return float(np.max(np.hypot(points[0], points[1]))), float(np.ptp(points[2]))
+
+
+def _build(scene, body, geometry, path, waves: bool, k_max: float, drifts: bool) -> PressureBody:
+    cog = np.asarray(body.cog, float)
+    settings = scene.hydro
+    panels = body_panels(geometry, cog, panel_size=settings.nonlinear_panel_size)
+    half, height = _extent(panels.points)
+    reach = settings.nonlinear_reach or (max(MIN_REACH_M, half) if drifts else FIXED_REACH_M)
+    direction = settings.nonlinear_direction
+    centre = np.asarray(geometry.get("center", cog), float)
+    if path == "analytic":
+        try:
+            model = axisymmetric_model(geometry, cog, direction, half_width=reach, k_max=k_max,
+                                       water_depth=scene.water.depth, g=scene.water.g)
+        except HydroError as exc:
+            raise SceneError(f"{scene.path}: [hydro] nonlinear_path: body '{body.name}': {exc}") \
+                from None
+        rows = model.n_rows if waves else 0
+        return PressureBody(body.name, path, model, None, rows, cog, centre, reach,
+                            omega_max(scene))
+    field = None
+    if waves:
+        depth_range = max(float(np.max(panels.points[2] + cog[2])), 0.0) + height + reach
+        field = _field(cog, direction, half + reach, depth_range, k_max, scene.water)
+    return PressureBody(body.name, path, panels, field, field.n_rows if field else 0, cog,
+                        centre, reach, omega_max(scene))
+
+
+def _field(cog, direction, half_width, depth_range, k_max, water) -> LocalField:
+    """The smallest Chebyshev orders whose truncation per unit amplitude stays below FIELD_TOL
+    at every wavenumber up to k_max."""
+    omega_max = math.sqrt(water.g * k_max * (math.tanh(k_max * water.depth)
+                                              if math.isfinite(water.depth) else 1.0))
+    omega = np.linspace(omega_max / 20, omega_max, 40)
+    m = n = 2
+    while True:
+        field = LocalField(float(cog[0]), float(cog[1]), float(direction), float(half_width),
+                           float(depth_range), m, n, water.depth, water.g)
+        error = field.truncation_error(omega)
+        if np.max(error) <= FIELD_TOL or (m >= MAX_ORDER and n >= MAX_ORDER):
+            return field
+        m, n = min(m + 2, MAX_ORDER), min(n + 1, MAX_ORDER)
+
+
+def _with_linear_fk(b: PressureBody, water) -> PressureBody:
+    """Attach the wrench per row at rest (force; moment about the CoG; n-frame = body axes):
+    the linear Froude-Krylov force of this surface model is linear_fk @ row coefficients."""
+    if b.n_rows == 0:
+        return b
+    rows = ca.SX.sym("rows", b.n_rows)
+    force, moment = b.wrench(rows, ca.DM.eye(3), ca.DM(b.cog), water.rho, water.g)
+    jac = ca.Function("j", [rows], [ca.jacobian(ca.vertcat(force, moment), rows)])
+    return dataclasses.replace(b, linear_fk=np.array(jac(np.zeros(b.n_rows))))
+
+
+def linear_froude_krylov(bodies, omega, dofs) -> np.ndarray:
+    """(n_omega, len(dofs)) complex linear Froude-Krylov force per unit amplitude of the
+    surface models on the hydro DOFs `dofs` ("<body>__<Dof>"), body axes at the CoG."""
+    from ..scene import DOF_NAMES
+    out = np.zeros((np.size(omega), len(dofs)), complex)
+    index = {d: i for i, d in enumerate(dofs)}
+    for b in bodies:
+        if b.n_rows == 0:
+            continue
+        per_dof = b.row_coefficients(omega) @ b.linear_fk.T          # (n_omega, 6)
+        for j, dof in enumerate(DOF_NAMES):
+            if f"{b.body}__{dof}" in index:
+                out[:, index[f"{b.body}__{dof}"]] = per_dof[:, j]
+    return out
+
+
+def pressure_loads(scene, topo, q, s, rows, bodies):
+    """(tau, potential, wave power): the generalised pressure and weight loads of the nonlinear
+    bodies; the calm-water potential relative to rest (J: hydrostatic and weight); the power
+    the incident wave's pressure does beyond calm water's (W), for the energy audit."""
+    tree, rho, g = topo.tree, scene.water.rho, scene.water.g
+    tau, tau_calm, energy = ca.SX.zeros(tree.n_s), ca.SX.zeros(tree.n_s), 0
+    start = 0
+    for b in bodies:
+        k = topo.body_index(b.body)
+        R, r_cog = tree.rotation(q, k), tree.cog(q, k)
+        body = scene.body(b.body)
+        weight = ca.DM([0.0, 0.0, body.mass * g])
+        mine = rows[start:start + b.n_rows] if b.n_rows else ca.DM.zeros(0)
+        start += b.n_rows
+        force, moment = b.wrench(mine, R, r_cog, rho, g)
+        tau += tree.generalized_force(q, k, ca.vertcat(R.T @ (force + weight), R.T @ moment))
+        if b.n_rows:
+            still, still_moment = b.wrench(ca.DM.zeros(b.n_rows), R, r_cog, rho, g)
+            tau_calm += tree.generalized_force(q, k, ca.vertcat(R.T @ (still + weight),
+                                                                R.T @ still_moment))
+        else:
+            tau_calm = tau_calm + tree.generalized_force(q, k, ca.vertcat(
+                R.T @ (force + weight), R.T @ moment))
+        energy += _calm_potential(b, body, R, r_cog, rho, g) - body.mass * g * (
+            r_cog[2] - b.cog[2])
+    return tau, energy, ca.dot(tau - tau_calm, s)
+
+
+def _calm_potential(b: PressureBody, body, R, r_cog, rho, g):
+    """rho g int_wet z dV (J) in calm water, relative to rest: exact for a sphere, else the
+    panel rule's rho g sum max(z, 0)^2 / 2 n_z (the wet volume closed by the plane z = 0,
+    where the integrand vanishes)."""
+    geometry = geometry_dict(body.geometry)
+    if geometry["type"] == "sphere":
+        now = primitive_potential(geometry, b.cog, R, r_cog, rho, g)
+        rest = primitive_potential(geometry, b.cog, np.eye(3), b.cog, rho, g)
+        return now - float(rest)
+    panels = b.model if b.path == "panels" else body_panels(geometry, b.cog)
+
+    def u(R_, r_):
+        z = r_[2] + ca.mtimes(R_[2, :], ca.DM(panels.points))
+        nz = ca.mtimes(R_[2, :], ca.DM(panels.normals))
+        return 0.5 * rho * g * ca.sum2(ca.fmax(z, 0) ** 2 * nz)
+    return u(R, r_cog) - float(ca.evalf(u(ca.DM.eye(3), ca.DM(b.cog))))
+
+
+def field_names(bodies) -> list[str]:
+    """Disturbance names of the field rows, in w's order after the excitation."""
+    return [f"w__field_{b.body}_{i}" for b in bodies for i in range(b.n_rows)]
+
+
+def check_wave(plant, wave) -> None:
+    """Refuse a sea the field was not built for: short-crested, or from another direction."""
+    from ..errors import WaveError
+    where = f"{plant.scene.path}: [hydro] froude_krylov = \"nonlinear\""
+    if wave.directional:
+        raise WaveError(f"{where}: the incident field is long-crested; a spread sea "
+                        f"(--spread) is not supported with nonlinear Froude-Krylov forces yet")
+    built = plant.scene.hydro.nonlinear_direction
+    if abs(math.remainder(float(wave.direction) - built, 2 * math.pi)) > 1e-9:
+        raise WaveError(f"{where}: the field is built for waves travelling to {built:.6g} rad "
+                        f"([hydro] nonlinear_direction); this sea travels to "
+                        f"{float(wave.direction):.6g} rad. Set nonlinear_direction to it")
+
+
+def wave_coefficients(plant, wave) -> np.ndarray:
+    """`ProcessPlant.wave_coefficients` with nonlinear Froude-Krylov forces: the BEM excitation
+    less the surface models' linear Froude-Krylov force, then the field's rows."""
+    check_wave(plant, wave)
+    coeffs = plant.hydro.excitation_at(wave.omega, wave.direction)
+    dofs = [d[len("w__"):] for d in plant.disturbances[:coeffs.shape[1]]]
+    coeffs = coeffs - linear_froude_krylov(plant.pressure, wave.omega, dofs)
+    return np.hstack([coeffs] + [b.row_coefficients(wave.omega) for b in plant.pressure
+                                 if b.n_rows])
