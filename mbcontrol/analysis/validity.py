@@ -309,6 +309,7 @@ def assess(ds, plant, wave=None, *, mean_power_W: float | None = None) -> dict:
     if window["problem"] is not None:
         verdict["valid"] = False
         verdict["invalid_reasons"].append(_window_reason(window))
+    _field_ranges(ds, verdict)
     loop = record(ds.attrs, "sampled_loop")
     if loop is not None and not loop["stable"]:       # sim.sampled, checked before the run
         verdict["valid"] = False
@@ -317,6 +318,21 @@ def assess(ds, plant, wave=None, *, mean_power_W: float | None = None) -> dict:
         verdict["checks"]["sampled_loop"] = loop
     mark(ds, verdict)
     return verdict
+
+
+def _field_ranges(ds, verdict: dict) -> None:
+    """Nonlinear Froude-Krylov bodies that left the box their incident field's series cover
+    (mbcontrol.plant.nonlinear.field_range above 1), where the series held their edge values."""
+    for name in (n for n in ds.data_vars if str(n).endswith("__field_range")):
+        used = float(np.max(ds[name].values))
+        verdict["checks"][name] = used
+        if used > 1.0:
+            body = str(name)[:-len("__field_range")]
+            verdict["valid"] = False
+            verdict["invalid_reasons"].append(
+                f"body {body!r} left the region its nonlinear incident field covers ({used:.3g} "
+                f"of it): the Froude-Krylov series held their edge values there{REMEDY}a larger "
+                f"[hydro] nonlinear_reach (the horizontal excursion and sinking the field covers)")
 
 
 def _window_check(window: dict) -> dict:

@@ -30,10 +30,11 @@ from dataclasses import dataclass
 import casadi as ca
 import numpy as np
 
-from ..errors import HydroError, SceneError
+from ..errors import HydroError, SceneError, WaveError
 from ..hydro import axisymmetric_fk as axisymmetric_model
 from ..hydro import body_panels, geometry_dict, hydrostatic_pressure, pressure_wrench
 from ..hydro import buoyancy_potential as primitive_potential
+from ..scene import DOF_NAMES
 from ..waves import LocalField, wavenumber
 
 FIELD_TOL = 1e-3            # truncation of the field's series per unit amplitude (m of head)
@@ -160,7 +161,10 @@ def _build(scene, body, geometry, path, waves: bool, k_max: float, drifts: bool)
                             omega_max(scene))
     field = None
     if waves:
-        depth_range = max(float(np.max(panels.points[2] + cog[2])), 0.0) + height + reach
+        # the deepest the stretched depth of a point gets: its depth at rest plus the body's
+        # height and reach, and never past the sea bed
+        depth_range = min(max(float(np.max(panels.points[2] + cog[2])), 0.0) + height + reach,
+                          scene.water.depth)
         field = _field(cog, direction, half + reach, depth_range, k_max, scene.water)
     return PressureBody(body.name, path, panels, field, field.n_rows if field else 0, cog,
                         centre, reach, omega_max(scene))
@@ -196,7 +200,6 @@ def _with_linear_fk(b: PressureBody, water) -> PressureBody:
 def linear_froude_krylov(bodies, omega, dofs) -> np.ndarray:
     """(n_omega, len(dofs)) complex linear Froude-Krylov force per unit amplitude of the
     surface models on the hydro DOFs `dofs` ("<body>__<Dof>"), body axes at the CoG."""
-    from ..scene import DOF_NAMES
     out = np.zeros((np.size(omega), len(dofs)), complex)
     index = {d: i for i, d in enumerate(dofs)}
     for b in bodies:
@@ -210,31 +213,50 @@ def linear_froude_krylov(bodies, omega, dofs) -> np.ndarray:
 
 
 def pressure_loads(scene, topo, q, s, rows, bodies):
-    """(tau, potential, wave power): the generalised pressure and weight loads of the nonlinear
-    bodies; the calm-water potential relative to rest (J: hydrostatic and weight); the power
-    the incident wave's pressure does beyond calm water's (W), for the energy audit."""
+    """(tau, potential, wave power, ranges): the generalised pressure and weight loads of the
+    nonlinear bodies; the calm-water potential relative to rest (J: hydrostatic and weight);
+    the power the incident wave's pressure does beyond calm water's (W), for the energy audit;
+    per body in waves, "<body>__field_range" (`field_range`: above 1 outside the field)."""
     tree, rho, g = topo.tree, scene.water.rho, scene.water.g
-    tau, tau_calm, energy = ca.SX.zeros(tree.n_s), ca.SX.zeros(tree.n_s), 0
+    tau, tau_wave, energy, ranges = ca.SX.zeros(tree.n_s), ca.SX.zeros(tree.n_s), 0, {}
     start = 0
     for b in bodies:
         k = topo.body_index(b.body)
         R, r_cog = tree.rotation(q, k), tree.cog(q, k)
         body = scene.body(b.body)
-        weight = ca.DM([0.0, 0.0, body.mass * g])
         mine = rows[start:start + b.n_rows] if b.n_rows else ca.DM.zeros(0)
         start += b.n_rows
         force, moment = b.wrench(mine, R, r_cog, rho, g)
-        tau += tree.generalized_force(q, k, ca.vertcat(R.T @ (force + weight), R.T @ moment))
-        if b.n_rows:
+        force += ca.DM([0.0, 0.0, body.mass * g])                # weight acts at the CoG
+        tau += tree.generalized_force(q, k, ca.vertcat(R.T @ force, R.T @ moment))
+        if b.n_rows:                 # the wave's part: what the pressure adds to calm water's
             still, still_moment = b.wrench(ca.DM.zeros(b.n_rows), R, r_cog, rho, g)
-            tau_calm += tree.generalized_force(q, k, ca.vertcat(R.T @ (still + weight),
-                                                                R.T @ still_moment))
-        else:
-            tau_calm = tau_calm + tree.generalized_force(q, k, ca.vertcat(
-                R.T @ (force + weight), R.T @ moment))
+            tau_wave += tree.generalized_force(q, k, ca.vertcat(
+                R.T @ (force - still), R.T @ (moment - still_moment)))
+            ranges[f"{b.body}__field_range"] = field_range(b, mine, R, r_cog)
         energy += _calm_potential(b, body, R, r_cog, rho, g) - body.mass * g * (
             r_cog[2] - b.cog[2])
-    return tau, energy, ca.dot(tau - tau_calm, s)
+    return tau, energy, ca.dot(tau_wave, s), ranges
+
+
+def field_range(b: PressureBody, rows, R, r_cog):
+    """How much of its incident field's box a body uses (dimensionless; above 1 it is outside
+    and the series hold their edge values): the CoG's horizontal offset along the sea over the
+    reach, and (panels) its sinking over the reach or (analytic) the centre's depth below the
+    local surface over the deepest the series cover."""
+    beta = b.field.direction if b.field is not None else b.model.direction
+    along = ca.DM([math.cos(beta), math.sin(beta)])
+    if b.path == "panels":
+        drift = ca.fabs(ca.dot(along, r_cog[:2] - ca.DM(b.cog[:2]))) / b.reach
+        return ca.fmax(drift, (r_cog[2] - b.cog[2]) / b.reach)
+    centre = r_cog + ca.mtimes(R, ca.DM(b.centre - b.cog))
+    xi = ca.dot(along, centre[:2] - ca.DM(b.centre[:2])) / b.model.half_width
+    previous, current, eta = 1, xi, rows[0]       # eta at the axis: Chebyshev rows in xi
+    for m in range(1, b.model.n_xi):
+        eta += rows[m] * current
+        previous, current = current, 2 * xi * current - previous
+    deepest = b.model.pieces[-1][1]
+    return ca.fmax(ca.fabs(xi), (centre[2] + eta) / deepest)
 
 
 def _calm_potential(b: PressureBody, body, R, r_cog, rho, g):
@@ -262,7 +284,6 @@ def field_names(bodies) -> list[str]:
 
 def check_wave(plant, wave) -> None:
     """Refuse a sea the field was not built for: short-crested, or from another direction."""
-    from ..errors import WaveError
     where = f"{plant.scene.path}: [hydro] froude_krylov = \"nonlinear\""
     if wave.directional:
         raise WaveError(f"{where}: the incident field is long-crested; a spread sea "

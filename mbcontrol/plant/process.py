@@ -149,7 +149,7 @@ def assemble_plant(scene: Scene | str, hydro: HydroModel | None = None, *,
     tau = -tree.bias(q, s, added_mass)
     if hydro_force is not None:
         tau += hydro_force
-    tau, potential, pto_signals, tensions, wave_power = _body_loads(
+    tau, potential, pto_signals, tensions, (wave_power, ranges) = _body_loads(
         tau, scene, topo, hydro, (q, s, u, w[n_w:]), params, pressure)
     power["excitation_power"] += wave_power
     extra, balance = preloads(scene, topo, (q, s, u, w, chi, tau), pto_signals, params,
@@ -164,7 +164,7 @@ def assemble_plant(scene: Scene | str, hydro: HydroModel | None = None, *,
     x_dot = ca.vertcat(ca.mtimes(tree.K(q), s), s_dot, chi_dot)
     kinetic = 0.5 * ca.mtimes([s.T, M, s])
     power["energy"] = kinetic + potential
-    y, output_names = _outputs(scene, topo, q, s, pto_signals, power, tensions, s_dot)
+    y, output_names = _outputs(scene, topo, q, s, pto_signals, power, tensions, s_dot, ranges)
     p = params.vector
 
     coords = list(tree.coordinate_names)
@@ -209,12 +209,12 @@ def _body_loads(tau, scene, topo, hydro, symbols, params, pressure):
     """tau plus hydrostatics, PTOs, friction, drag, moorings, end stops, gravity, static loads
     (in this order: the compiled code stays the same); the potential (J: hydrostatic with the
     static loads' own, drivetrain springs, moorings, end stops, gravity), PTO signals, mooring
-    tensions, and the power of the nonlinear incident pressure beyond calm water's (W)."""
+    tensions, and (the power of the nonlinear incident pressure beyond calm water's, W; the
+    bodies' field ranges, plant.nonlinear.field_range)."""
     q, s, u, rows = symbols
-    wave_power = 0
+    wave = (0, {})
     if scene.hydro.hydrostatics == "nonlinear":
-        restoring, potential, wave_power = nonlinear.pressure_loads(scene, topo, q, s, rows,
-                                                                    pressure)
+        restoring, potential, *wave = nonlinear.pressure_loads(scene, topo, q, s, rows, pressure)
     elif scene.hydro.hydrostatics == "large_angle":
         restoring, potential = loads.large_angle_hydrostatics(scene, topo, q)
     else:
@@ -237,7 +237,7 @@ def _body_loads(tau, scene, topo, hydro, symbols, params, pressure):
                                                        if hydro else {})
         tau += tau_static
         potential += static_energy
-    return tau, potential, pto_signals, tensions, wave_power
+    return tau, potential, pto_signals, tensions, wave
 
 
 def _hydro_scales(params, dofs) -> dict:
@@ -269,7 +269,7 @@ def active_hydro_dofs(scene: Scene, topo: Topology) -> list[str]:
     return dofs
 
 
-def _outputs(scene, topo: Topology, q, s, pto_signals, power, tensions, s_dot):
+def _outputs(scene, topo: Topology, q, s, pto_signals, power, tensions, s_dot, ranges):
     tree = topo.tree
     q_rest = ca.DM.zeros(tree.n_q)
     values, names = [q, s], list(tree.coordinate_names) + [f"{c}__vel" for c in
@@ -295,6 +295,8 @@ def _outputs(scene, topo: Topology, q, s, pto_signals, power, tensions, s_dot):
     for line, signals in tensions.items():
         values += list(signals)
         names += [f"{line}__tension", f"{line}__span", f"{line}__height"]
+    values += list(ranges.values())        # "<body>__field_range" (plant.nonlinear.field_range)
+    names += list(ranges)
     return ca.vertcat(*values), names
 
 
@@ -342,6 +344,8 @@ def _units(plant, signal: str) -> str:
         return _ENERGY_UNITS[signal]
     if signal.startswith("radiation_") or signal.startswith("w__field_"):
         return "internal"
+    if signal.endswith("__field_range"):
+        return "1"
     if signal.startswith("w__"):
         return _BODY_UNITS[signal.split("__")[-1]][1]
     base = signal[3:] if signal.startswith("u__") else signal

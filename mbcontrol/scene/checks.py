@@ -326,8 +326,9 @@ def check_topology(scene, top: Reader):
                 raise SceneError(f"{where}: body[{i}].geometry: body '{body.name}' takes "
                                  f"hydrodynamic loads but has no geometry, and the scene gives "
                                  f"no hydrodynamic data ([hydro] file, or source: your WAMIT "
-                                 f".out, BEMIO .h5 or Capytaine .nc) or asks for large-angle "
-                                 f"hydrostatics; give a geometry, or data, or set hydro = false")
+                                 f".out, BEMIO .h5 or Capytaine .nc) or asks for nonlinear "
+                                 f"(or large-angle) hydrostatics, which integrate over it; give "
+                                 f"a geometry, or data, or set hydro = false")
     return replace(scene, joints=tuple(joints))
 
 

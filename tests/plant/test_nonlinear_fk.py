@@ -130,3 +130,31 @@ def test_seas_the_field_was_not_built_for_are_refused(plants):
         "cos2s", 0.0, math.radians(30.0)))
     with pytest.raises(WaveError, match="long-crested"):
         sim.simulate(nonlinear, spread, duration=10, dt=0.01)
+
+
+def test_a_body_past_its_field_is_invalid(plants):
+    from mbcontrol.analysis import assess
+    nonlinear, _ = plants
+    sea = waves.regular(0.01 * 9.81 * 81, 9.0)
+    ds = sim.simulate(nonlinear, sea, duration=120, dt=0.01,
+                      params=nonlinear.params(pto__damping=PTO_DAMPING))
+    used = float(ds["sphere__field_range"].max())
+    assert 0.1 < used < 1.0                      # a heave-only sphere in a steep wave: inside
+    verdict = assess(ds, nonlinear, sea)
+    assert verdict["checks"]["sphere__field_range"] == pytest.approx(used)
+    assert not any("nonlinear incident field" in r for r in verdict["invalid_reasons"])
+    # the same record as if the sphere had gone 20 % past the deepest the series cover
+    ds["sphere__field_range"] = ds["sphere__field_range"] * (1.2 / used)
+    verdict = assess(ds, nonlinear, sea)
+    assert not verdict["valid"]
+    assert any("left the region its nonlinear incident field covers" in r and
+               "nonlinear_reach" in r for r in verdict["invalid_reasons"])
+
+
+def test_the_fidelity_search_can_take_the_pressure_linear():
+    from mbcontrol.plant import Fidelity, plant_for
+    linear = plant_for(SCENE, Fidelity(pressure="linear"))
+    assert linear.wave_rows == 0 and linear.scene.hydro.froude_krylov == "linear"
+    assert Fidelity(pressure="linear").label() == "pressure=linear"
+    a, b = (heave_rao(p, 0.02, 8.0) for p in (linear, build_plant("sphere")))
+    assert a == pytest.approx(b, rel=5e-4)       # the catalogue sphere but for its mass
