@@ -158,3 +158,13 @@ def test_the_fidelity_search_can_take_the_pressure_linear():
     assert Fidelity(pressure="linear").label() == "pressure=linear"
     a, b = (heave_rao(p, 0.02, 8.0) for p in (linear, build_plant("sphere")))
     assert a == pytest.approx(b, rel=5e-4)       # the catalogue sphere but for its mass
+
+
+def test_sweeps_do_not_take_linear_theory_for_the_scatter_of_a_nonlinear_plant(plants):
+    # the spectral estimate of a sea's power scatter is linear theory: with nonlinear pressure
+    # a sweep needs seeds for it (--seeds 2 or more), as for a nonlinear law
+    from mbcontrol.studies.sweep.spectral import law_gains
+    nonlinear, linear = plants
+    gains, why = law_gains(nonlinear, "passive", {"damping": 1e6})
+    assert gains is None and "hydrostatics" in why
+    assert law_gains(linear, "passive", {"damping": 1e6})[0] is not None

@@ -48,8 +48,8 @@ def statistical(weights, stderr_W, dof) -> dict:
     lacking = int(np.sum(~np.isfinite(s) & (w > 0)))
     if not known.any():
         return component("statistical", "A", "quadrature", absent=(
-            "no sea has an estimate of its mean power's scatter: a nonlinear law with one "
-            "seed (run --seeds 2 or more)"))
+            "no sea has an estimate of its mean power's scatter: a nonlinear law or plant "
+            "with one seed (run --seeds 2 or more)"))
     terms = MWH_PER_W * w[known] * s[known]
     u = float(np.sqrt(np.sum(terms ** 2)))
     finite = np.isfinite(nu[known])

@@ -23,6 +23,8 @@ def law_gains(plant, controller: str | None, settings: dict, params=None):
         return None, f"the {controller} law is not linear"
     if any(f.coulomb for f in plant.scene.frictions):
         return None, "the scene's Coulomb friction is not linear"
+    if plant.scene.hydro.hydrostatics != "linear":
+        return None, "the scene's hydrostatics (and Froude-Krylov forces) are not linear"
     params = dict(params or {})
     if controller is None:
         return {p.name: (params.get(f"{p.name}__damping", p.damping),
