@@ -10,7 +10,6 @@ roll grew). Writes mathieu_spar.nc and mathieu_spar.png.
 from __future__ import annotations
 
 import argparse
-import sys
 import time
 from pathlib import Path
 
@@ -18,15 +17,13 @@ import numpy as np
 import xarray as xr
 
 from mbcontrol.plant import Fidelity, build_plant, plant_for
-from mbcontrol.studies import plot_stability_maps, stability_map
+from mbcontrol.studies import natural_period, plot_stability_maps, stability_map
 
-ROOT = Path(__file__).resolve().parents[1]
-SCENE = str(ROOT / "tests" / "plant" / "spar_mathieu.toml")
-sys.path.insert(0, str(ROOT / "tests" / "studies"))
+SCENE = str(Path(__file__).resolve().parents[1] / "tests" / "plant" / "spar_mathieu.toml")
+ROLL = "float__Roll"
 
 
 def main(argv=None) -> int:
-    from test_parametric import ROLL, roll_period
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", type=Path, default=Path("out/bench/mathieu"))
     args = parser.parse_args(argv)
@@ -45,7 +42,7 @@ def main(argv=None) -> int:
     args.out.mkdir(parents=True, exist_ok=True)
     xr.Dataset({("nonlinear" if "nonlinear" in k else "linear"): v.drop_attrs()
                 for k, v in maps.items()}).to_netcdf(args.out / "mathieu_spar.nc")
-    plot_stability_maps(maps, args.out / "mathieu_spar.png", natural_period=roll_period(lti))
+    plot_stability_maps(maps, args.out / "mathieu_spar.png", natural_period=natural_period(lti, ROLL))
     return 0
 
 

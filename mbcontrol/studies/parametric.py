@@ -58,6 +58,17 @@ def stability_map(plant, coordinate: str, periods, heights, *, offset: float = 0
                                "model": plant.name, "failures": failures})
 
 
+def natural_period(plant, coordinate: str) -> float:
+    """The period (s) of the linearised plant's mode that moves `coordinate` the most: its
+    eigenvalue whose eigenvector has the largest share of that state (radiation included)."""
+    from ..analysis import linearize
+    values, vectors = np.linalg.eig(linearize(plant).A)
+    row = plant.states.index(coordinate)
+    oscillating = np.flatnonzero(values.imag > 1e-6)
+    mode = oscillating[np.argmax(np.abs(vectors[row, oscillating]))]
+    return float(2 * np.pi / abs(values[mode]))
+
+
 def plot_stability_maps(maps: dict, path=None, *, natural_period: float | None = None):
     """Side-by-side growth maps {label: stability_map(...)} on one colour scale (log10 of the
     growth; 0 is neutral), with T_n / 2 marked when the coordinate's natural period is given."""

@@ -8,9 +8,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from mbcontrol.analysis import linearize
 from mbcontrol.plant import Fidelity, build_plant, plant_for
-from mbcontrol.studies import stability_map
+from mbcontrol.studies import natural_period, stability_map
 
 SCENE = str(Path(__file__).parents[1] / "plant" / "spar_mathieu.toml")
 ROLL = "float__Roll"
@@ -21,20 +20,9 @@ def plants():
     return build_plant(SCENE), plant_for(SCENE, Fidelity(pressure="linear", kinematics="linear"))
 
 
-def roll_period(plant) -> float:
-    """The roll mode's period (s) of the linearised plant: its eigenvalue whose eigenvector
-    moves roll the most."""
-    sys = linearize(plant)
-    values, vectors = np.linalg.eig(sys.A)
-    row = plant.states.index(ROLL)
-    oscillating = np.flatnonzero(values.imag > 1e-6)
-    mode = oscillating[np.argmax(np.abs(vectors[row, oscillating]))]
-    return float(2 * np.pi / abs(values[mode]))
-
-
 def test_small_waves_excite_roll_only_at_half_its_period(plants):
     nonlinear, lti = plants
-    half = roll_period(lti) / 2                      # ~7.1 s
+    half = natural_period(lti, ROLL) / 2                      # ~7.1 s
     periods = np.round(np.array([half - 2.5, half - 0.5, half, half + 2.5]), 2)
     growth = stability_map(nonlinear, ROLL, periods, [0.1], duration=300.0)
     assert not growth.attrs["failures"]
