@@ -17,6 +17,7 @@ from .fidelity import Fidelity, FidelityError, has_couplings, plant_for
 from .freeze import as_wave_list
 from .jacobians import jacobians
 from .mechanical import MechanicalMatrices, dof_selector, mechanical_matrices
+from .nonlinear import with_nonlinear_pressure
 from .ownership import controlled_params, linear_params
 from .pieces import f_by_parts
 from .process import ProcessPlant, active_hydro_dofs, device_around, response_error_of
@@ -27,4 +28,4 @@ __all__ = ["build_plant", "ProcessPlant", "active_hydro_dofs", "dof_selector", "
            "Fidelity", "FidelityError", "plant_for", "CatenaryLine", "CatenarySolution",
            "catenary_line", "solve_catenary", "provenance", "MechanicalMatrices", "mechanical_matrices",
            "device_around", "linear_params", "controlled_params", "response_error_of",
-           "derived", "has_couplings", "as_wave_list", "f_by_parts"]
+           "derived", "has_couplings", "as_wave_list", "f_by_parts", "with_nonlinear_pressure"]

@@ -24,6 +24,7 @@ Long-crested seas only, in the direction [hydro] nonlinear_direction.
 from __future__ import annotations
 
 import dataclasses
+import hashlib
 import math
 from dataclasses import dataclass
 
@@ -32,11 +33,13 @@ import numpy as np
 
 from ..errors import HydroError, SceneError, WaveError
 from ..hydro import axisymmetric_fk as axisymmetric_model
-from ..hydro import body_panels, geometry_dict, hydrostatic_pressure, pressure_wrench
+from ..hydro import (body_panels, calm_water_function, geometry_dict, largest_function,
+                     pressure_wrench_function)
 from ..hydro import buoyancy_potential as primitive_potential
 from ..scene import DOF_NAMES
-from ..waves import LocalField, wavenumber
+from ..waves import LocalField, band_field, wavenumber
 
+WAVE_GRIDS_KEPT = 64        # frequency grids x directions whose rows a plant keeps
 FIELD_TOL = 1e-3            # truncation of the field's series per unit amplitude (m of head)
 MAX_ORDER = 24              # Chebyshev terms per direction at most
 MIN_REACH_M = 5.0           # the field covers at least this horizontal excursion from rest
@@ -56,6 +59,9 @@ class PressureBody:
     reach: float                    # m: horizontal excursion the field covers
     omega_max: float = math.inf     # rad/s: components above it stay linear (zero rows)
     linear_fk: np.ndarray | None = None   # (6, n_rows): wrench per row at rest (set after build)
+    surface: ca.Function | None = None    # panels in waves: (rows, R, r_cog) -> wrench
+    usage: ca.Function | None = None      # panels in waves: (rows, R, r_cog) -> field's box used
+    calm: ca.Function | None = None       # not a sphere: (R, r_cog) -> calm water's wrench, J
 
     def row_coefficients(self, omega) -> np.ndarray:
         """(n_omega, n_rows) complex rows per unit amplitude, exp(-i omega t); zero above
@@ -72,13 +78,24 @@ class PressureBody:
             centre = r_cog + ca.mtimes(R, ca.DM(self.centre - self.cog))
             force, moment_c = self.model.wrench(rows, centre, rho, g)
             return force, moment_c + ca.cross(centre - r_cog, force)
-        if self.field is None:
-            pressure = hydrostatic_pressure(rho, g)
-        else:
-            def pressure(x, y, z):
-                return self.field.pressure(rows, x, y, z, rho, g)
-        force, moment = pressure_wrench(self.model, R, r_cog, pressure)
-        return ca.vertcat(*[force[i] for i in range(3)]), ca.vertcat(*[moment[i] for i in range(3)])
+        if self.surface is None:                           # calm water
+            return tuple(self.calm.call([R, r_cog])[:2])
+        return tuple(self.surface.call([rows, R, r_cog]))   # the scene's rho and g
+
+
+def with_nonlinear_pressure(scene):
+    """The scene with [hydro] hydrostatics = froude_krylov = "nonlinear" (the model that covers
+    large motions); SceneError naming the body when a hydro body has no [body.geometry]."""
+    if scene.hydro is None:
+        raise SceneError(f"{scene.path}: the nonlinear pressure needs hydro bodies; this scene "
+                         f"has no [hydro] table")
+    bare = [b.name for b in scene.bodies if b.hydro and b.geometry is None]
+    if bare:
+        raise SceneError(f"{scene.path}: body '{bare[0]}': the nonlinear hydrostatics and "
+                         f"Froude-Krylov forces integrate over the body's surface; expected a "
+                         f"[body.geometry] table (a mesh file, a primitive or a profile)")
+    hydro = dataclasses.replace(scene.hydro, hydrostatics="nonlinear", froude_krylov="nonlinear")
+    return dataclasses.replace(scene, hydro=hydro)
 
 
 def pressure_bodies(scene, topo, hydro) -> tuple[PressureBody, ...]:
@@ -157,33 +174,55 @@ def _build(scene, body, geometry, path, waves: bool, k_max: float, drifts: bool)
             raise SceneError(f"{scene.path}: [hydro] nonlinear_path: body '{body.name}': {exc}") \
                 from None
         rows = model.n_rows if waves else 0
+        calm = None if geometry["type"] == "sphere" else _calm_function(body.name, panels,
+                                                                        scene.water)
         return PressureBody(body.name, path, model, None, rows, cog, centre, reach,
-                            omega_max(scene))
+                            omega_max(scene), calm=calm)
     field = None
     if waves:
         # the deepest the stretched depth of a point gets: its depth at rest plus the body's
         # height and reach, and never past the sea bed
         depth_range = min(max(float(np.max(panels.points[2] + cog[2])), 0.0) + height + reach,
                           scene.water.depth)
-        field = _field(cog, direction, half + reach, depth_range, k_max, scene.water)
+        # along the sea: the body's extent at rest plus the reach (its motion, rotation
+        # included); every point is checked against the box (LocalField.usage)
+        along = float(np.max(np.abs(np.array([math.cos(direction), math.sin(direction)])
+                                    @ panels.points[:2])))
+        field = _field(cog, direction, along + reach, depth_range, k_max, scene.water)
     return PressureBody(body.name, path, panels, field, field.n_rows if field else 0, cog,
-                        centre, reach, omega_max(scene))
+                        centre, reach, omega_max(scene),
+                        surface=_surface_function(body.name, panels, field, scene.water)
+                        if field else None,
+                        usage=_usage_function(body.name, panels, field) if field else None,
+                        calm=_calm_function(body.name, panels, scene.water))
+
+
+def _surface_function(name: str, panels, field: LocalField, water) -> ca.Function:
+    """The panel wrench in waves as one compiled call (mbcontrol.hydro.mesh.surface_sums)."""
+    def pressure_of(rows):
+        return lambda x, y, z: field.pressure(rows, x, y, z, water.rho, water.g)
+
+    return pressure_wrench_function(panels, pressure_of, field.n_rows, f"pressure_wrench_{name}")
+
+
+def _usage_function(name: str, panels, field: LocalField) -> ca.Function:
+    """The most of the field's box any panel point uses (`LocalField.usage`), for the outputs."""
+    return largest_function(panels, lambda rows: lambda x, y, z: field.usage(rows, x, y, z),
+                            field.n_rows, f"field_usage_{name}")
+
+
+def _calm_function(name: str, panels, water) -> ca.Function:
+    return calm_water_function(panels, water.rho, water.g, f"calm_water_{name}")
 
 
 def _field(cog, direction, half_width, depth_range, k_max, water) -> LocalField:
-    """The smallest Chebyshev orders whose truncation per unit amplitude stays below FIELD_TOL
-    at every wavenumber up to k_max."""
+    """The fewest rows whose truncation per unit amplitude stays below FIELD_TOL at every
+    wavenumber up to k_max (each direction's order grows only as its own tail needs)."""
     omega_max = math.sqrt(water.g * k_max * (math.tanh(k_max * water.depth)
                                               if math.isfinite(water.depth) else 1.0))
-    omega = np.linspace(omega_max / 20, omega_max, 40)
-    m = n = 2
-    while True:
-        field = LocalField(float(cog[0]), float(cog[1]), float(direction), float(half_width),
-                           float(depth_range), m, n, water.depth, water.g)
-        error = field.truncation_error(omega)
-        if np.max(error) <= FIELD_TOL or (m >= MAX_ORDER and n >= MAX_ORDER):
-            return field
-        m, n = min(m + 2, MAX_ORDER), min(n + 1, MAX_ORDER)
+    return band_field(float(cog[0]), float(cog[1]), float(direction), float(half_width),
+                      float(depth_range), np.linspace(omega_max / 20, omega_max, 40),
+                      water_depth=water.depth, g=water.g, tol=FIELD_TOL, max_order=MAX_ORDER)
 
 
 def _with_linear_fk(b: PressureBody, water) -> PressureBody:
@@ -230,7 +269,8 @@ def pressure_loads(scene, topo, q, s, rows, bodies):
         force += ca.DM([0.0, 0.0, body.mass * g])                # weight acts at the CoG
         tau += tree.generalized_force(q, k, ca.vertcat(R.T @ force, R.T @ moment))
         if b.n_rows:                 # the wave's part: what the pressure adds to calm water's
-            still, still_moment = b.wrench(ca.DM.zeros(b.n_rows), R, r_cog, rho, g)
+            still, still_moment = b.calm.call([R, r_cog])[:2] if b.path == "panels" \
+                else b.wrench(ca.DM.zeros(b.n_rows), R, r_cog, rho, g)
             tau_wave += tree.generalized_force(q, k, ca.vertcat(
                 R.T @ (force - still), R.T @ (moment - still_moment)))
             ranges[f"{b.body}__field_range"] = field_range(b, mine, R, r_cog)
@@ -241,14 +281,12 @@ def pressure_loads(scene, topo, q, s, rows, bodies):
 
 def field_range(b: PressureBody, rows, R, r_cog):
     """How much of its incident field's box a body uses (dimensionless; above 1 it is outside
-    and the series hold their edge values): the CoG's horizontal offset along the sea over the
-    reach, and (panels) its sinking over the reach or (analytic) the centre's depth below the
-    local surface over the deepest the series cover."""
-    beta = b.field.direction if b.field is not None else b.model.direction
-    along = ca.DM([math.cos(beta), math.sin(beta)])
+    and the series hold their edge values). Panels: the most any point uses
+    (`LocalField.usage`). Analytic: the centre's offset along the sea over the half-width,
+    or its depth below the local surface over the deepest the series cover."""
     if b.path == "panels":
-        drift = ca.fabs(ca.dot(along, r_cog[:2] - ca.DM(b.cog[:2]))) / b.reach
-        return ca.fmax(drift, (r_cog[2] - b.cog[2]) / b.reach)
+        return b.usage(rows, R, r_cog)
+    along = ca.DM([math.cos(b.model.direction), math.sin(b.model.direction)])
     centre = r_cog + ca.mtimes(R, ca.DM(b.centre - b.cog))
     xi = ca.dot(along, centre[:2] - ca.DM(b.centre[:2])) / b.model.half_width
     previous, current, eta = 1, xi, rows[0]       # eta at the axis: Chebyshev rows in xi
@@ -268,13 +306,8 @@ def _calm_potential(b: PressureBody, body, R, r_cog, rho, g):
         now = primitive_potential(geometry, b.cog, R, r_cog, rho, g)
         rest = primitive_potential(geometry, b.cog, np.eye(3), b.cog, rho, g)
         return now - float(rest)
-    panels = b.model if b.path == "panels" else body_panels(geometry, b.cog)
-
-    def u(R_, r_):
-        z = r_[2] + ca.mtimes(R_[2, :], ca.DM(panels.points))
-        nz = ca.mtimes(R_[2, :], ca.DM(panels.normals))
-        return 0.5 * rho * g * ca.sum2(ca.fmax(z, 0) ** 2 * nz)
-    return u(R, r_cog) - float(ca.evalf(u(ca.DM.eye(3), ca.DM(b.cog))))
+    now, rest = (b.calm.call([R_, r_])[2] for R_, r_ in ((R, r_cog), (ca.DM.eye(3), ca.DM(b.cog))))
+    return now - float(rest)
 
 
 def field_names(bodies) -> list[str]:
@@ -297,10 +330,23 @@ def check_wave(plant, wave) -> None:
 
 def wave_coefficients(plant, wave) -> np.ndarray:
     """`ProcessPlant.wave_coefficients` with nonlinear Froude-Krylov forces: the BEM excitation
-    less the surface models' linear Froude-Krylov force, then the field's rows."""
-    check_wave(plant, wave)
-    coeffs = plant.hydro.excitation_at(wave.omega, wave.direction)
-    dofs = [d[len("w__"):] for d in plant.disturbances[:coeffs.shape[1]]]
-    coeffs = coeffs - linear_froude_krylov(plant.pressure, wave.omega, dofs)
-    return np.hstack([coeffs] + [b.row_coefficients(wave.omega) for b in plant.pressure
-                                 if b.n_rows])
+    less the surface models' linear Froude-Krylov force, then the field's rows. Kept per
+    frequency grid and direction (closed forms per component: a run asks again for its last
+    output sample, and seeds of a sea share them)."""
+    from .workspace import derived
+    omega = np.ascontiguousarray(wave.omega, float)
+    kept = derived(plant, ("plant.nonlinear.wave_coefficients",), dict)
+    key = (hashlib.sha256(omega.tobytes() + np.asarray(wave.direction, float).tobytes())
+           .hexdigest(), omega.size)
+    if key not in kept:
+        check_wave(plant, wave)
+        coeffs = plant.hydro.excitation_at(wave.omega, wave.direction)
+        dofs = [d[len("w__"):] for d in plant.disturbances[:coeffs.shape[1]]]
+        coeffs = coeffs - linear_froude_krylov(plant.pressure, wave.omega, dofs)
+        if len(kept) >= WAVE_GRIDS_KEPT:
+            kept.clear()
+        rows = np.hstack([coeffs] + [b.row_coefficients(wave.omega)
+                                     for b in plant.pressure if b.n_rows])
+        rows.setflags(write=False)                      # shared by every run that asks
+        kept[key] = rows
+    return kept[key]

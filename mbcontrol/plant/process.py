@@ -101,9 +101,9 @@ class ProcessPlant:
         """(n_components, n_w) complex rows of w per unit amplitude, exp(-i omega t): the BEM
         excitation on the hydro DOFs, less the surface model's linear Froude-Krylov force when
         that force is nonlinear (the plant computes it), then the wave field's rows."""
-        if self.wave_rows:
-            return nonlinear.wave_coefficients(self, wave)
-        return self.hydro.excitation_at(wave.omega, wave.direction)
+        if not self.wave_rows:
+            return self.hydro.excitation_at(wave.omega, wave.direction)
+        return nonlinear.wave_coefficients(self, wave)
 
 
 def assemble_plant(scene: Scene | str, hydro: HydroModel | None = None, *,

@@ -46,10 +46,9 @@ PLAIN_OUTPUTS_STATES = 200
 # --- one step -------------------------------------------------------------------------------
 
 def calls_f(plant) -> bool:
-    """Whether a step calls f rather than inlining it: a large plant, or one whose f holds a
-    panel surface (mbcontrol.plant.nonlinear: hundreds of points, each a series in the wave
-    field, would be copied into every stage)."""
-    return plant.nx > CALL_F_STATES or any(b.path == "panels" for b in plant.pressure)
+    """Whether a step calls f rather than inlining it: a large plant. (A panel surface's
+    wrench is already one call node inside f: mbcontrol.hydro.mesh.surface_sums.)"""
+    return plant.nx > CALL_F_STATES
 
 
 def _symbols(plant, n_nodes, n_theta: int = 0):

@@ -139,8 +139,8 @@ def _coefficients(plant, wave) -> np.ndarray:
     if key not in kept:
         if len(kept) > COEFFICIENT_GRIDS_KEPT:
             kept.clear()
-        try:
-            coeffs = plant.hydro.excitation_at(wave.omega, wave.direction)
+        try:       # the plant's rows of w: with nonlinear Froude-Krylov, the field's too
+            coeffs = plant.wave_coefficients(wave)
         except HydroError:
             raise
         except ValueError as exc:

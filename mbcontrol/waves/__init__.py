@@ -12,8 +12,8 @@ from .annual import HOURS_PER_YEAR, annual_energy_MWh, bin_seas
 from .dispersion import group_velocities, group_velocity, wavenumber
 from .excitation import (coefficient_offsets, coefficient_series, excitation_at_offsets, excitation_impulse_response,
                          excitation_series, interpolate_complex)
-from .local_field import (LocalField, choose_field, direct_elevation, direct_pressure,
-                          field_rows_offsets, field_rows_series)
+from .local_field import LocalField, band_field, choose_field, field_rows_offsets, field_rows_series
+from .direct_field import direct_elevation, direct_pressure
 from .flux import deep_water_flux, energy_flux, spectrum_energy_flux
 from .realisation import (DEFAULT_BAND, Wave, band_limits, from_args, from_elevation,
                           irregular, regular, repeat_period, variance_outside)
@@ -36,6 +36,6 @@ __all__ = [
     "read_ndbc_spectra", "occurrence", "SPREAD_MAX_DEG", "WEIGHT_SUM_TOLERANCE",
     "Spreading", "component_directions", "spread_from_s", "spreading_from_settings",
     "HOURS_PER_YEAR", "annual_energy_MWh", "bin_seas",
-    "LocalField", "choose_field", "direct_elevation", "direct_pressure", "field_rows_offsets",
+    "LocalField", "band_field", "choose_field", "direct_elevation", "direct_pressure", "field_rows_offsets",
     "field_rows_series",
 ]

@@ -28,16 +28,17 @@ p 3: about 2 M N + 4 M + 3 N + 9, 161 at M = 8, N = 6 (CasADi's SX: 150 instruct
 Measured: a Function rows x 1000 points -> p, compiled by `mbcontrol.sim.compiled
 .compile_function` (-O3), 10^4 calls, one core of the development machine:
 
-    M x N    rows   expanded SX (C, gcc)      one-point Function called per point
+    M x N    rows   expanded SX (C, gcc)      a never-inlined call per point
     4 x 4      20   32 us (32 ns/pt), 14 s    17 us (17 ns/pt), 3 s
     8 x 6      56   62 us (62 ns/pt), 17 s    24 us (24 ns/pt), 3 s
     16 x 9    160  127 us (127 ns/pt), 51 s   49 us (49 ns/pt), 3 s
     8 x 6, H = 30 m: expanded 67 ns/pt.
 
 Expanding every point's series into one SX graph makes megabytes of straight-line C (2.7 MB at
-8 x 6) that compiles slowly and runs slower (likely instruction-cache misses); a plant should call
-`LocalField.point_function` (a never-inlined one-point Function) at each panel instead. For
-comparison, the direct sum of a 278-component sea costs a cosine per component per point.
+8 x 6) that compiles slowly and runs slower (likely instruction-cache misses); the plant sums
+the points in blocks inside one call instead (mbcontrol.hydro.mesh.surface_sums: 25 ns a point
+at 8 x 6). For comparison, the direct sum of a 278-component sea
+(mbcontrol.waves.direct_field) costs a cosine per component per point.
 
 Accuracy. `truncation_error` is a rigorous bound (|T_m| <= 1); `choose_field` weights it by
 amplitude, the worst case over phases. Measured against the direct sums (box +-10 m by 12 m,
@@ -52,6 +53,7 @@ Tests: tests/waves/test_local_field.py (against the direct sums `direct_elevatio
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 import warnings
 from dataclasses import dataclass
@@ -62,7 +64,6 @@ from scipy.special import ive, jv
 from ..errors import WaveError
 from .dispersion import wavenumber
 from .excitation import coefficient_offsets, coefficient_series
-from .synthesis import ramp
 
 WARN_FACTOR = 10.0      # choose_field: a bound within this many tol is a warning, past it refused
 
@@ -240,26 +241,22 @@ class LocalField:
             head = head + inner * td[n]
         return (rho * g) * fmax(z + head, 0.0)
 
-    def point_function(self, rho: float, g: float, name: str = "incident_pressure"):
-        """A CasADi Function (rows (n_rows,), x, y, z scalars, m) -> p (Pa) for one point,
-        never inlined: called at each panel inside an SX plant it stays one call in the
-        generated C (2.5x faster at 8 x 6 than the expanded series, and compiled in seconds;
-        see the module docstring). rho (kg/m^3), g (m/s^2)."""
-        import casadi as ca
-        rows = ca.SX.sym("rows", self.n_rows)
-        x, y, z = ca.SX.sym("x"), ca.SX.sym("y"), ca.SX.sym("z")
-        return ca.Function(name, [rows, x, y, z], [self.pressure(rows, x, y, z, rho, g)],
-                           ["rows", "x", "y", "z"], ["p"], {"never_inline": True})
-
-    def outside(self, rows, x, y, z) -> np.ndarray:
-        """numpy: True where a point lies past the box (|xi| > L, or below the surface with a
-        stretched depth past D), where `pressure` used the boundary's value."""
-        x, y, z = (np.asarray(v, float) for v in (x, y, z))
+    def usage(self, rows, x, y, z):
+        """How much of the box each point uses (dimensionless; numpy arrays or CasADi rows,
+        elementwise): max(|xi| / L, d / D), d the stretched depth (negative above the surface).
+        Above 1 the point lies past the box, where `pressure` used the boundary's value."""
+        fmax, _ = _ops(rows, x, y, z)
+        rows = rows if type(rows).__module__.startswith("casadi") else np.asarray(rows, float)
         xi = (x - self.x0) * math.cos(self.direction) + (y - self.y0) * math.sin(self.direction)
         eta = self.elevation(rows, x, y)
         depth = z + eta if math.isinf(self.water_depth) \
             else self.water_depth * (z + eta) / (self.water_depth + eta)
-        return (np.abs(xi) > self.half_width) | (depth > self.depth_range)
+        return fmax(abs(xi) * (1 / self.half_width), depth * (1 / self.depth_range))
+
+    def outside(self, rows, x, y, z) -> np.ndarray:
+        """numpy: True where a point lies past the box (`usage` above 1)."""
+        x, y, z = (np.asarray(v, float) for v in (x, y, z))
+        return np.asarray(self.usage(rows, x, y, z)) > 1.0
 
 
 def choose_field(wave, x0: float, y0: float, half_width: float, depth_range: float, *,
@@ -283,19 +280,10 @@ def choose_field(wave, x0: float, y0: float, half_width: float, depth_range: flo
     field = LocalField(x0, y0, float(wave.direction), half_width, depth_range, 1, 1,
                        water_depth, g)
     k = _wavenumbers(wave.omega, water_depth, g)
-    a_head, a_tail, _, b_tail = _tails(k, field, max_order)
-    amp = np.asarray(wave.amplitude, float)
-    # bound[M - 1, N - 1] = sum_j amp_j (tail_a(M) B + A_M tail_b(N)), M, N = 1..max_order
-    bound = ((amp * b_tail[:, 0]) @ a_tail[:, 1:])[:, None] \
-        + a_head[:, 1:].T @ (amp[:, None] * b_tail[:, 1:])
-    orders = np.arange(1, max_order + 1)
-    rows = orders[:, None] * (1 + orders[None, :])
-    ok = bound <= tol
-    if ok.any():
-        cost = np.where(ok, rows * (max_order + 1) + orders[:, None], np.iinfo(int).max)
-        m, n = np.unravel_index(np.argmin(cost), cost.shape)
-        return LocalField(x0, y0, float(wave.direction), half_width, depth_range, int(m + 1),
-                          int(n + 1), water_depth, g)
+    bound = _bounds(field, k, np.asarray(wave.amplitude, float), max_order)
+    orders = _fewest_rows(bound, tol)
+    if orders is not None:
+        return dataclasses.replace(field, n_xi=orders[0], n_depth=orders[1])
     best = float(bound[-1, -1])
     what = (f"a local field over +-{half_width:g} m by {depth_range:g} m deep reaches a "
             f"truncation bound of {best:.3g} m at orders {max_order} x {max_order}, above "
@@ -307,6 +295,38 @@ def choose_field(wave, x0: float, y0: float, half_width: float, depth_range: flo
     warnings.warn(what + "; using those orders", RuntimeWarning, stacklevel=2)
     return LocalField(x0, y0, float(wave.direction), half_width, depth_range, max_order,
                       max_order, water_depth, g)
+
+
+def band_field(x0: float, y0: float, direction: float, half_width: float, depth_range: float,
+               omega, *, water_depth: float = math.inf, g: float = 9.81, tol: float = 1e-3,
+               max_order: int = 24) -> LocalField:
+    """The field of fewest rows whose truncation bound per unit amplitude is at most tol (m)
+    at every omega (rad/s): any sea in that band, before it is known. max_order x max_order
+    when none is (the caller reports it). Box and units as `choose_field`."""
+    field = LocalField(x0, y0, direction, half_width, depth_range, 1, 1, water_depth, g)
+    bound = _bounds(field, _wavenumbers(omega, water_depth, g), None, max_order)
+    m, n = _fewest_rows(bound, tol) or (max_order, max_order)
+    return dataclasses.replace(field, n_xi=m, n_depth=n)
+
+
+def _bounds(field: LocalField, k, weights, max_order: int) -> np.ndarray:
+    """bound[M - 1, N - 1], M, N = 1..max_order: the truncation bound tail_a(M) B +
+    A_M tail_b(N) per component, summed with ``weights`` (amplitudes), or its max (None)."""
+    a_head, a_tail, _, b_tail = _tails(k, field, max_order)
+    err = a_tail[:, 1:, None] * b_tail[:, :1, None] + a_head[:, 1:, None] * b_tail[:, None, 1:]
+    return err.max(axis=0) if weights is None else np.tensordot(weights, err, 1)
+
+
+def _fewest_rows(bound: np.ndarray, tol: float):
+    """(M, N) of the fewest rows M (1 + N) with bound <= tol (ties: the smaller M), or None."""
+    orders = np.arange(1, bound.shape[0] + 1)
+    rows = orders[:, None] * (1 + orders[None, :])
+    ok = bound <= tol
+    if not ok.any():
+        return None
+    cost = np.where(ok, rows * (bound.shape[0] + 1) + orders[:, None], np.iinfo(int).max)
+    m, n = np.unravel_index(np.argmin(cost), cost.shape)
+    return int(m + 1), int(n + 1)
 
 
 def field_rows_series(field: LocalField, wave, t) -> np.ndarray:
@@ -329,56 +349,3 @@ def _check_direction(field: LocalField, wave) -> None:
         raise WaveError(f"local field: made for direction {field.direction:g} rad, given a "
                         f"wave of direction {wave.mean_direction:g} rad"
                         + (" spread over directions" if wave.directional else ""))
-
-
-def _phases(wave, t, x, y, water_depth: float, g: float):
-    """k (rad/m, per component), the points' times (broadcast, flattened) and a generator of
-    (slice, cos theta) over blocks of points, theta = k_j xi_j - omega_j t - phi_j
-    (n_block, n_components): Re a exp(-i (omega t + phi)) exp(i k xi) = a cos theta."""
-    t, x, y = (a.ravel() for a in np.broadcast_arrays(*(np.asarray(v, float) for v in (t, x, y))))
-    k = _wavenumbers(wave.omega, water_depth, g)
-    beta = np.broadcast_to(np.asarray(wave.direction, float), k.shape)   # a spread sea too
-    kx, ky = k * np.cos(beta), k * np.sin(beta)
-
-    def blocks(size=512):                  # bounded memory: points x components per block
-        for start in range(0, t.size, size):
-            s = slice(start, start + size)
-            theta = (np.multiply.outer(x[s], kx) + np.multiply.outer(y[s], ky)
-                     - np.multiply.outer(t[s], wave.omega) - wave.phase)
-            yield s, np.cos(theta)
-    return k, t, blocks
-
-
-def direct_elevation(wave, t, x, y, *, water_depth: float = math.inf,
-                     g: float = 9.81) -> np.ndarray:
-    """eta (m, up) by the exact sum over components at times t (s) and points x, y (m, NED),
-    broadcast together (shape of the broadcast), ramp included as `Wave.elevation`: the
-    reference for the series. A spread sea's per-component directions are honoured."""
-    shape = np.broadcast_shapes(np.shape(t), np.shape(x), np.shape(y))
-    _, times, blocks = _phases(wave, t, x, y, water_depth, g)
-    out = np.empty(times.size)
-    for s, cos in blocks():
-        out[s] = cos @ wave.amplitude
-    return (ramp(times, wave.ramp_time) * out).reshape(shape)
-
-
-def direct_pressure(wave, t, x, y, z, *, water_depth: float = math.inf, rho: float = 1025.0,
-                    g: float = 9.81) -> np.ndarray:
-    """Total incident pressure (Pa) by the exact sum at times t (s) and points x, y, z (m,
-    NED, z down), broadcast: p = rho g max(z + p_dyn(d) / (rho g), 0) at the Wheeler-stretched
-    depth d = H (z + eta) / (H + eta) clipped to >= 0 (deep: z + eta), as `LocalField.pressure`
-    (0 above the surface); eta and p_dyn each sum every component, ramp included."""
-    shape = np.broadcast_shapes(np.shape(t), np.shape(x), np.shape(y), np.shape(z))
-    z = np.broadcast_to(np.asarray(z, float), shape).ravel()
-    eta = direct_elevation(wave, t, x, y, water_depth=water_depth, g=g)
-    eta = np.broadcast_to(eta, shape).ravel()
-    depth = z + eta if math.isinf(water_depth) else water_depth * (z + eta) / (water_depth + eta)
-    depth = np.maximum(depth, 0.0)
-    k, times, blocks = _phases(wave, np.broadcast_to(t, shape), np.broadcast_to(x, shape),
-                               np.broadcast_to(y, shape), water_depth, g)
-    head = np.empty(times.size)
-    for s, cos in blocks():
-        head[s] = np.sum(cos * wave.amplitude * depth_factor(k, depth[s, None], water_depth),
-                         axis=1)
-    head *= ramp(times, wave.ramp_time)
-    return (rho * g * np.maximum(z + head, 0.0)).reshape(shape)

@@ -10,9 +10,8 @@ from numpy.polynomial import chebyshev as C
 
 from mbcontrol.errors import WaveError
 from mbcontrol.waves import Spreading, irregular, regular, wavenumber
-from mbcontrol.waves.local_field import (LocalField, choose_field, direct_elevation,
-                                         direct_pressure, field_rows_offsets,
-                                         field_rows_series)
+from mbcontrol.waves import (LocalField, band_field, choose_field, direct_elevation,
+                             direct_pressure, field_rows_offsets, field_rows_series)
 
 RHO, G = 1025.0, 9.81
 X0, Y0 = 3.0, -2.0             # the reference point: off the origin, so its phase matters
@@ -164,10 +163,17 @@ def test_casadi_evaluation_equals_numpy():
     np.testing.assert_allclose(eta, field.elevation(values, x, y), rtol=0, atol=1e-12)
     np.testing.assert_allclose(p / (RHO * G), field.pressure(values, x, y, z, RHO, G) / (RHO * G),
                                rtol=0, atol=1e-12)
-    one = field.point_function(RHO, G)
-    p_one = [float(one(values, x[i], y[i], z[i])) for i in range(80)]
-    np.testing.assert_allclose(np.array(p_one) / (RHO * G), p / (RHO * G), rtol=0, atol=1e-12)
-    assert field.outside(values, x, y, z).any() and not field.outside(values, x, y, z).all()
+    usage = ca.Function("u", [rows, X, Y, Z], [field.usage(rows, X, Y, Z)])
+    used = np.asarray(usage(values, x[None], y[None], z[None])).ravel()
+    outside = field.outside(values, x, y, z)
+    assert outside.any() and not outside.all()
+    np.testing.assert_array_equal(used > 1.0, outside)
+    # the box's own edges by hand: |xi| / L and the Wheeler-stretched depth over D
+    xi = (x - field.x0) * math.cos(field.direction) + (y - field.y0) * math.sin(field.direction)
+    eta, H = field.elevation(values, x, y), field.water_depth
+    np.testing.assert_allclose(used, np.maximum(np.abs(xi) / field.half_width,
+                                                H * (z + eta) / (H + eta) / field.depth_range),
+                               rtol=1e-12)
 
 
 def test_orders_grow_with_the_box_and_the_frequency():
