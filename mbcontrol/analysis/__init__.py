@@ -19,8 +19,8 @@ from .ports import linear_params, multiport_bound, port_responses
 from .power_statistics import law_params, law_responses, record_power_statistics
 from .reduce import balanced_truncation
 from .summary import summary
-from .validity import (ANGLE_MAX_RAD, DRAFT_FACTOR, assess, mean_draft, simulate_checked,
-                       split_remedy, wave_at)
+from .validity import (ANGLE_MAX_RAD, DRAFT_FACTOR, assess, left_linear_range, mean_draft,
+                       simulate_checked, split_remedy, wave_at)
 
 __all__ = ["linearize", "frequency_domain_response", "statespace_response", "excitation_transfer",
            "regular_wave_amplitudes", "mechanical_matrices", "complex_conjugate_bound",
@@ -30,4 +30,4 @@ __all__ = ["linearize", "frequency_domain_response", "statespace_response", "exc
            "ENVELOPE_SHARE", "PEAK_SHARE", "envelope_bound", "envelope_items", "envelope_response",
            "linear_params", "port_responses", "law_params", "law_responses",
            "record_power_statistics", "ANGLE_MAX_RAD", "DRAFT_FACTOR", "mean_draft", "wave_at",
-           "split_remedy"]
+           "split_remedy", "left_linear_range"]

@@ -83,6 +83,12 @@ def split_remedy(reason: str) -> tuple[str, str | None]:
     return what, remedy or None
 
 
+def left_linear_range(reasons) -> bool:
+    """Whether any of a verdict's INVALID reasons is that the motions left the linear range
+    (the reason whose remedy is the nonlinear model, REMEDIES["range"])."""
+    return any(split_remedy(r)[1] == REMEDIES["range"] for r in reasons)
+
+
 RESPONSE_GRIDS_KEPT = 256         # (params, direction, frequency grid) a plant keeps responses for
 
 

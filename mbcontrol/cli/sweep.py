@@ -46,6 +46,9 @@ The --json summary is a contract: {"model", "cases", "computed", "reused", "wall
 "settings", "amplitudes"}, and with --isolated "farm": {"devices", "isolated_devices",
 "isolated_scene_params", "q_factor", "annual_energy_isolated_MWh", "q_annual",
 "isolated_invalid_cases", "isolated_wall_time_s"} and "q_factor" per sea, and with
+--nonlinear invalid per sea "nonlinear_cases" (cases whose linear run left the linear
+range and ran on the nonlinear plant) and "linear_mean_power_W" (those linear runs' mean,
+INVALID, for comparison; null where none), and with
 --design per sea "settings" (the tuned values), "predicted_power_W", "bound_W",
 "percent_of_bound", "inside_envelope" and "meets_robustness_floors", and with a PTO
 rated_power "rated_power_W" (the weighted figures then cap each sea's power at it), and with
@@ -153,6 +156,12 @@ def add_parser(sub) -> None:
     p.add_argument("--amplitudes", choices=("deterministic", "random"), default="deterministic",
                    help="deterministic: a = sqrt(2 S dw), the expected power (default); random: "
                         "Rayleigh amplitudes, a record's statistics")
+    p.add_argument("--nonlinear", choices=("scene", "invalid", "always"), default="scene",
+                   help="scene: the scene's own hydrostatics (default); invalid: the linear\n"
+                        "plant, and for seas whose run leaves the linear range the nonlinear\n"
+                        "one (hydrostatics and Froude-Krylov over the instantaneous wetted\n"
+                        "surface) with the same controller; always: the nonlinear plant for\n"
+                        "every sea. Needs each hydro body's [body.geometry]")
     p.add_argument("--identified", metavar="SUMMARY.json",
                    help="an identification of this model (`identify --json` or its\n"
                         "summary.json): its parameter values are run, and its model error\n"
@@ -241,6 +250,9 @@ def run_sweep(args) -> int:
         if args.identified:
             raise InputError("--identified with --isolated: not built (a farm's budget); "
                              "sweep one device with --identified instead")
+        if args.nonlinear != "scene":
+            raise InputError("--nonlinear with --isolated: not built (a farm's plant); sweep "
+                             "one device with --nonlinear instead")
         if args.design:
             raise InputError("--design with --isolated: not built (a farm's controllers are "
                              "tuned per device); tune one device with --design instead")
@@ -252,7 +264,7 @@ def run_sweep(args) -> int:
         years = read_year_weights(args.seas) if args.seas else None
         ds, summary = sweep(args.model, seas, scene_params=scene_params, design=args.design,
                             robust=args.robust, identified=args.identified, years=years,
-                            **common)
+                            nonlinear=args.nonlinear, **common)
     if args.plot:
         from ..studies.sweep import plot_sweep
         plot_sweep(ds, summary, args.plot)

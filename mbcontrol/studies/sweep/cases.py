@@ -43,6 +43,7 @@ class Case:
     design: bool = False                # tune the controller for the case's sea (--design)
     robust: bool = False                # ... within the robustness floors (--robust)
     amplitudes: str = "deterministic"   # or "random": Rayleigh amplitudes (waves.irregular)
+    nonlinear: str = "scene"            # "always", "invalid": the nonlinear plant (run_case)
 
     @property
     def key(self) -> str:
@@ -56,6 +57,8 @@ class Case:
                 record.pop(flag)
         if record["amplitudes"] == "deterministic":
             record.pop("amplitudes")
+        if record["nonlinear"] == "scene":
+            record.pop("nonlinear")
         sea = record["sea"]             # a long-crested sea keeps the key it had before
         for name in ("direction", "spread"):
             if sea[name] != sea[name]:   # NaN: not given
@@ -84,13 +87,13 @@ def build_cases(model: str, seas, *, seeds: int = 1, vary: dict | None = None, r
                 duration: float | None = None, dt: float | None = None,
                 method: str | None = None, inputs: dict | None = None,
                 design: bool = False, robust: bool = False,
-                amplitudes: str = "deterministic") -> list[Case]:
+                amplitudes: str = "deterministic", nonlinear: str = "scene") -> list[Case]:
     """Every sea x seed x combination of the varied values. roles: varied name -> "param",
     "scene" or "setting" (see `roles_for`); inputs: the plant's provenance (content hashes),
     part of every case's key. duration, dt and method left out: the "sweep.*" defaults.
     design: each case's controller is tuned for its sea (studies.design.sea); robust:
     within the robustness floors; amplitudes: the seas' ("deterministic" or "random",
-    waves.irregular)."""
+    waves.irregular); nonlinear: "scene", "invalid" or "always" (`case_run.run_case`)."""
     duration = defaults.resolve("sweep.duration", duration)
     dt, method = defaults.resolve("sweep.dt", dt), defaults.resolve("sweep.method", method)
     vary = dict(vary or {})
@@ -105,7 +108,7 @@ def build_cases(model: str, seas, *, seeds: int = 1, vary: dict | None = None, r
                           tuple(sorted((scene_params or {}).items())), controller,
                           tuple(sorted((settings or {}).items())), float(duration), float(dt),
                           method, dict(roles or {}), tuple(sorted((inputs or {}).items())),
-                          bool(design), bool(robust), amplitudes))
+                          bool(design), bool(robust), amplitudes, nonlinear))
     return cases
 
 

@@ -24,140 +24,7 @@ from collections import defaultdict
 
 from ...console import progress_bar
 
-# The plants this process built, most recent last: cases run a plant at a time (`groups`),
-# so a few suffice, and a sweep over scene parameters (each value a plant with its compiled
-# code) does not keep every one it has passed
-PLANTS_KEPT = 4
-_PLANTS: dict = {}
-# The last light run of this process, kept until the next one has its arrays: freed at once,
-# a run's records (35 MB for rm3 over an hour) top glibc's heap and go back to the kernel, and
-# the next case faults them in again page by page (rm3: 4,300 page faults, 12 ms of 70 a case)
-_LAST_RUN: list = []
-
-
-def _plant(model: str, scene_params: tuple):
-    """The plant of a model and scene parameters, built once while it is among the last
-    PLANTS_KEPT used in this process."""
-    key = (model, scene_params)
-    if key in _PLANTS:
-        keep_plant(model, scene_params, _PLANTS.pop(key))
-    else:
-        from ...plant import build_plant
-        from ...scene import load_scene
-        keep_plant(model, scene_params, build_plant(load_scene(model, dict(scene_params) or None)))
-    return _PLANTS[key]
-
-
-def keep_plant(model: str, scene_params: tuple, plant) -> None:
-    """Remember `plant` as the one of (model, sorted scene-parameter items) for the cases run
-    in this process (a plant the caller has already built is not built again)."""
-    _PLANTS.pop((model, scene_params), None)
-    _PLANTS[(model, scene_params)] = plant
-    while len(_PLANTS) > PLANTS_KEPT:
-        _PLANTS.pop(next(iter(_PLANTS)))
-
-
-def run_case(case) -> dict:
-    """Simulate one case in closed loop and measure it: {"case": key, "metrics": {name:
-    value} (per PTO `<pto>__<metric>` as `mbcontrol.analysis.metrics.pto_metrics`, and the
-    totals mean_power_W, mean_electrical_power_W), "valid", "invalid_reasons",
-    "wall_time_s"} (`case_record`); a case whose run raises gives a `failed_record` instead.
-    A case without a controller on a fixed-step method runs
-    through `mbcontrol.sim.light.simulate_arrays` (the arrays its metrics need, no Dataset),
-    any other through `simulate`; both give the same record to rounding."""
-    import inspect
-
-    from mbcontrol.controllers import REGISTRY, make
-
-    from ...sim import can_run_light, simulate, simulate_arrays
-    params, scene_params, settings = case.resolved()
-    plant = _plant(case.model, tuple(sorted(scene_params.items())))
-    direction = None if case.direction_deg is None else math.radians(case.direction_deg)
-    wave = sea_wave(plant, case.sea, case.duration, seed=case.seed, direction=direction,
-                    amplitudes=case.amplitudes)
-    controller, designed = None, None
-    start = time.perf_counter()
-    if case.design:      # tuned for this sea; settings given with --set take precedence
-        from mbcontrol.studies.design import design_for_sea
-        try:
-            designed = design_for_sea(plant, wave, case.controller, dt=case.dt,
-                                      robust=case.robust)
-        except Exception as exc:   # noqa: BLE001 - a sea the tuner cannot serve is a result
-            return failed_record(case, exc, start)
-        settings = {**designed["settings"], **settings}
-    if case.controller:
-        cls = REGISTRY[case.controller]
-        if "wave" in inspect.signature(cls).parameters:
-            settings.setdefault("wave", wave)
-        controller = make(case.controller, **settings)
-    try:
-        if can_run_light(plant, controller, case.method):
-            run = simulate_arrays(plant, wave, duration=case.duration, dt=case.dt,
-                                  method=case.method, params=params or None)
-            _LAST_RUN[:] = [run]     # the previous run is let go only now (see _LAST_RUN)
-        else:
-            run = simulate(plant, wave, duration=case.duration, dt=case.dt,
-                           controller=controller, method=case.method, params=params or None)
-        record = case_record(case, plant, wave, run, start)
-    except Exception as exc:       # noqa: BLE001 - a case that fails is a result (see below)
-        record = failed_record(case, exc, start)
-    if designed is not None:
-        record["design"] = designed
-    return record
-
-
-def sea_wave(plant, sea, duration: float, *, seed: int = 0, direction: float | None = None,
-             amplitudes: str = "deterministic"):
-    """The wave a case of `sea` runs in: JONSWAP cut to the hydro data's band, seeded; its
-    direction `direction` (rad, --vary direction), else the sea's own (a seas file's
-    column), else the data's one heading, or 0. A sea with a spread is short-crested: its
-    spreading about that direction (`directional.sea_spreading`), one direction per
-    component."""
-    from ... import waves
-    from .directional import sea_spreading
-    headings = plant.hydro.data["wave_direction"].values
-    omega = plant.hydro.omega
-    if direction is None and math.isfinite(sea.direction):
-        direction = sea.direction
-    if direction is None:
-        direction = float(headings[0]) if len(headings) == 1 else 0.0
-    return waves.irregular(sea.hs, sea.tp, gamma=sea.gamma, seed=seed, duration=duration,
-                           data_band=(float(omega[0]), float(omega[-1])), direction=direction,
-                           amplitudes=amplitudes, spreading=sea_spreading(plant, sea, direction))
-
-
-def failed_record(case, exc: BaseException, start: float) -> dict:
-    """The record of a case whose run raised (a divergence, a solver that gave up, ...): no
-    metrics, not valid, `failed` with the error's type and message, so one bad sea neither
-    stops the sweep nor loses the others, and is never averaged. It is stored like any
-    record: the same case fails the same way again, so a resumed sweep does not rerun it."""
-    reason = f"{type(exc).__name__}: {exc}"
-    return {"case": case.key, "metrics": {}, "valid": False, "failed": True,
-            "failure": reason, "invalid_reasons": [f"run failed ({reason})"],
-            "wall_time_s": time.perf_counter() - start}
-
-
-def case_record(case, plant, wave, run, start: float) -> dict:
-    """A case's record from its run: `run` is a Dataset from `simulate` or a Run from
-    `simulate_arrays` (both read as run[name].values and run.attrs), `start` the
-    perf_counter at the start of its simulation. The one place a record is made: metrics
-    (every numeric entry of `pto_metrics` per PTO, `<pto>__<key>`, and the totals), the
-    validity verdict (`mbcontrol.analysis.validity.assess` on the run and its wave)."""
-    from ...analysis import pto_metrics
-    from ...analysis import assess
-    from ...results import jsonable
-    ptos = {pto.name: jsonable(pto_metrics(run, pto)) for pto in plant.scene.ptos}
-    metrics = {}
-    for pto, m in ptos.items():
-        for k, v in m.items():
-            if isinstance(v, (int, float)) and not isinstance(v, bool):
-                metrics[f"{pto}__{k}"] = float(v)
-    metrics["mean_power_W"] = sum(m["mean_power_W"] for m in ptos.values())
-    metrics["mean_electrical_power_W"] = sum(m["mean_electrical_power_W"] for m in ptos.values())
-    verdict = assess(run, plant, wave, mean_power_W=metrics["mean_power_W"])
-    return {"case": case.key, "metrics": metrics, "valid": verdict["valid"],
-            "invalid_reasons": verdict["invalid_reasons"],
-            "wall_time_s": time.perf_counter() - start}
+from .case_run import _plant, keep_plant, run_case, sea_wave  # noqa: F401  (this module's face)
 
 
 def run_group(cases) -> list[dict]:
@@ -169,7 +36,7 @@ def groups(cases, per_task: int) -> list[list]:
     """Cases split into tasks: same plant in a task, at most per_task cases each."""
     by_plant = defaultdict(list)
     for c in cases:
-        by_plant[(c.model, dict(c.resolved()[1]).__repr__())].append(c)
+        by_plant[(c.model, dict(c.resolved()[1]).__repr__(), c.nonlinear)].append(c)
     out = []
     for members in by_plant.values():
         out += [members[k:k + per_task] for k in range(0, len(members), per_task)]
@@ -291,7 +158,8 @@ def _local(queue: list, save, n: int, per_task) -> str:
             return "serial"
     first = queue[0]
     starter = _ClusterStarter(n, (first.model, tuple(sorted(first.resolved()[1].items())),
-                                  int(round(first.duration / first.dt)), first.method), method)
+                                  int(round(first.duration / first.dt)), first.method,
+                                  first.nonlinear == "always"), method)
     starter.start()
     deadline = time.perf_counter() + START_TIMEOUT_S
     while queue and not forced and method == "spawn" and not starter.ready.is_set():
@@ -361,7 +229,8 @@ class _ClusterStarter:
             self.cluster.close()
 
 
-def _warm(model: str, scene_params: tuple, n_steps: int, method: str) -> None:
+def _warm(model: str, scene_params: tuple, n_steps: int, method: str,
+          nonlinear: bool = False) -> None:
     """On a worker: import what a case uses (the checks' control and scipy: ~1 s), build the
     plant and load its compiled stepping and output code, before cases come."""
     import numpy as np
@@ -371,7 +240,7 @@ def _warm(model: str, scene_params: tuple, n_steps: int, method: str) -> None:
     import mbcontrol.analysis  # noqa: F401   (its metrics and validity checks)
     from ...sim import method as method_of
     from ...sim import plant_outputs, prepare
-    plant = _plant(model, scene_params)
+    plant = _plant(model, scene_params, nonlinear)
     if method_of(method).fixed_step:
         prepare(plant, n_steps, method)
         rows = n_steps + 1

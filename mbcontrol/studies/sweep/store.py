@@ -132,6 +132,8 @@ def assemble(cases, store: CaseStore, seas, vary: dict, seeds: int, attrs: dict)
             data[f"{m}__unchecked"] = (dims, raw)
     if any("design" in r for r in records.values()):
         data.update(_design_variables(records, shape, dims))
+    if any("model" in r for r in records.values()):        # --nonlinear invalid
+        data.update(_model_variables(records, shape, dims))
     coords = {"sea": np.arange(len(seas)), "seed": np.arange(seeds),
               "hs": ("sea", [s.hs for s in seas]), "tp": ("sea", [s.tp for s in seas]),
               "te": ("sea", [s.te for s in seas]), "gamma": ("sea", [s.gamma for s in seas]),
@@ -141,6 +143,23 @@ def assemble(cases, store: CaseStore, seas, vary: dict, seeds: int, attrs: dict)
     ds.attrs.update({k: v for k, v in attrs.items() if v is not None and not   # JSON in files only
                      (isinstance(v, float) and math.isnan(v))})
     return ds
+
+
+def _model_variables(records: dict, shape: tuple, dims: tuple) -> dict:
+    """--nonlinear invalid: which cases ran on the nonlinear plant (their linear run left the
+    linear range), and the linear run's mean power there (W; INVALID, for comparison)."""
+    escalated = np.zeros(shape, bool)
+    linear_power = np.full(shape, np.nan)
+    for index, r in records.items():
+        if r.get("model") == "nonlinear":
+            escalated[index] = True
+            linear_power[index] = r["linear"]["metrics"].get("mean_power_W", np.nan)
+    return {"nonlinear_model": (dims, escalated, {
+                "long_name": "the case ran on the nonlinear plant: its linear run left the "
+                             "linear range (sweep --nonlinear invalid)"}),
+            "mean_power_W__linear": (dims, linear_power, {
+                "long_name": "the linear plant's mean absorbed power where it left its range "
+                             "(INVALID there; for comparison)", "units": "W"})}
 
 
 def _design_variables(records: dict, shape: tuple, dims: tuple) -> dict:

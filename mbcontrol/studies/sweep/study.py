@@ -22,13 +22,16 @@ from .runner import execute, keep_plant
 from .store import CaseStore, assemble
 
 
+NONLINEAR_MODES = ("scene", "invalid", "always")
+
+
 def sweep(model: str, seas, *, seeds: int = 1, vary: dict | None = None, params=None,
           scene_params=None, controller: str | None = None, settings=None,
           duration: float | None = None, dt: float | None = None, method: str | None = None,
           store=None, workers: int | None = 0, scheduler: str | None = None,
           width: float | None = None, progress: bool = True, design: bool = False,
           robust: bool = False, amplitudes: str = "deterministic", identified=None,
-          years: dict | None = None):
+          years: dict | None = None, nonlinear: str = "scene"):
     """Run a sweep and return (Dataset, summary).
 
     seas: SeaStates (`cases.grid`, `cases.read_seas`); vary: name -> values (scene
@@ -45,7 +48,11 @@ def sweep(model: str, seas, *, seeds: int = 1, vary: dict | None = None, params=
     energy's budget (`uncertainty`); years: label -> per-year weights of the seas
     (`waves.read_year_weights`), the budget's resource term. duration, dt (s) and method left out
     take the defaults "sweep.duration" (600 s), "sweep.dt" (0.05 s) and "sweep.method"
-    (mbcontrol.defaults)."""
+    (mbcontrol.defaults). nonlinear: "scene" (the scene's own hydrostatics), "always" (every
+    sea on the nonlinear plant: [hydro] hydrostatics = froude_krylov = "nonlinear") or
+    "invalid" (the linear plant, and the nonlinear one only for seas whose linear run leaves
+    the linear range, with the same controller; those cases are marked nonlinear_model and
+    keep the linear run's power as mean_power_W__linear)."""
     from mbcontrol.controllers import REGISTRY
 
     from ...plant import build_plant
@@ -55,17 +62,11 @@ def sweep(model: str, seas, *, seeds: int = 1, vary: dict | None = None, params=
     dt, method = defaults.resolve("sweep.dt", dt), defaults.resolve("sweep.method", method)
     vary = {k: list(v) for k, v in (vary or {}).items()}
     scene = load_scene(model, scene_params or None)
-    if controller is not None and controller not in REGISTRY:
-        raise InputError(f"--controller {controller}: expected one of {', '.join(REGISTRY)}")
-    if robust and not design:
-        raise InputError("--robust tunes within the robustness floors: it goes with --design")
-    if design:
-        from mbcontrol.studies.design import DESIGNABLE
-        if controller not in DESIGNABLE:
-            raise InputError(f"--design tunes a controller for each sea: give --controller, one "
-                             f"of {', '.join(DESIGNABLE)} (got {controller})")
+    _check_controller(controller, design, robust)
     plant = build_plant(scene)
-    keep_plant(model, tuple(sorted((scene_params or {}).items())), plant)   # serial path: reuse
+    scene_key = tuple(sorted((scene_params or {}).items()))
+    keep_plant(model, scene_key, plant)   # serial path: reuse
+    _keep_nonlinear_plant(model, scene, scene_key, nonlinear)
     roles = roles_for(vary, scene, plant.parameters, REGISTRY.get(controller))
     if identified is not None:
         from .uncertainty import read_identified
@@ -79,13 +80,16 @@ def sweep(model: str, seas, *, seeds: int = 1, vary: dict | None = None, params=
     cases = build_cases(model, seas, seeds=seeds, vary=vary, roles=roles, params=params,
                         scene_params=scene_params, controller=controller, settings=settings,
                         duration=duration, dt=dt, method=method, inputs=inputs,
-                        design=design, robust=robust, amplitudes=amplitudes)
+                        design=design, robust=robust, amplitudes=amplitudes,
+                        nonlinear=nonlinear)
     case_store = CaseStore(store, inputs)
     run = execute(cases, case_store, workers=workers, scheduler=scheduler, progress=progress)
     depth, rho, g = scene.water.depth, scene.water.rho, scene.water.g
     made_by = {**inputs, "controller": controller,
                "settings": resolved_settings(controller, settings, vary, roles),
                "amplitudes": amplitudes}
+    if nonlinear != "scene":
+        made_by["nonlinear"] = nonlinear
     if identified is not None:
         made_by["identified"] = identified["source"]
     if design:
@@ -123,6 +127,29 @@ def sweep(model: str, seas, *, seeds: int = 1, vary: dict | None = None, params=
     if "rated_power_W" in ds.attrs:
         summary["rated_power_W"] = float(ds.attrs["rated_power_W"])
     return ds, summary
+
+
+def _check_controller(controller, design: bool, robust: bool) -> None:
+    from mbcontrol.controllers import REGISTRY
+    if controller is not None and controller not in REGISTRY:
+        raise InputError(f"--controller {controller}: expected one of {', '.join(REGISTRY)}")
+    if robust and not design:
+        raise InputError("--robust tunes within the robustness floors: it goes with --design")
+    if design:
+        from mbcontrol.studies.design import DESIGNABLE
+        if controller not in DESIGNABLE:
+            raise InputError(f"--design tunes a controller for each sea: give --controller, one "
+                             f"of {', '.join(DESIGNABLE)} (got {controller})")
+
+
+def _keep_nonlinear_plant(model: str, scene, scene_key: tuple, nonlinear: str) -> None:
+    """--nonlinear invalid|always: the nonlinear plant built now (a scene that cannot have it
+    fails before any case runs) and kept for the cases."""
+    if nonlinear not in NONLINEAR_MODES:
+        raise InputError(f"--nonlinear {nonlinear}: expected one of {', '.join(NONLINEAR_MODES)}")
+    if nonlinear != "scene":
+        from ...plant import build_plant, with_nonlinear_pressure
+        keep_plant(model, scene_key, build_plant(with_nonlinear_pressure(scene)), True)
 
 
 def resolved_settings(controller, settings, vary=None, roles=None) -> dict:
@@ -175,6 +202,8 @@ def _summary(ds, seas, run, wall, n_cases) -> dict:
             row.update(seed_statistics(ds["mean_power_W"].isel(sea=k).values))
         if "bound_W" in ds:                 # --design: the sea's settings and its bound
             row.update(_designed_row(ds, k))
+        if "nonlinear_model" in ds:         # --nonlinear invalid: seas that left the range
+            row.update(_nonlinear_row(ds.isel(sea=k)))
         if "capture_width_ratio" in ds:
             row["capture_width_ratio"] = _plain(ds["capture_width_ratio"].mean("seed")
                                                 .isel(sea=k).values)
@@ -319,6 +348,15 @@ def _cases_where(ds, mask) -> list[dict]:
                     **{d: float(ds[d].values[i]) for d, i in zip(ds["valid"].dims[2:], index[2:])},
                     "reasons": str(ds["invalid_reasons"].values[index])})
     return out
+
+
+def _nonlinear_row(sea) -> dict:
+    """--nonlinear invalid, one sea: its cases run on the nonlinear plant and, where any,
+    their linear runs' mean power (W; INVALID, for comparison)."""
+    escalated = int(sea["nonlinear_model"].sum())
+    return {"nonlinear_cases": escalated,
+            "linear_mean_power_W": _plain(sea["mean_power_W__linear"].mean("seed").values)
+            if escalated else None}
 
 
 def _plain(values):

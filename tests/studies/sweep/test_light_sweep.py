@@ -4,7 +4,7 @@ import pytest
 
 from mbcontrol.sim import light
 from mbcontrol.studies.sweep import grid
-from mbcontrol.studies.sweep import runner
+from mbcontrol.studies.sweep import case_run, runner
 from mbcontrol.studies.sweep.cases import build_cases
 from mbcontrol.studies.sweep.store import CaseStore
 
@@ -114,16 +114,16 @@ def test_a_busy_machine_runs_the_sweep_here(monkeypatch):
 def test_a_process_keeps_only_its_last_plants(monkeypatch):
     """A sweep over scene parameters builds a plant per value; a worker keeps the last
     PLANTS_KEPT (cases run a plant at a time), not every one it has passed."""
-    monkeypatch.setattr(runner, "_PLANTS", {})
+    monkeypatch.setattr(case_run, "_PLANTS", {})
     built = []
     monkeypatch.setattr("mbcontrol.plant.build_plant", lambda scene: built.append(scene) or object())
     monkeypatch.setattr("mbcontrol.scene.load_scene", lambda model, params=None: (model, params))
-    keys = [(("mass", float(m)),) for m in range(runner.PLANTS_KEPT + 3)]
-    plants = [runner._plant("sphere", key) for key in keys]
-    assert len(runner._PLANTS) == runner.PLANTS_KEPT and len(built) == len(keys)
-    assert runner._plant("sphere", keys[-1]) is plants[-1] and len(built) == len(keys)
-    runner._plant("sphere", keys[0])                     # dropped long ago: built again
+    keys = [(("mass", float(m)),) for m in range(case_run.PLANTS_KEPT + 3)]
+    plants = [case_run._plant("sphere", key) for key in keys]
+    assert len(case_run._PLANTS) == case_run.PLANTS_KEPT and len(built) == len(keys)
+    assert case_run._plant("sphere", keys[-1]) is plants[-1] and len(built) == len(keys)
+    case_run._plant("sphere", keys[0])                     # dropped long ago: built again
     assert len(built) == len(keys) + 1
     mine = object()
-    runner.keep_plant("sphere", (("mass", -1.0),), mine)   # a plant the caller built
-    assert runner._plant("sphere", (("mass", -1.0),)) is mine and len(built) == len(keys) + 1
+    case_run.keep_plant("sphere", (("mass", -1.0),), mine)   # a plant the caller built
+    assert case_run._plant("sphere", (("mass", -1.0),)) is mine and len(built) == len(keys) + 1

@@ -1,0 +1,187 @@
+"""One case of a sweep: its plant (built once per process), its wave, its controller (tuned for
+its sea with --design), its run and its record. With ``--nonlinear invalid`` a sea whose linear
+run leaves the linear range is run again on the nonlinear plant (the scene with
+[hydro] hydrostatics = froude_krylov = "nonlinear"), with the same controller: the controller
+designed on the linear model, checked on the model that covers large motions."""
+from __future__ import annotations
+
+import math
+import time
+
+# The plants this process built, most recent last: cases run a plant at a time (`groups`),
+# so a few suffice, and a sweep over scene parameters (each value a plant with its compiled
+# code) does not keep every one it has passed
+PLANTS_KEPT = 4
+_PLANTS: dict = {}
+# The last light run of this process, kept until the next one has its arrays: freed at once,
+# a run's records (35 MB for rm3 over an hour) top glibc's heap and go back to the kernel, and
+# the next case faults them in again page by page (rm3: 4,300 page faults, 12 ms of 70 a case)
+_LAST_RUN: list = []
+
+
+def _plant(model: str, scene_params: tuple, nonlinear: bool = False):
+    """The plant of a model and scene parameters (with ``nonlinear``: the scene's hydro bodies
+    under the nonlinear pressure, `mbcontrol.plant.with_nonlinear_pressure`), built once
+    while it is among the last PLANTS_KEPT used in this process."""
+    key = (model, scene_params) + (("nonlinear",) if nonlinear else ())
+    if key in _PLANTS:
+        _PLANTS[key] = _PLANTS.pop(key)                 # most recent last
+    else:
+        from ...plant import build_plant, with_nonlinear_pressure
+        from ...scene import load_scene
+        scene = load_scene(model, dict(scene_params) or None)
+        _PLANTS[key] = build_plant(with_nonlinear_pressure(scene) if nonlinear else scene)
+        while len(_PLANTS) > PLANTS_KEPT:
+            _PLANTS.pop(next(iter(_PLANTS)))
+    return _PLANTS[key]
+
+
+def keep_plant(model: str, scene_params: tuple, plant, nonlinear: bool = False) -> None:
+    """Remember `plant` as the one of (model, sorted scene-parameter items[, nonlinear]) for
+    the cases run in this process (a plant the caller has already built is not built again)."""
+    key = (model, scene_params) + (("nonlinear",) if nonlinear else ())
+    _PLANTS.pop(key, None)
+    _PLANTS[key] = plant
+    while len(_PLANTS) > PLANTS_KEPT:
+        _PLANTS.pop(next(iter(_PLANTS)))
+
+
+def run_case(case) -> dict:
+    """Simulate one case in closed loop and measure it: {"case": key, "metrics": {name:
+    value} (per PTO `<pto>__<metric>` as `mbcontrol.analysis.metrics.pto_metrics`, and the
+    totals mean_power_W, mean_electrical_power_W), "valid", "invalid_reasons",
+    "wall_time_s"} (`case_record`); a case whose run raises gives a `failed_record` instead.
+    A case without a controller on a fixed-step method runs
+    through `mbcontrol.sim.light.simulate_arrays` (the arrays its metrics need, no Dataset),
+    any other through `simulate`; both give the same record to rounding.
+
+    case.nonlinear: "scene" runs the scene as it is; "always" the nonlinear plant; "invalid"
+    the linear one, then, where that run leaves the linear range (an INVALID reason whose
+    remedy is the nonlinear model), the nonlinear plant with the same controller: its record
+    is the case's, with "model": "nonlinear" and the linear run's under "linear"."""
+    params, scene_params, settings = case.resolved()
+    scene_key = tuple(sorted(scene_params.items()))
+    plant = _plant(case.model, scene_key, case.nonlinear == "always")
+    direction = None if case.direction_deg is None else math.radians(case.direction_deg)
+    wave = sea_wave(plant, case.sea, case.duration, seed=case.seed, direction=direction,
+                    amplitudes=case.amplitudes)
+    designed = None
+    start = time.perf_counter()
+    if case.design:      # tuned for this sea; settings given with --set take precedence
+        from mbcontrol.studies.design import design_for_sea
+        try:
+            designed = design_for_sea(plant, wave, case.controller, dt=case.dt,
+                                      robust=case.robust)
+        except Exception as exc:   # noqa: BLE001 - a sea the tuner cannot serve is a result
+            return failed_record(case, exc, start)
+        settings = {**designed["settings"], **settings}
+    record = _run(case, plant, wave, settings, params, start)
+    if case.nonlinear == "invalid" and _left_linear_range(record):
+        record = _escalated(case, record, scene_key, wave, settings, params)
+    if designed is not None:
+        record["design"] = designed
+    return record
+
+
+def _run(case, plant, wave, settings: dict, params: dict, start: float) -> dict:
+    import inspect
+
+    from mbcontrol.controllers import REGISTRY, make
+
+    from ...sim import can_run_light, simulate, simulate_arrays
+    controller = None
+    if case.controller:
+        cls = REGISTRY[case.controller]
+        if "wave" in inspect.signature(cls).parameters:
+            settings = {"wave": wave, **settings}
+        controller = make(case.controller, **settings)
+    try:
+        if can_run_light(plant, controller, case.method):
+            run = simulate_arrays(plant, wave, duration=case.duration, dt=case.dt,
+                                  method=case.method, params=params or None)
+            _LAST_RUN[:] = [run]     # the previous run is let go only now (see _LAST_RUN)
+        else:
+            run = simulate(plant, wave, duration=case.duration, dt=case.dt,
+                           controller=controller, method=case.method, params=params or None)
+        return case_record(case, plant, wave, run, start)
+    except Exception as exc:       # noqa: BLE001 - a case that fails is a result (see below)
+        return failed_record(case, exc, start)
+
+
+def _left_linear_range(record: dict) -> bool:
+    """Whether a record is INVALID because its motions left the linear range."""
+    from ...analysis import left_linear_range
+    return left_linear_range(record["invalid_reasons"])
+
+
+def _escalated(case, linear: dict, scene_key: tuple, wave, settings, params) -> dict:
+    """The case run again on the nonlinear plant; the linear record under "linear". A
+    nonlinear run that cannot be made keeps the linear record, with the reason added."""
+    summary = {k: linear[k] for k in ("metrics", "valid", "invalid_reasons", "wall_time_s")}
+    start = time.perf_counter()
+    try:
+        plant = _plant(case.model, scene_key, True)
+    except Exception as exc:       # noqa: BLE001 - reported in the record, as a failed run
+        record = failed_record(case, exc, start)
+    else:
+        record = _run(case, plant, wave, settings, params, start)
+    if record.get("failed"):
+        return {**linear, "model": "linear", "invalid_reasons": linear["invalid_reasons"] + [
+            f"the nonlinear plant could not run this sea ({record['failure']})"]}
+    return {**record, "model": "nonlinear", "linear": summary}
+
+
+def sea_wave(plant, sea, duration: float, *, seed: int = 0, direction: float | None = None,
+             amplitudes: str = "deterministic"):
+    """The wave a case of `sea` runs in: JONSWAP cut to the hydro data's band, seeded; its
+    direction `direction` (rad, --vary direction), else the sea's own (a seas file's
+    column), else the data's one heading, or 0. A sea with a spread is short-crested: its
+    spreading about that direction (`directional.sea_spreading`), one direction per
+    component."""
+    from ... import waves
+    from .directional import sea_spreading
+    headings = plant.hydro.data["wave_direction"].values
+    omega = plant.hydro.omega
+    if direction is None and math.isfinite(sea.direction):
+        direction = sea.direction
+    if direction is None:
+        direction = float(headings[0]) if len(headings) == 1 else 0.0
+    return waves.irregular(sea.hs, sea.tp, gamma=sea.gamma, seed=seed, duration=duration,
+                           data_band=(float(omega[0]), float(omega[-1])), direction=direction,
+                           amplitudes=amplitudes, spreading=sea_spreading(plant, sea, direction))
+
+
+def failed_record(case, exc: BaseException, start: float) -> dict:
+    """The record of a case whose run raised (a divergence, a solver that gave up, ...): no
+    metrics, not valid, `failed` with the error's type and message, so one bad sea neither
+    stops the sweep nor loses the others, and is never averaged. It is stored like any
+    record: the same case fails the same way again, so a resumed sweep does not rerun it."""
+    reason = f"{type(exc).__name__}: {exc}"
+    return {"case": case.key, "metrics": {}, "valid": False, "failed": True,
+            "failure": reason, "invalid_reasons": [f"run failed ({reason})"],
+            "wall_time_s": time.perf_counter() - start}
+
+
+def case_record(case, plant, wave, run, start: float) -> dict:
+    """A case's record from its run: `run` is a Dataset from `simulate` or a Run from
+    `simulate_arrays` (both read as run[name].values and run.attrs), `start` the
+    perf_counter at the start of its simulation. The one place a record is made: metrics
+    (every numeric entry of `pto_metrics` per PTO, `<pto>__<key>`, and the totals), the
+    validity verdict (`mbcontrol.analysis.validity.assess` on the run and its wave)."""
+    from ...analysis import pto_metrics
+    from ...analysis import assess
+    from ...results import jsonable
+    ptos = {pto.name: jsonable(pto_metrics(run, pto)) for pto in plant.scene.ptos}
+    metrics = {}
+    for pto, m in ptos.items():
+        for k, v in m.items():
+            if isinstance(v, (int, float)) and not isinstance(v, bool):
+                metrics[f"{pto}__{k}"] = float(v)
+    metrics["mean_power_W"] = sum(m["mean_power_W"] for m in ptos.values())
+    metrics["mean_electrical_power_W"] = sum(m["mean_electrical_power_W"] for m in ptos.values())
+    verdict = assess(run, plant, wave, mean_power_W=metrics["mean_power_W"])
+    return {"case": case.key, "metrics": metrics, "valid": verdict["valid"],
+            "invalid_reasons": verdict["invalid_reasons"],
+            "wall_time_s": time.perf_counter() - start}
+
+
