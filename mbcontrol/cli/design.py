@@ -146,6 +146,8 @@ def _print_design(plant, wave, result, command) -> None:
                   f"{estimator['window_start_s']:.4g} s)")
         print("    result: valid (bound, energy balance, linear-hydrodynamics range checked)"
               if result.valid else "\n".join(invalid_lines(result.invalid_reasons, "    ")))
+    if result.envelope_lifted is not None:
+        _print_lifted(result.envelope_lifted, units)
     print(f"  re-run: {command}")
 
 
@@ -157,3 +159,18 @@ def _tidy(value) -> str:
     if isinstance(value, dict):
         return "{" + ", ".join(f"{k}: {_tidy(v)}" for k, v in value.items()) + "}"
     return repr(value)
+
+
+def _print_lifted(lifted: dict, units: dict) -> None:
+    """The design with the linear model's envelope lifted, on a plant that covers large
+    motions (studies.design.envelope_gain)."""
+    used = ", ".join(f"{k} {v:.2f}" for k, v in lifted["envelope_used"].items() if v > 0) or "n/a"
+    gains = ", ".join(f"{k} = {_tidy(v)} {units.get(k, '')}" for k, v in lifted["parameters"].items()
+                      if k in ("damping", "stiffness"))
+    verdict = "valid" if lifted["valid"] else "INVALID: " + "; ".join(lifted["invalid_reasons"])
+    gain = (f" ({lifted['gain_percent']:+.1f} % against the design inside the envelope)"
+            if lifted["gain_percent"] is not None else "")
+    print(f"  envelope lifted (nonlinear hydrostatics and Froude-Krylov cover large motions): "
+          f"{gains}; simulated {_power(lifted['mean_power_W'])}{gain}; linear theory "
+          f"predicted {_power(lifted['predicted_power_W'])}")
+    print(f"    motion against the linear model's range (1 = its edge): {used}; {verdict}")

@@ -28,6 +28,11 @@ constrained power bounds, and the metrics of a closed-loop simulation on the non
 with the share of each bound it reaches. It ends with the `mbcontrol simulate` command line
 that re-runs that simulation (the parameters as --set KEY=VALUE).
 
+On a scene with nonlinear hydrostatics and Froude-Krylov forces, a passive or reactive law is
+also tuned with the linear model's envelope lifted (the PTO's limits kept) and simulated on
+that plant: how far past the linear range it goes and the power it gains or loses against
+the design inside the envelope (JSON "envelope_lifted"; null elsewhere).
+
 Example:
   mbcontrol design sphere --controller passive --wave regular --height 2.5 --period 9.6664
 """

@@ -57,6 +57,7 @@ from mbcontrol.results import jsonable
 from ...controllers import REGISTRY, make
 from ...sim import period_of
 from .tuning import CONTRACT, tune
+from .envelope_gain import lifted_envelope
 
 MAX_HARMONICS = 25            # the constrained bound's QP stays < 0.1 s (0.07 s at 15)
 SETTLE_TIME_CONSTANTS = 12      # e^-12 = 6e-6: the start-up transient left in the window
@@ -82,7 +83,9 @@ class DesignResult:
     percent_of_bound: 100 x simulated power / each bound; margins: controllers.margins.Margins
     (passive and reactive); tuner: what tuned it and what it reported; simulation: duration_s,
     dt_s and the full `mbcontrol simulate --json` summary; warnings: what the reader should
-    know (an unstable loop, a tuner without constrained tuning, ...).
+    know (an unstable loop, a tuner without constrained tuning, ...); envelope_lifted: on a
+    plant with nonlinear pressure, the same law tuned without the linear model's envelope and
+    simulated there (studies.design.envelope_gain.lifted_envelope), else None.
     """
     name: str
     pto: str
@@ -96,6 +99,7 @@ class DesignResult:
     simulation: dict | None
     warnings: list = field(default_factory=list)
     dataset: object = field(default=None, repr=False)     # the closed-loop run (xarray)
+    envelope_lifted: dict | None = None   # nonlinear pressure: envelope_gain.lifted_envelope
 
     @property
     def valid(self) -> bool | None:
@@ -118,7 +122,8 @@ class DesignResult:
                "predicted_power_W": self.predicted_power_W, "bound": self.bound,
                "metrics": self.metrics, "percent_of_bound": self.percent_of_bound,
                "margins": None if self.margins is None else self.margins.to_dict(),
-               "tuner": self.tuner, "simulation": self.simulation, "warnings": self.warnings}
+               "tuner": self.tuner, "simulation": self.simulation, "warnings": self.warnings,
+               "envelope_lifted": self.envelope_lifted}
         return jsonable(out)
 
 
@@ -212,8 +217,20 @@ def design(plant, wave, name: str, *, pto: str | None = None, simulate_s: float 
         if value is not None and kind == "bound" and value > 100 * (1 + BOUND_TOLERANCE):
             notes.append(f"the simulated power is {value:.1f} % of the {key.replace('_', '-')} "
                          f"bound: the linear theory behind the bound does not hold for this run")
+    lifted = None if not limits or metrics is None else lifted_envelope(
+        plant, wave, name, pto_obj, _as_designed(parameters, metrics, simulation),
+        duration=duration, dt=dt, score_from_s=duration - repeat if whole else None,
+        model_params=model_params)
     return DesignResult(name, pto_obj.name, parameters, predicted, bound, metrics, percent,
-                        margins, tuner, simulation, notes, ds)
+                        margins, tuner, simulation, notes, ds, lifted)
+
+
+def _as_designed(parameters, metrics, simulation) -> dict:
+    """The design inside the envelope, as `envelope_gain.lifted_envelope` compares with it."""
+    verdict = simulation["summary"]
+    return {"parameters": parameters, "mean_power_W": metrics["mean_power_W"],
+            "valid": verdict["valid"], "invalid_reasons": verdict["invalid_reasons"],
+            "excursions": verdict["validity"].get("excursions", {})}
 
 
 def _loop_checks(plant, wave, name, parameters, pto, predicted, others, tuner, notes):

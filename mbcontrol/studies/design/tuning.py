@@ -38,9 +38,12 @@ def _limit_kwargs(func, finite: dict, what: str, notes: list) -> dict:
     return taken
 
 
-def tune(plant, wave, name, pto_obj, limits, model_params, notes, robust: bool = False):
+def tune(plant, wave, name, pto_obj, limits, model_params, notes, robust: bool = False,
+         envelope: bool = True):
     """(parameters, predicted W or None, tuner info, extra controller settings). robust: a
-    reactive law within the robustness floors (controllers.robustness)."""
+    reactive law within the robustness floors (controllers.robustness); envelope: with
+    limits, a passive or reactive law also within the linear model's envelope
+    (analysis.envelope; False: the PTO's limits only, `envelope_gain.lifted_envelope`)."""
     cls = REGISTRY[name]
     pto = pto_obj.name
     scene = {"force_max": float(pto_obj.force_max), "stroke_max": float(pto_obj.stroke_max)}
@@ -64,7 +67,7 @@ def tune(plant, wave, name, pto_obj, limits, model_params, notes, robust: bool =
         return _tune_jointly(plant, wave, name, limits, model_params, own, extra)
     if name in ("passive", "reactive"):
         return _tune_linear(plant, wave, name, pto_obj, limits, model_params, notes, robust,
-                            finite=finite, own=own, extra=extra)
+                            finite=finite, own=own, extra=extra, envelope=envelope)
     if name in ("latching", "declutching"):
         return _tune_switching(plant, wave, name, pto_obj.name, model_params, notes,
                                finite=finite, own=own, extra=extra)
@@ -72,7 +75,7 @@ def tune(plant, wave, name, pto_obj, limits, model_params, notes, robust: bool =
 
 
 def _tune_linear(plant, wave, name, pto_obj, limits, model_params, notes, robust, *, finite,
-                 own, extra):
+                 own, extra, envelope: bool = True):
     """A passive or reactive law tuned for one PTO: within its limits, the linear model's
     envelope and its rated power (with limits); flagged, not refused, outside the envelope."""
     from ...controllers import optimal_damping, reactive_tuning
@@ -82,9 +85,10 @@ def _tune_linear(plant, wave, name, pto_obj, limits, model_params, notes, robust
     if pto_obj.efficiency != 1 and _accepts(tuner, "efficiency"):
         kw["efficiency"] = float(pto_obj.efficiency)    # tune for electrical power
     info = {"function": tuner.__name__, "settings": dict(kw)}
-    if limits:                # and the linear model's range (analysis.envelope)
+    if limits and envelope:   # and the linear model's range (analysis.envelope)
         kw["envelope"] = True
         info["envelope"] = {"share": ENVELOPE_SHARE, "inside": True}
+    if limits:
         if math.isfinite(pto_obj.rated_power):     # detuned to the PTO's rated power
             kw["rated_power"] = info["settings"]["rated_power"] = pto_obj.rated_power
     if robust and name == "reactive":
