@@ -60,6 +60,7 @@ bench: $(VENV)/.installed-test
 	    --out $(OUT)/bench/work_precision_rm3
 	$(PY) benchmarks/batch.py
 	$(PY) benchmarks/nonlinear_fk.py --out $(OUT)/bench/nonlinear_fk
+	$(PY) benchmarks/oes_sphere.py --out $(OUT)/bench/oes_sphere
 	$(PY) benchmarks/mathieu_spar.py --out $(OUT)/bench/mathieu
 	$(PY) benchmarks/radiation_fit.py --tols 0.1 0.05 0.02 0.01 --out $(OUT)/bench/radiation_barge
 	$(PY) benchmarks/radiation_fit.py --file models/rm3_hydro.nc --omega-max 3.0 \
