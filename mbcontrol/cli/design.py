@@ -170,6 +170,9 @@ def _print_lifted(lifted: dict, units: dict) -> None:
     verdict = "valid" if lifted["valid"] else "INVALID: " + "; ".join(lifted["invalid_reasons"])
     gain = (f" ({lifted['gain_percent']:+.1f} % against the design inside the envelope)"
             if lifted["gain_percent"] is not None else "")
+    if lifted["mean_power_W"] is None:
+        print(f"  envelope lifted: {'; '.join(lifted['invalid_reasons'])}")
+        return
     print(f"  envelope lifted (nonlinear hydrostatics and Froude-Krylov cover large motions): "
           f"{gains}; simulated {_power(lifted['mean_power_W'])}{gain}; linear theory "
           f"predicted {_power(lifted['predicted_power_W'])}")

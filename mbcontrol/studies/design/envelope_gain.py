@@ -52,8 +52,14 @@ def lifted_envelope(plant, wave, name: str, pto_obj, design: dict, *, duration: 
     from mbcontrol.sim import simulate
 
     from .tuning import tune
-    parameters, predicted, _, extra = tune(plant, wave, name, pto_obj, True, model_params, [],
-                                           envelope=False)
+    try:
+        parameters, predicted, _, extra = tune(plant, wave, name, pto_obj, True, model_params,
+                                               [], envelope=False)
+    except ValueError as exc:          # the tuner cannot serve this sea without the envelope
+        return {"parameters": {}, "predicted_power_W": None, "binds": None,
+                "mean_power_W": None, "valid": False,
+                "invalid_reasons": [f"not tuned without the envelope: {exc}"],
+                "envelope_used": {}, "gain_W": None, "gain_percent": None}
     binds = any(abs(parameters.get(k, 0.0) - design["parameters"].get(k, 0.0))
                 > 1e-9 * max(1.0, abs(design["parameters"].get(k, 0.0)))
                 for k in ("damping", "stiffness"))
