@@ -18,7 +18,9 @@ arguments once per block), 8 points 25 ns, 32 points 29 ns; MX elementwise opera
 points 41 ns. A 1,048-point sphere at 9 x 10: 33 ns a point, of which 11 ns is the floor of
 the hydrostatic pressure alone (the transform, the sums and the map's copies). Skipping blocks
 above the surface (a short-circuit branch per block) saved nothing measurable: the test of
-each block's elevation costs about what the skipped series would. The last block is padded
+each block's elevation costs about what the skipped series would. A hand-written C loop over
+the points with the series unrolled, vectorised by gcc with the same flags, took 40 ns a point
+(1,048 points, 9 x 10): no faster. The last block is padded
 with points of zero weight, which add nothing. Benchmarks: benchmarks/nonlinear_fk.py.
 """
 from __future__ import annotations
