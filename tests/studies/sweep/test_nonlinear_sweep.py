@@ -9,6 +9,7 @@ change) and the sweep of the scene with the nonlinear pair itself (--nonlinear a
 """
 from __future__ import annotations
 
+import dataclasses
 import json
 import subprocess
 import sys
@@ -64,13 +65,12 @@ def test_the_escalated_sea_is_the_nonlinear_plants_own_run(sweeps):
         float(linear["mean_power_W"].isel(sea=0, seed=0)), rel=0.03)
 
 
-def test_a_scene_without_surfaces_is_refused_before_any_case_runs(tmp_path):
-    scene = load_scene("rm3")
-    bare = [b.name for b in scene.bodies if b.hydro and b.geometry is None]
-    if not bare:
-        pytest.skip("rm3's bodies all carry geometry")
-    with pytest.raises(SceneError, match=f"body '{bare[0]}'.*geometry"):
-        with_nonlinear_pressure(scene)
+def test_a_scene_without_surfaces_is_refused_naming_the_body():
+    sphere = load_scene("sphere")               # its body without [body.geometry]
+    bare = dataclasses.replace(sphere, bodies=tuple(dataclasses.replace(b, geometry=None)
+                                                    for b in sphere.bodies))
+    with pytest.raises(SceneError, match="body 'sphere'.*geometry"):
+        with_nonlinear_pressure(bare)
 
 
 def test_cli_flag_and_json_contract(tmp_path):
