@@ -76,8 +76,9 @@ def run_case(case) -> dict:
             return failed_record(case, exc, start)
         settings = {**designed["settings"], **settings}
     record = _run(case, plant, wave, settings, params, start)
-    if case.nonlinear == "invalid" and _left_linear_range(record):
-        record = _escalated(case, record, scene_key, wave, settings, params)
+    if case.nonlinear == "invalid":    # every record says which model made it
+        record = _escalated(case, record, scene_key, wave, settings, params) \
+            if _left_linear_range(record) else {**record, "model": "linear"}
     if designed is not None:
         record["design"] = designed
     return record

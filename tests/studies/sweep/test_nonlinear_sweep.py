@@ -48,6 +48,9 @@ def test_only_the_sea_that_leaves_the_linear_range_runs_nonlinear(sweeps):
     assert rows[1]["linear_mean_power_W"] == pytest.approx(
         float(linear["mean_power_W__unchecked"].isel(sea=1, seed=0)), rel=1e-12)
     assert summary["provenance"]["nonlinear"] == "invalid"
+    # the JSON keys are there when no sea leaves the range too
+    _, calm = sweep("sphere", grid([2.0], [9.0]), nonlinear="invalid", **RUN)
+    assert calm["seas"][0]["nonlinear_cases"] == 0 and calm["seas"][0]["linear_mean_power_W"] is None
 
 
 def test_the_escalated_sea_is_the_nonlinear_plants_own_run(sweeps):
