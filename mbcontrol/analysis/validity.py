@@ -338,7 +338,9 @@ def _field_ranges(ds, verdict: dict) -> None:
             verdict["invalid_reasons"].append(
                 f"body {body!r} left the region its nonlinear incident field covers ({used:.3g} "
                 f"of it): the Froude-Krylov series held their edge values there{REMEDY}a larger "
-                f"[hydro] nonlinear_reach (the horizontal excursion and sinking the field covers)")
+                f"[hydro] nonlinear_reach (the horizontal excursion and sinking the field covers), "
+                f"or an end stop on a joint whose body swings into the sea bed (the field ends "
+                f"there)")
 
 
 def _window_check(window: dict) -> dict:
