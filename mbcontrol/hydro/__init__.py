@@ -41,7 +41,7 @@ from .fit.ssforms import state_blocks
 from .mesh.large_angle import buoyancy
 from .mesh.large_angle import potential as buoyancy_potential
 from .mesh.panels import Panels, body_panels, hydrostatic_pressure, pressure_wrench
-from .mesh.surface_sums import calm_water_function, largest_function, pressure_wrench_function
+from .mesh.surface_sums import calm_water_function, pressure_wrench_function
 from .mesh.axisymmetric import AxisymmetricFK
 from .mesh.axisymmetric import from_geometry as axisymmetric_fk
 from .model import FITS_SERVED, obstacle_bodies, shipped_fits_dir
@@ -58,7 +58,7 @@ __all__ = [
     "HydroModel", "load_hydro_model", "load_hydro_data", "fit_hydro_model", "fit_method", "geometry_dict",
     "compute_isolated", "SECTOR_SIGMAS", "Device", "response_error_on", "state_blocks", "buoyancy",
     "buoyancy_potential", "Panels", "body_panels", "hydrostatic_pressure", "pressure_wrench",
-    "pressure_wrench_function", "calm_water_function", "largest_function",
+    "pressure_wrench_function", "calm_water_function",
     "AxisymmetricFK", "axisymmetric_fk",
     "FITS_SERVED", "obstacle_bodies", "shipped_fits_dir", "converted_source",
 ]

@@ -15,6 +15,7 @@ from .catenary import CatenarySolution, solve_catenary
 from .catenary_line import CatenaryLine, catenary_line
 from .fidelity import Fidelity, FidelityError, has_couplings, plant_for
 from .freeze import as_wave_list
+from .held_pressure import stage_load
 from .jacobians import jacobians
 from .mechanical import MechanicalMatrices, dof_selector, mechanical_matrices
 from .nonlinear import with_nonlinear_pressure
@@ -28,4 +29,5 @@ __all__ = ["build_plant", "ProcessPlant", "active_hydro_dofs", "dof_selector", "
            "Fidelity", "FidelityError", "plant_for", "CatenaryLine", "CatenarySolution",
            "catenary_line", "solve_catenary", "provenance", "MechanicalMatrices", "mechanical_matrices",
            "device_around", "linear_params", "controlled_params", "response_error_of",
-           "derived", "has_couplings", "as_wave_list", "f_by_parts", "with_nonlinear_pressure"]
+           "derived", "has_couplings", "as_wave_list", "f_by_parts", "with_nonlinear_pressure",
+           "stage_load"]

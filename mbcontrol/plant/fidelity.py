@@ -307,5 +307,5 @@ def linearised_plant(plant: ProcessPlant) -> ProcessPlant:
         gradient = ca.Function("g", [p], [Jy[plant.outputs.index("energy"), :plant.nx]])
         notes["energy_gradient_at_rest"] = float(np.max(np.abs(np.asarray(gradient(plant.p0))),
                                                         initial=0.0))
-    return dataclasses.replace(plant, f=f_fun, h=h_fun, notes=notes, parts=None)
+    return dataclasses.replace(plant, f=f_fun, h=h_fun, notes=notes, parts=None, held=None)
 

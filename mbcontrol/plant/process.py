@@ -20,10 +20,12 @@ from ..hydro import Device, HydroModel, RadiationModel, load_hydro_model
 from ..multibody import Topology, build_topology
 from ..scene import DOF_NAMES, Scene, load_scene
 from . import checks, loads, nonlinear
+from .held_pressure import HeldPressure, held_pressure
 from .mechanical import dof_selector, mechanical_matrices
 from .ownership import linear_params
 from .pieces import plant_parts
 from .rest import preloads
+from .units import DRIVETRAIN_SIGNALS, drivetrain_signals, signal_unit
 
 
 @dataclass(frozen=True, eq=False)      # identity semantics: derived data is kept per plant
@@ -45,6 +47,8 @@ class ProcessPlant:
     # nonlinear hydrostatics and Froude-Krylov bodies (module plant.nonlinear); their field
     # rows follow the excitation in w
     pressure: tuple = field(default=(), repr=False)
+    # [hydro] nonlinear_update = "step": f with the pressure load held (module plant.held_pressure)
+    held: HeldPressure | None = field(default=None, repr=False)
     # derived data and compiled code, freed with the plant (module plant.workspace)
     workspace: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
@@ -57,7 +61,7 @@ class ProcessPlant:
 
     def units(self, signal: str) -> str:
         """SI unit of a named state, input, disturbance or output."""
-        return _units(self, signal)
+        return signal_unit(self, signal)
 
     @property
     def nx(self) -> int:
@@ -149,23 +153,31 @@ def assemble_plant(scene: Scene | str, hydro: HydroModel | None = None, *,
     tau = -tree.bias(q, s, added_mass)
     if hydro_force is not None:
         tau += hydro_force
-    tau, potential, pto_signals, tensions, (wave_power, ranges) = _body_loads(
-        tau, scene, topo, hydro, (q, s, u, w[n_w:]), params, pressure)
+    slot = ca.SX.sym("tau_p", tree.n_s)    # the hydrostatic (pressure) load's place in tau
+    tau, potential, pto_signals, tensions, (wave_power, ranges), restoring = _body_loads(
+        tau, scene, topo, hydro, (q, s, u, w[n_w:], slot), params, pressure)
     power["excitation_power"] += wave_power
-    extra, balance = preloads(scene, topo, (q, s, u, w, chi, tau), pto_signals, params,
+    # f sums each surface for its wrench alone; the outputs (restoring) also for its range
+    load = nonlinear.pressure_load(scene, topo, q, w[n_w:], pressure) if pressure else restoring
+    tau_full = ca.substitute(tau, slot, load)
+    extra, balance = preloads(scene, topo, (q, s, u, w, chi, tau_full), pto_signals, params,
                               hydro.buoyancy(scene.water) if hydro else {})
-    tau += extra
+    tau, tau_full = tau + extra, tau_full + extra
 
     M = tree.mass_matrix(q, added_mass)
-    notes = checks.rest_checks(scene, topo, q, s, u, w, chi, tau, M, params)
+    notes = checks.rest_checks(scene, topo, q, s, u, w, chi, tau_full, M, params)
     notes["rest_balance"] = balance        # weight against buoyancy, what preloads hold (plant.rest)
-    s_dot = ca.solve(M, tau)
     x = ca.vertcat(q, s, chi)
-    x_dot = ca.vertcat(ca.mtimes(tree.K(q), s), s_dot, chi_dot)
+    x_dot_slot = ca.vertcat(ca.mtimes(tree.K(q), s), ca.solve(M, tau), chi_dot)
+    x_dot = ca.substitute(x_dot_slot, slot, load)
     kinetic = 0.5 * ca.mtimes([s.T, M, s])
     power["energy"] = kinetic + potential
-    y, output_names = _outputs(scene, topo, q, s, pto_signals, power, tensions, s_dot, ranges)
+    y, output_names = _outputs(scene, topo, q, s, pto_signals, power, tensions,
+                               x_dot_slot[tree.n_q:tree.n_q + tree.n_s], ranges)
+    y = ca.substitute(y, slot, restoring)
     p = params.vector
+    held = held_pressure([x, u, w, p], q, slot, x_dot_slot, load) \
+        if pressure and scene.hydro.nonlinear_update == "step" else None
 
     coords = list(tree.coordinate_names)
     states = coords + [f"{c}__vel" for c in coords] + [f"radiation_{i}" for i in range(n_r)]
@@ -175,8 +187,8 @@ def assemble_plant(scene: Scene | str, hydro: HydroModel | None = None, *,
     h = ca.Function("h", [x, u, w, p], [y], ["x", "u", "w", "p"], ["y"])
     return ProcessPlant(scene, topo, hydro, tuple(states), tuple(inputs), tuple(disturbances),
                         tuple(output_names), tuple(params.names), np.array(params.values),
-                        f, h, notes, plant_parts([x, u, w, p], M, tau, x_dot[:tree.n_q], chi_dot,
-                                                 radiation_apart), pressure)
+                        f, h, notes, plant_parts([x, u, w, p], M, tau_full, x_dot[:tree.n_q],
+                                                 chi_dot, radiation_apart), pressure, held)
 
 
 def _hydro_loads(hydro, radiation, scale, select, P, s, w, chi):
@@ -206,12 +218,13 @@ def _hydro_loads(hydro, radiation, scale, select, P, s, w, chi):
 
 
 def _body_loads(tau, scene, topo, hydro, symbols, params, pressure):
-    """tau plus hydrostatics, PTOs, friction, drag, moorings, end stops, gravity, static loads
-    (in this order: the compiled code stays the same); the potential (J: hydrostatic with the
-    static loads' own, drivetrain springs, moorings, end stops, gravity), PTO signals, mooring
-    tensions, and (the power of the nonlinear incident pressure beyond calm water's, W; the
-    bodies' field ranges, plant.nonlinear.field_range)."""
-    q, s, u, rows = symbols
+    """tau plus the symbol `slot` in the hydrostatic load's place, PTOs, friction, drag,
+    moorings, end stops, gravity, static loads (in this order: the compiled code stays the
+    same); the potential (J: hydrostatic with the static loads' own, drivetrain springs,
+    moorings, end stops, gravity), PTO signals, mooring tensions, (the power of the nonlinear
+    incident pressure beyond calm water's, W; the bodies' field ranges,
+    plant.nonlinear.field_range), and the hydrostatic load that `slot` stands for."""
+    q, s, u, rows, slot = symbols
     wave = (0, {})
     if scene.hydro.hydrostatics == "nonlinear":
         restoring, potential, *wave = nonlinear.pressure_loads(scene, topo, q, s, rows, pressure)
@@ -220,7 +233,7 @@ def _body_loads(tau, scene, topo, hydro, symbols, params, pressure):
     else:
         restoring, potential = loads.restoring_forces(topo, q, hydro.stiffness_by_body() if hydro
                                                       else {})
-    tau += restoring
+    tau += slot
     tau_pto, pto_signals = loads.pto_forces(scene, topo, q, s, u, params)
     tau += tau_pto + loads.friction_forces(scene, topo, s, params)
     potential += loads.drivetrain_spring_energy(scene, pto_signals)
@@ -237,7 +250,7 @@ def _body_loads(tau, scene, topo, hydro, symbols, params, pressure):
                                                        if hydro else {})
         tau += tau_static
         potential += static_energy
-    return tau, potential, pto_signals, tensions, wave
+    return tau, potential, pto_signals, tensions, wave, restoring
 
 
 def _hydro_scales(params, dofs) -> dict:
@@ -298,74 +311,6 @@ def _outputs(scene, topo: Topology, q, s, pto_signals, power, tensions, s_dot, r
     values += list(ranges.values())        # "<body>__field_range" (plant.nonlinear.field_range)
     names += list(ranges)
     return ca.vertcat(*values), names
-
-
-_BODY_UNITS = {"Surge": ("m", "N"), "Sway": ("m", "N"), "Heave": ("m", "N"),
-               "Roll": ("rad", "N m"), "Pitch": ("rad", "N m"), "Yaw": ("rad", "N m")}
-_ENERGY_UNITS = {"radiated_power": "W", "excitation_power": "W", "energy": "J"}
-
-
-DRIVETRAIN_SIGNALS = {"current": "A", "voltage": "V", "winding_loss": "W", "friction_loss": "W",
-                      "electrical_power": "W", "mechanical_power": "W",
-                      "hull_force": "force"}   # N or N m, as the PTO's force
-
-
-def drivetrain_signals(d, x, v, force, acceleration) -> list:
-    """A drivetrain's signals (DRIVETRAIN_SIGNALS, in order) from the PTO position x and
-    velocity v, the machine's force (the PTO force) and the PTO acceleration a: current
-    F / (gear kt'), voltage R I + kt' gear v (a current-controlled drive; the inductive
-    L dI/dt, whose mean power is zero, is left out), winding loss R I^2, friction loss
-    gear^2 b v^2, electrical power delivered -F v - R I^2, and the mechanical power the joint
-    puts in, -(F - gear^2 (J a + b v + K x)) v = electrical + losses + d/dt(gear^2 (J v^2 +
-    K x^2) / 2) (the shaft spring's part has mean zero over a periodic motion), and the force
-    on the hull F - gear^2 (J a + b v + K x) (what force_max_on = "hull" limits)."""
-    current = force / d.force_per_current
-    winding = d.winding_resistance * current ** 2
-    friction = d.gear_ratio ** 2 * d.friction * v * v
-    shaft = d.gear_ratio ** 2 * (d.inertia * acceleration + d.friction * v + d.stiffness * x)
-    return [current, d.winding_resistance * current + d.kt * d.gear_ratio * v, winding,
-            friction, -force * v - winding, -(force - shaft) * v, force - shaft]
-
-
-def _coordinate_unit(plant, name: str) -> str:
-    """rad for rotations, m for translations, from the joint that owns the coordinate."""
-    for joint in plant.scene.joints:
-        if name == joint.name:
-            if joint.type == "free":
-                return _BODY_UNITS[joint.dofs[0]][0]
-            return "rad" if joint.type == "revolute" else "m"
-        if name.startswith(joint.name + "__"):
-            return _BODY_UNITS[name.split("__")[-1]][0]
-    return ""
-
-
-def _units(plant, signal: str) -> str:
-    if signal in _ENERGY_UNITS:
-        return _ENERGY_UNITS[signal]
-    if signal.startswith("radiation_") or signal.startswith("w__field_"):
-        return "internal"
-    if signal.endswith("__field_range"):
-        return "1"
-    if signal.startswith("w__"):
-        return _BODY_UNITS[signal.split("__")[-1]][1]
-    base = signal[3:] if signal.startswith("u__") else signal
-    for pto in plant.scene.ptos:
-        if base == pto.name or base.startswith(pto.name + "__"):
-            coord = "m" if pto.between_points else _coordinate_unit(plant, pto.joint)
-            force = "N m" if coord == "rad" else "N"
-            kind = "force" if base == pto.name else base.split("__")[-1]
-            return {"position": coord, "velocity": f"{coord}/s", "power": "W",
-                    **DRIVETRAIN_SIGNALS, "force": force, "hull_force": force}[kind]
-    if signal.endswith("__tension"):
-        return "N"
-    if signal.endswith(("__span", "__height")):
-        return "m"
-    if signal.endswith("__vel"):
-        return f"{_coordinate_unit(plant, signal[:-5])}/s"
-    if "__" in signal and signal.split("__")[-1] in _BODY_UNITS and \
-            signal.split("__")[0] in plant.topology.bodies:
-        return _BODY_UNITS[signal.split("__")[-1]][0]
-    return _coordinate_unit(plant, signal)
 
 
 def device_around(scene, source: str, data, dofs) -> Device:

@@ -262,6 +262,9 @@ class HydroSettings:
     nonlinear_direction: float = 0.0           # rad: the sea's direction the field is built for
     nonlinear_omega_max: float | None = None   # rad/s: components above it stay linear (None:
                                                # response_band's top, else 4 rad/s)
+    nonlinear_update: str = "stage"            # "stage": the pressure integral at every
+                                               # Runge-Kutta stage; "step": once per step
+                                               # (mbcontrol.plant.held_pressure)
     axisymmetric: bool = False                 # bodies of revolution on the z axis, in heave:
                                                # one heading's excitation serves every direction
 

@@ -281,7 +281,7 @@ def _hydro(r: Reader, path: Path) -> HydroSettings:
             "source", "source_bodies", "source_options", "fit_omega_max", "response_band", "interaction",
             "interaction_radius", "hydrostatics", "radiation_fit", "fit_judged_by", "axisymmetric",
             "froude_krylov", "nonlinear_path", "nonlinear_panel_size", "nonlinear_reach",
-            "nonlinear_direction", "nonlinear_omega_max")
+            "nonlinear_direction", "nonlinear_omega_max", "nonlinear_update")
     band = r.finite_list("response_band", "frequency", default=()) or None
     if band is not None and not (len(band) == 2 and 0 <= band[0] < band[1]):
         r.fail("response_band", f"expected [low, high] in rad/s with 0 <= low < high, got {band}")
@@ -326,7 +326,11 @@ def _nonlinear(r: Reader) -> dict:
                                if "nonlinear_reach" in r.data else None),
            "nonlinear_direction": r.finite("nonlinear_direction", "angle", default=0.0),
            "nonlinear_omega_max": (r.positive("nonlinear_omega_max", "frequency")
-                                   if "nonlinear_omega_max" in r.data else None)}
+                                   if "nonlinear_omega_max" in r.data else None),
+           "nonlinear_update": r.choice("nonlinear_update", ("stage", "step"), default="stage")}
+    if out["nonlinear_update"] != "stage" and out["hydrostatics"] != "nonlinear":
+        r.fail("nonlinear_update", "expected hydrostatics = \"nonlinear\" with it: it sets how "
+               "often the nonlinear pressure is integrated, and this scene has none")
     if out["froude_krylov"] == "nonlinear" and out["hydrostatics"] != "nonlinear":
         r.fail("froude_krylov", "expected hydrostatics = \"nonlinear\" with it: the incident "
                "pressure and the buoyancy are one pressure over one wetted surface, and either "

@@ -23,7 +23,7 @@ import casadi as ca
 import numpy as np
 
 from ..errors import InputError
-from ..plant import derived, f_by_parts
+from ..plant import derived, f_by_parts, stage_load
 from .compiled import compile_function
 from .methods import METHODS, method, radiation_exponential, radiation_split
 from .protocol import parametric_law
@@ -89,6 +89,22 @@ def _held_input(plant, law, x, u, W, p):
     return law(y) if law.n_in() == 1 else law(y, p[n:])
 
 
+def _stage_function(plant, x, u, W, p, column):
+    """f(xs, c): the plant's x' at a stage state xs and node c of the step from x. With
+    [hydro] nonlinear_update = "step" the pressure load is evaluated once, at the step's start,
+    and moved to the other stages by its rest increments (module plant.held_pressure)."""
+    held = getattr(plant, "held", None)     # a ProcessPlant's, else none
+    if held is not None:
+        n_q = plant.n_q
+        load0 = held.load(x[:n_q], W[:, 0])
+        return lambda xs, c: held.f(xs, u, W[:, column[c]], p, stage_load(
+            held, x[:n_q], W[:, 0], load0, xs[:n_q], W[:, column[c]]))
+    # MX symbols (a large plant): f is called, not inlined, and called in its parts, so that
+    # gcc compiles four moderate functions instead of one long one (module plant.pieces)
+    plant_f = f_by_parts(plant) if isinstance(x, ca.MX) else plant.f
+    return lambda xs, c: plant_f(xs, u, W[:, column[c]], p)
+
+
 def step_function(plant, method_name: str = "rk4", law=None) -> ca.Function:
     """One fixed step (x, u, W, p, h, *extras) -> (x_next, u_applied).
 
@@ -104,12 +120,7 @@ def step_function(plant, method_name: str = "rk4", law=None) -> ca.Function:
     u_held = _held_input(plant, law, x, u, W, p)
     column = {c: i for i, c in enumerate(tab.nodes)}
     p_plant = p[:len(plant.p0)]
-    # MX symbols (a large plant): f is called, not inlined, and called in its parts, so that
-    # gcc compiles four moderate functions instead of one long one (module plant.pieces)
-    plant_f = f_by_parts(plant) if isinstance(x, ca.MX) else plant.f
-
-    def f(xs, c):
-        return plant_f(xs, u_held, W[:, column[c]], p_plant)
+    f = _stage_function(plant, x, u_held, W, p_plant, column)
 
     if m.kind == "explicit":
         k, zero = [], type(x)(0)
@@ -232,12 +243,13 @@ def excitation_at_nodes(plant, wave, n: int, dt: float, nodes) -> np.ndarray:
 
 
 def run_fixed_step(plant, x0, U, W_nodes, p, dt, method_name="rk4", law=None, compiled=True,
-                   on_chunk=None):
+                   *, on_chunk=None, alongside=None):
     """Integrate n steps; returns states (n+1, nx) and the inputs actually applied (n, nu).
 
     U: (n, nu) inputs held over each step (ignored with a law); W_nodes: (n, n_nodes, nw)
     excitation at the method's nodes. `on_chunk(i_end, X)` is called after each chunk
-    (progress, checks) and may raise to stop.
+    (progress, checks) and may raise to stop; then `alongside.advance` (sim.alongside: the
+    outputs of the finished steps, on a second core).
     """
     n, nu, nx = U.shape[0], len(plant.inputs), plant.nx
     length = chunk_length(n)
@@ -281,34 +293,49 @@ def run_fixed_step(plant, x0, U, W_nodes, p, dt, method_name="rk4", law=None, co
             X[start + 1:stop + 1], U_applied[start:stop] = X_out[:m], U_out[:m]
         if on_chunk is not None:
             on_chunk(stop, X[:stop + 1])
+        if alongside is not None:
+            alongside.advance(stop, X, U_applied, W_nodes[:, 0])
     return X, U_applied
 
 
 def outputs(plant, X, U, W, p, compiled=True) -> np.ndarray:
     """Plant outputs y_i = h(x_i, u_i, w_i, p) for every row, in compiled chunks (bounded memory).
 
-    X (n, nx), U (n, nu), W (n, nw); returns (n, ny).
+    X (n, nx), U (n, nu), W (n, nw); returns (n, ny). (sim.alongside evaluates the same blocks
+    on a second core while a run steps.)
     """
     n = X.shape[0]
     length = chunk_length(n)
-    fun = derived(plant, ("sim.outputs", compiled, length),
-                  lambda: _output_map(plant, compiled, length))
-    Y = np.empty((n, len(plant.outputs)))
-    buffer, _ = fun.buffer()
+    buffer, _ = output_function(plant, compiled, length).buffer()
     p = np.ascontiguousarray(p, dtype=float)
-    buffer.set_arg(3, memoryview(p))
+    Y = np.empty((n, len(plant.outputs)))
     for start in range(0, n, length):
         stop = min(start + length, n)
-        blocks = [np.zeros((length, a.shape[1])) for a in (X, U, W)]
-        for block, a in zip(blocks, (X, U, W)):
-            block[:stop - start] = a[start:stop]
-        out = np.empty((length, len(plant.outputs)))
-        for i, block in enumerate(blocks):
-            buffer.set_arg(i, memoryview(block))
-        buffer.set_res(0, memoryview(out))
-        buffer._eval()
-        Y[start:stop] = out[:stop - start]
+        output_block(buffer, p, X[start:stop], U[start:stop], W[start:stop], Y[start:stop],
+                     length)
     return Y
+
+
+def output_function(plant, compiled: bool, length: int) -> ca.Function:
+    """The compiled map of h over `length` samples (x, u, w columns; p shared), built once."""
+    return derived(plant, ("sim.outputs", compiled, length),
+                   lambda: _output_map(plant, compiled, length))
+
+
+def output_block(buffer, p, X, U, W, Y, length: int) -> None:
+    """Y[:] = h over the rows of X, U, W (at most `length`), through a FunctionBuffer of
+    output_function(..., length): the rows padded to the map's length."""
+    rows = X.shape[0]
+    blocks = [np.zeros((length, a.shape[1])) for a in (X, U, W)]
+    for block, a in zip(blocks, (X, U, W)):
+        block[:rows] = a
+    out = np.empty((length, Y.shape[1]))
+    for i, block in enumerate(blocks):
+        buffer.set_arg(i, memoryview(block))
+    buffer.set_arg(3, memoryview(p))
+    buffer.set_res(0, memoryview(out))
+    buffer._eval()
+    Y[:] = out[:rows]
 
 
 def _output_map(plant, compiled: bool, length: int) -> ca.Function:

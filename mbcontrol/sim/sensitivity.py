@@ -56,4 +56,4 @@ def sensitivity_plant(plant, names, outputs):
     outs = plant.outputs + tuple(sensitivity_name(o, n) for n in names for o in outputs)
     notes = {**plant.notes, "sensitivities": {"parameters": list(names), "outputs": list(outputs)}}
     return dataclasses.replace(plant, states=states, outputs=outs, f=f_aug, h=h_aug, notes=notes,
-                               parts=None)
+                               parts=None, held=None)

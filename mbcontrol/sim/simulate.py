@@ -7,7 +7,7 @@ its period; a controller that offers a CasADi law with period dt runs inside com
 
 Every run is audited before its result is returned: a non-finite or absurd state (checked
 during the run, chunk by chunk) or a mechanical energy beyond what the waves and PTOs put in
-raises SimulationError naming the time, the step and a remedy.
+(sim.audit) raises SimulationError naming the time, the step and a remedy.
 """
 from __future__ import annotations
 
@@ -26,6 +26,8 @@ from ..errors import InputError, SimulationError
 from ..plant import controlled_params, provenance
 from ..results import jsonable
 from . import diagnose, integrators, sampled
+from .alongside import OutputsAlongside
+from .audit import diverged, energy_audit, energy_budget  # noqa: F401 (energy_budget: re-exported)
 from .held import HeldStepper
 from .methods import time_steps
 from .moorings import mooring_report
@@ -46,8 +48,9 @@ def simulate(plant, wave=None, *, duration: float, dt: float | None = None, cont
     `energy_audit`). Returns a Dataset over time with every plant output, the applied
     inputs u, the excitation w, the wave elevation `eta` and the states, plus provenance in
     attrs: wall_time_s is the excitation synthesis and the time-stepping (compilation and
-    the output evaluation excluded; output_time_s is the latter). A controller with a period
-    and a static law has its held loop checked first (sim.sampled: a RuntimeWarning when
+    the output evaluation excluded; output_time_s is the latter: on two cores most of it runs
+    alongside the steps, sim.alongside, and output_time_s is what remained after them). A
+    controller with a period and a static law has its held loop checked first (sim.sampled: a RuntimeWarning when
     unstable; the verdict in attrs["sampled_loop"], which analysis.validity reads).
     """
     dt, method = defaults.resolve("sim.dt", dt), defaults.resolve("sim.method", method)
@@ -72,18 +75,25 @@ def simulate(plant, wave=None, *, duration: float, dt: float | None = None, cont
     # gains (when it offers them as parameters) at the end of p: new gains, no new code
     law, gains = integrators.embedded_law(controller, plant) if spec.fixed_step else (None, None)
     embedded = controller is None or (law is not None and _period(controller, dt) == dt)
+    alongside = None
     if spec.fixed_step:                  # compile first: wall_time_s excludes it
         steps = n if embedded else _steps_per_period(_period(controller, dt), dt)
         integrators.prepare(plant, steps, method, law if embedded else None, compiled)
+        alongside = OutputsAlongside(plant, n + 1, p, compiled)
     start = time.perf_counter()
-    if spec.fixed_step:
-        W_nodes = integrators.excitation_at_nodes(plant, wave, n, dt, spec.nodes)
-        p_run = np.concatenate([p, gains]) if embedded and gains is not None else p
-        X, U = _run_fixed(plant, method, controller, x0, W_nodes, p_run, dt=dt, n=n,
-                          law=law if embedded else None, embedded=embedded, compiled=compiled,
-                          check=check)
-    else:
-        X, U = _run_cvodes(plant, wave, controller, x0, p, dt, n, rtol, check, method)
+    try:
+        if spec.fixed_step:
+            W_nodes = integrators.excitation_at_nodes(plant, wave, n, dt, spec.nodes)
+            p_run = np.concatenate([p, gains]) if embedded and gains is not None else p
+            X, U = _run_fixed(plant, method, controller, x0, W_nodes, p_run, dt=dt, n=n,
+                              law=law if embedded else None, embedded=embedded,
+                              compiled=compiled, check=check, alongside=alongside)
+        else:
+            X, U = _run_cvodes(plant, wave, controller, x0, p, dt, n, rtol, check, method)
+    except BaseException:
+        if alongside is not None:
+            alongside.close(errors=False)
+        raise
     wall = time.perf_counter() - start
     if bar is not None:
         bar.close()
@@ -96,7 +106,8 @@ def simulate(plant, wave=None, *, duration: float, dt: float | None = None, cont
     else:
         W = plant.excitation(wave, t)
     U_full = np.vstack([U, _last_command(plant, controller, t[-1], X[-1], U, W[-1], p)])
-    Y = integrators.outputs(plant, X, U_full, W, p, compiled=compiled)
+    Y = alongside.finish(X, U_full, W) if alongside is not None \
+        else integrators.outputs(plant, X, U_full, W, p, compiled=compiled)
     output_wall = time.perf_counter() - start
     if audit:
         energy_audit(plant, t, Y, method, dt, why)
@@ -113,75 +124,6 @@ def simulate(plant, wave=None, *, duration: float, dt: float | None = None, cont
     if loop is not None:                 # analysis.validity reads it
         ds.attrs["sampled_loop"] = copy.deepcopy(loop)
     return ds
-
-
-ENERGY_MARGIN = 2.0     # a run may not end up with more than twice the energy put in
-
-
-def energy_budget(plant, t, Y):
-    """(E - E_0, W_in) per sample (J): the mechanical energy gained, and the work the waves and
-    the PTOs put in, W_in = int (P_exc + sum max(0, -P_pto)) dt (trapezoid).
-
-    Radiation (passive, starting at rest), friction, drag and mooring damping only remove
-    energy, so a faithful solution has E - E_0 <= W_in (up to its integration error).
-    None when the plant has a catenary mooring (its energy is not in the plant's audit).
-    """
-    col = {name: i for i, name in enumerate(plant.outputs)}
-    if "energy" not in col or any(m.kind == "catenary" for m in plant.scene.moorings):
-        return None        # a catenary's elastic and gravity energy is not in the audit
-    power_in = Y[:, col["excitation_power"]].copy()
-    for pto in plant.scene.ptos:
-        power_in += np.maximum(0.0, -Y[:, col[f"{pto.name}__power"]])
-    work = np.concatenate([[0.0], np.cumsum(0.5 * (power_in[1:] + power_in[:-1])
-                                             * np.diff(t))])
-    return Y[:, col["energy"]] - Y[0, col["energy"]], work
-
-
-def energy_audit(plant, t, Y, method: str, dt: float, why=None) -> None:
-    """Raise SimulationError at the first sample whose energy gain exceeds ENERGY_MARGIN times
-    the work put in so far (plus a floor: 5 % of the record's input, half the initial
-    energy), or whose outputs are not finite: the signature of an unstable step or of an
-    unstable closed loop. why: the closed-loop diagnosis (sim.diagnose.explainer; None: the
-    step is blamed); the error's `t_fail` attribute is the time, s.
-    """
-    bad = np.flatnonzero(~np.isfinite(Y).all(axis=1))
-    budget = energy_budget(plant, t, Y)
-    if budget is not None:
-        gain, work = budget
-        energy0 = abs(Y[0, plant.outputs.index("energy")])
-        work_so_far = np.maximum.accumulate(np.maximum(work, 0.0))
-        # the floor forgives what a faithful solution shows: kinematic O(q^3) mismatches
-        # between loads and potentials early in the ramp (0.1 % of the record's work on
-        # wavestar), a mooring table extrapolated beyond its envelope (not quite
-        # conservative), integration error on a free decay. An unstable step grows energy
-        # geometrically, by orders of magnitude, and outgrows the floor within a few steps.
-        allowed = ENERGY_MARGIN * work_so_far + 0.05 * work_so_far[-1] + 0.5 * energy0 \
-            + 1e-12
-        with np.errstate(invalid="ignore"):
-            bad = np.union1d(bad, np.flatnonzero(gain > allowed))
-    if bad.size == 0:
-        return
-    i = int(bad[0])
-    detail = "non-finite outputs" if not np.isfinite(Y[i]).all() else (
-        f"mechanical energy grew by {gain[i]:.4g} J while the waves and PTOs had put in "
-        f"{work[i]:.4g} J")
-    head = (f"{plant.name}: simulation diverged at t = {t[i]:.4g} s (step {i}, dt = {dt} s, "
-            f"method {method!r}): {detail}")
-    cause = why(float(t[i])) if why is not None else None
-    if cause:
-        raise _diverged(f"{head}: {cause}", float(t[i]))
-    raise _diverged(
-        f"{head}. Remedy: a smaller dt (try {dt / 4:g} s), "
-        f"method='exp-rk4' when fast radiation poles limit the step, method='cvodes' for "
-        f"stiff loads (end stops, friction, latching), or `mbcontrol bench {plant.name} "
-        f"--stability` for each method's largest stable step", float(t[i]))
-
-
-def _diverged(message: str, t_fail: float) -> SimulationError:
-    """A SimulationError carrying the time of the divergence (s) as `t_fail`."""
-    error = SimulationError(message)
-    error.t_fail = t_fail
-    return error
 
 
 def _last_command(plant, controller, t, x, U, w, p) -> np.ndarray:
@@ -210,11 +152,12 @@ def _parameters(plant, params, controller) -> np.ndarray:
 
 
 def _run_fixed(plant, method, controller, x0, W_nodes, p, *, dt, n, law, embedded, compiled,
-               check):
+               check, alongside):
     nu = len(plant.inputs)
     if embedded:
         return integrators.run_fixed_step(plant, x0, np.zeros((n, nu)), W_nodes, p, dt, method,
-                                          law=law, compiled=compiled, on_chunk=check)
+                                          law=law, compiled=compiled, on_chunk=check,
+                                          alongside=alongside)
     m = _steps_per_period(_period(controller, dt), dt)
     stepper = HeldStepper(plant, method, m, p, dt, compiled)
     X, U = np.empty((n + 1, plant.nx)), np.empty((n, nu))
@@ -226,6 +169,7 @@ def _run_fixed(plant, method, controller, x0, W_nodes, p, *, dt, n, law, embedde
         U[i:i + k] = u_prev
         X[i + 1:i + k + 1] = stepper.advance(X[i], u_prev, W_nodes[i:i + k])
         check(i + k, X[:i + k + 1])
+        alongside.advance(i + k, X, U, W_nodes[:, 0])
     return X, U
 
 
@@ -328,8 +272,8 @@ def _divergence_check(plant, dt, method, bar, why=None):
                 f"method {method!r}); state {worst!r} became non-finite or exceeded 1e8")
         cause = why(i * dt) if why is not None else None
         if cause:
-            raise _diverged(f"{head}: {cause}", i * dt)
-        raise _diverged(
+            raise diverged(f"{head}: {cause}", i * dt)
+        raise diverged(
             f"{head}. Remedy: a "
             f"smaller dt (try {dt / 4:g} s), method='exp-rk4' when fast radiation poles limit "
             f"the step, method='cvodes' for stiff loads (end stops, friction velocity_scale, "

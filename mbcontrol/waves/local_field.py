@@ -226,10 +226,16 @@ class LocalField:
         Elementwise over numpy arrays or CasADi SX rows, without branching on values: xh and dh
         are clamped to [-1, 1] (a point outside the box takes the boundary's value; the
         caller's validity check reports it, `outside`). Cost: the module docstring."""
+        return self.pressure_and_usage(rows, x, y, z, rho, g)[0]
+
+    def pressure_and_usage(self, rows, x, y, z, rho: float, g: float):
+        """(`pressure`, `usage`) at the points, sharing the elevation and stretched depth:
+        what a panel sum needs to report its field's range at little extra cost."""
         fmax, fmin = _ops(rows, x, y, z)
         rows = rows if type(rows).__module__.startswith("casadi") else np.asarray(rows, float)
         m_count, n_count = self.n_xi, self.n_depth
-        tx = _chebyshev(self._xi_hat(x, y), m_count)
+        xi = (x - self.x0) * math.cos(self.direction) + (y - self.y0) * math.sin(self.direction)
+        tx = _chebyshev(fmin(fmax(xi * (1 / self.half_width), -1.0), 1.0), m_count)
         eta = sum(rows[m] * tx[m] for m in range(m_count))
         depth = z + eta
         if not math.isinf(self.water_depth):          # Wheeler: d = H (z + eta) / (H + eta)
@@ -239,7 +245,8 @@ class LocalField:
         for n in range(n_count):
             inner = sum(rows[m_count + m * n_count + n] * tx[m] for m in range(m_count))
             head = head + inner * td[n]
-        return (rho * g) * fmax(z + head, 0.0)
+        usage = fmax(abs(xi) * (1 / self.half_width), depth * (1 / self.depth_range))
+        return (rho * g) * fmax(z + head, 0.0), usage
 
     def usage(self, rows, x, y, z):
         """How much of the box each point uses (dimensionless; numpy arrays or CasADi rows,

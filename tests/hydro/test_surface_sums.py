@@ -3,7 +3,8 @@
 References, independent of the block map under test:
 - the point-by-point numpy sums of mbcontrol.hydro.mesh.panels.pressure_wrench (same panels,
   same pressure), for wrenches in calm water and in a wave field;
-- numpy's max of LocalField.usage over the posed points, for `largest_function`;
+- numpy's max of LocalField.usage over the posed points, for the wrench's `largest` output
+  (and the wrench with it must be the wrench without it);
 - the box in closed form, rho g A d^2 / 2 (an upright box of waterplane A at draft d), and the
   potential's own derivative: d(potential)/d(sinking) = rho g V_wet = -F_z (a conservation law
   the panel rule must keep with its force).
@@ -21,7 +22,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from mbcontrol.hydro import (body_panels, calm_water_function, hydrostatic_pressure,
-                             largest_function, pressure_wrench, pressure_wrench_function)
+                             pressure_wrench, pressure_wrench_function)
 from mbcontrol.waves import LocalField
 
 RHO, G = 1025.0, 9.81
@@ -48,14 +49,17 @@ def _field_pressure(rows):
 def test_the_wave_wrench_is_the_point_by_point_sum(flap, block):
     assert flap.n % 8 and flap.n % 13                   # padding exercised
     fun = pressure_wrench_function(flap, _field_pressure, FIELD.n_rows, "w", block=block)
-    usage_fun = largest_function(flap, lambda rows: lambda x, y, z: FIELD.usage(rows, x, y, z),
-                                 FIELD.n_rows, "u", block=block)
+    with_usage = pressure_wrench_function(
+        flap, lambda rows: lambda x, y, z: FIELD.pressure_and_usage(rows, x, y, z, RHO, G),
+        FIELD.n_rows, "wu", block=block, largest=True)
     rng = np.random.default_rng(3)
     for deg in (0.0, 12.0, -25.0):
         rows = rng.normal(size=FIELD.n_rows) * 0.3
         R, r = _pose(deg), COG + [0.4, 0.0, 0.2]
         force, moment = (np.asarray(v).ravel() for v in fun(rows, R, r))
-        usage = np.asarray(usage_fun(rows, R, r)).ravel()
+        *wrench, usage = (np.asarray(v).ravel() for v in with_usage(rows, R, r))
+        for together, alone in zip(wrench, (force, moment)):
+            np.testing.assert_allclose(together, alone, rtol=1e-14, atol=0)
         f_ref, m_ref = pressure_wrench(flap, R, r, _field_pressure(rows))
         scale = np.max(np.abs(f_ref))
         np.testing.assert_allclose(force, f_ref, rtol=0, atol=1e-12 * scale)

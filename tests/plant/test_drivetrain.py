@@ -1,4 +1,4 @@
-"""A PTO's drivetrain (scene [pto.drivetrain]; mbcontrol.plant.process.drivetrain_signals):
+"""A PTO's drivetrain (scene [pto.drivetrain]; mbcontrol.plant.units.drivetrain_signals):
 parsing with units, its signals, and energy conserved two ways: the drivetrain's own balance
 (mechanical in = electrical out + winding and friction losses + its stored kinetic energy)
 pointwise and over a run, and the whole plant's, dE/dt = excitation - radiated - PTO -

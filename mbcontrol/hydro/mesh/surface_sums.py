@@ -65,36 +65,28 @@ def _mapped(name: str, extra: list, panels: Panels, block: int, per_block, n_sum
 
 
 def pressure_wrench_function(panels: Panels, pressure_of, n_rows: int, name: str,
-                             block: int = BLOCK) -> ca.Function:
+                             block: int = BLOCK, largest: bool = False) -> ca.Function:
     """Function (rows (n_rows,), R (3x3), r_cog (3,)) -> (force (3,), moment (3,)): the wrench
     of the pressure p(x, y, z) = pressure_of(rows)(x, y, z) (Pa; CasADi SX 1 x n rows in,
     elementwise, zero where dry) on the posed surface, n-frame axes, moment about the current
     CoG; N and N m. The same numbers as `panels.pressure_wrench`
-    (tests/hydro/test_surface_sums.py), as one never-inlined call."""
+    (tests/hydro/test_surface_sums.py), as one never-inlined call.
+
+    largest: pressure_of(rows)(x, y, z) gives (p, v), and a third output is the largest v
+    over the points (zero-weight padding included, at the CoG): e.g. how much of its incident
+    field's box the surface uses (`LocalField.pressure_and_usage`), from the same pass."""
     rows = ca.SX.sym("rows", n_rows)
 
     def per_block(rows_, R, X, normals, arms):
         p = pressure_of(rows_)(X[0, :], X[1, :], X[2, :])
-        return [ca.mtimes(normals, p.T), ca.mtimes(arms, p.T)]
+        p, extra = (p[0], [ca.mmax(p[1])]) if largest else (p, [])
+        return [ca.mtimes(normals, p.T), ca.mtimes(arms, p.T)] + extra
 
-    (rows_mx,), R, r, (force_b, moment_b) = _mapped(name, [rows], panels, block, per_block, 2)
-    return ca.Function(name, [rows_mx, R, r], [-ca.mtimes(R, force_b), -ca.mtimes(R, moment_b)],
-                       ["rows", "R", "r_cog"], ["force", "moment"], {"never_inline": True})
-
-
-def largest_function(panels: Panels, value_of, n_rows: int, name: str,
-                     block: int = BLOCK) -> ca.Function:
-    """Function (rows (n_rows,), R (3x3), r_cog (3,)) -> the largest of value_of(rows)(x, y,
-    z) over the posed points (CasADi SX rows in, elementwise; zero-weight padding included, at
-    the CoG): e.g. how much of its incident field's box a surface uses. Apart from the wrench,
-    so that a plant's f does not pay for what only its outputs report."""
-    rows = ca.SX.sym("rows", n_rows)
-
-    def per_block(rows_, R, X, normals, arms):
-        return [ca.mmax(value_of(rows_)(X[0, :], X[1, :], X[2, :]))]
-
-    (rows_mx,), R, r, (largest,) = _mapped(name, [rows], panels, block, per_block, 0)
-    return ca.Function(name, [rows_mx, R, r], [largest], ["rows", "R", "r_cog"], ["largest"],
+    (rows_mx,), R, r, (force_b, moment_b, *extra) = _mapped(name, [rows], panels, block,
+                                                           per_block, 2)
+    return ca.Function(name, [rows_mx, R, r], [-ca.mtimes(R, force_b), -ca.mtimes(R, moment_b),
+                                               *extra],
+                       ["rows", "R", "r_cog"], ["force", "moment"] + ["largest"] * largest,
                        {"never_inline": True})
 
 
