@@ -60,8 +60,10 @@ def table(header: str, with_header: bool = False) -> list[list[str]]:
 
 
 def row(header: str, first_cell: str) -> list[str]:
-    """The row of table `header` whose first cell starts with `first_cell`."""
-    hits = [r for r in table(header) if r[0].startswith(first_cell)]
+    """The row of table `header` whose first cell is `first_cell`, or starts with it and a
+    space or a comma ("rm3" is not "rm3_moored")."""
+    hits = [r for r in table(header) if r[0] == first_cell
+            or r[0].startswith((first_cell + " ", first_cell + ","))]
     if len(hits) != 1:
         raise AssertionError(f"table {header!r} (README.md, notebooks/guide.md): expected one row starting "
                              f"{first_cell!r}, found {len(hits)}")

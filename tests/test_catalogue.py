@@ -71,7 +71,8 @@ KNOWN_FIT_SHORTFALL = {"flume_section": 0.043}
 # wave band per model (rad/s): where its seas carry energy (tank models: periods 0.5-3 s)
 WAVE_BANDS = {"hinged_barge": (3.0, 14.0), "hinged_raft": (3.0, 14.0), "raft3": (3.0, 12.0),
               "barge_chain": (3.0, 12.0), "array4": (2.0, 12.0), "array_grid": (2.0, 12.0), "flap_pair": (1.0, 4.5),
-              "sphere": (0.3, 2.5), "rm3": (0.3, 2.0), "wavestar": (2.0, 12.0),
+              "sphere": (0.3, 2.5), "rm3": (0.3, 2.0), "rm3_moored": (0.3, 2.0),
+              "wavestar": (2.0, 12.0),
               "flume_section": (4.0, 10.0), "oswec": (0.3, 2.0), "wavebot": (1.0, 6.0)}
 # oswec: the band includes its 18 s pitch resonance (0.347 rad/s), damped almost only by the PTO,
 # where the radiation damping is 1e-3 of its peak; a fit judged by a global norm over the band was

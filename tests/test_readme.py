@@ -65,6 +65,7 @@ TABLES = {
     "R": ("measured", "benchmarks/interaction_cutoff.py"),
     "rm3 at PacWave South, reactive, designed per sea": ("measured", "--amplitudes random"),
     "PacWave South, 32 seas × 600 s, passive designed per sea": ("measured", "--spread 30"),
+    "segments (lower/upper)": ("measured", "benchmarks/moordyn_rm3.py"),
 }
 MODEL_TABLES = {"mbcontrol (method, dt, radiation tol)": ("measured", "benchmarks/speed.py"),
                 "C step median / p99 / max (us)": ("measured", "benchmarks/export_step.py"),

@@ -14,7 +14,8 @@ from .envelope import ENVELOPE_SHARE, PEAK_SHARE, envelope_bound, envelope_items
 from .frequency import (excitation_transfer, frequency_domain_response, mechanical_matrices,
                         regular_wave_amplitudes, statespace_response)
 from .linearize import linearize
-from .metrics import electrical_power, pto_metrics
+from .metrics import analysis_window, electrical_power, pto_metrics
+from .mooring_stats import mooring_summary, tension_lines, tension_statistics
 from .ports import linear_params, multiport_bound, port_responses
 from .power_statistics import law_params, law_responses, record_power_statistics
 from .reduce import balanced_truncation
@@ -22,7 +23,8 @@ from .summary import summary
 from .validity import (ANGLE_MAX_RAD, DRAFT_FACTOR, assess, left_linear_range, mean_draft,
                        simulate_checked, split_remedy, wave_at)
 
-__all__ = ["linearize", "frequency_domain_response", "statespace_response", "excitation_transfer",
+__all__ = ["analysis_window", "mooring_summary", "tension_lines", "tension_statistics",
+           "linearize", "frequency_domain_response", "statespace_response", "excitation_transfer",
            "regular_wave_amplitudes", "mechanical_matrices", "complex_conjugate_bound",
            "pseudo_spectral_bound", "pto_thevenin", "pto_metrics", "electrical_power", "summary",
            "balanced_truncation", "multiport_bound", "assess", "simulate_checked",

@@ -8,6 +8,7 @@ import numpy as np
 
 from ..results import jsonable, record, run_info
 from .metrics import _BODY_KEYS, analysis_window, pto_metrics, signal_stats, statistics_window
+from .mooring_stats import mooring_summary, slack_lines
 from .validity import assess
 
 
@@ -26,9 +27,10 @@ def summary(ds, plant) -> dict:
     ptos = {pto.name: jsonable({**pto_metrics(ds, pto), "valid": verdict["valid"],
                                 "invalid_reasons": verdict["invalid_reasons"]})
             for pto in plant.scene.ptos}
+    moorings = mooring_summary(ds, mask)
     return {"model": ds.attrs["model"], "valid": verdict["valid"],
             "invalid_reasons": verdict["invalid_reasons"],
-            "validity_warnings": verdict["warnings"], "wave": run.wave,
+            "validity_warnings": verdict["warnings"] + slack_lines(moorings), "wave": run.wave,
             "duration_s": float(ds.attrs["duration_s"]), "dt_s": float(ds.attrs["dt_s"]),
             "wall_time_s": float(ds.attrs["wall_time_s"]), "method": ds.attrs["method"],
             "window_start_s": stats_window["start_s"], "window_end_s": stats_window["end_s"],
@@ -36,7 +38,8 @@ def summary(ds, plant) -> dict:
             "controller": run.controller, "estimator": run.estimator,
             "provenance": {k: ds.attrs.get(k) for k in ("scene_sha256", "hydro_sha256",
                                                         "radiation_sha256")},
-            "dofs": dofs, "bodies": bodies, "ptos": ptos,
+            "dofs": dofs, "bodies": bodies, "ptos": ptos, **({"moorings": jsonable(moorings)}
+                                                              if moorings else {}),
             "validity": jsonable(verdict["checks"])}
 
 

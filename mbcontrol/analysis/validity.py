@@ -106,6 +106,12 @@ def wave_of(ds):
                 d_omega=ds["wave_omega"].attrs.get("d_omega"))
 
 
+UNBOUNDED = ("the complex-conjugate bound of this wave is unbounded: some of its components "
+             "excite a PTO at frequencies where the hydro data give no radiation damping (BEM data "
+             "repaired to zero, or past the mesh's range), so the power was not checked against a "
+             "bound; cut the sea's band, or extend the data")
+
+
 def power_bound(plant, wave, params, window=None) -> dict:
     """{"bound_W": spectral multiport bound, "window_bound_W": the same over `window` (s)
     for this realisation, or None when not asked}. Cached per plant, parameters, direction
@@ -190,6 +196,8 @@ def assess_values(plant, wave, params, *, window, mean_power_W: float, energy=No
                     f"{where} ({limit * scale:.3g} {unit}) {100 * e[f'{key}_share_beyond']:.2g} "
                     f"% of the time; linear hydrodynamics are approximate there")
     checks["excursions"] = excursions or {}
+    if not math.isfinite(checks.get("bound_W", 0.0)):
+        warnings.append(UNBOUNDED)
     return {"valid": not reasons, "invalid_reasons": reasons, "warnings": warnings,
             "checks": checks}
 

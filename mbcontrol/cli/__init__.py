@@ -102,6 +102,7 @@ def _loudness(args) -> None:
 def _main(argv) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
+    _check_wave_flags(args)
     _loudness(args)
     if not hasattr(args, "run"):
         parser.print_help()
@@ -357,8 +358,18 @@ def _model_options(p) -> None:
 
 
 def _wave_options(p) -> None:
+    """The shared wave flags; --wave elevation without --eta FILE, or --eta with another wave,
+    is a usage error (exit 2), found before the model is built."""
     g = p.add_argument_group("waves")
-    g.add_argument("--wave", choices=("regular", "jonswap", "pm", "none"), default="regular")
+    g.add_argument("--wave", choices=("regular", "jonswap", "pm", "elevation", "none"),
+                   default="regular",
+                   help="regular (--height, --period), jonswap or pm (--hs, --tp), elevation (a\n"
+                        "measured record: --eta FILE) or none (still water)")
+    g.add_argument("--eta", metavar="FILE",
+                   help="--wave elevation's record: two columns, time (s) and free-surface\n"
+                        "elevation (m, positive up) at the scene's origin; whitespace or commas,\n"
+                        "one header line and # comments allowed (mbcontrol.waves.from_record).\n"
+                        "simulate's default duration: the record's; a longer run repeats it")
     g.add_argument("--height", type=float, help="regular wave height H, m")
     g.add_argument("--period", type=float, help="regular wave period T, s")
     g.add_argument("--hs", type=float, help="significant wave height, m")
@@ -368,3 +379,22 @@ def _wave_options(p) -> None:
     g.add_argument("--direction", type=float, metavar="DEG",
                    help="heading the waves travel towards, degrees in the n-frame (default: the "
                         "hydro data's heading when it has one only, else 0)")
+    p.set_defaults(wave_parser=p)          # `_check_wave_flags` reports on it
+
+
+def _check_wave_flags(args) -> None:
+    """Usage errors (exit 2, before any model is built) of the wave flags taken together."""
+    p = getattr(args, "wave_parser", None)
+    if p is None:
+        return
+    if args.wave == "elevation" and args.eta is None:
+        p.error("--wave elevation needs --eta FILE, the measured elevation record")
+    if args.wave != "elevation" and args.eta is not None:
+        p.error(f"--eta {args.eta}: a record is read with --wave elevation; expected "
+                f"--wave elevation, got --wave {args.wave}")
+    if args.wave == "elevation" and p.prog.endswith(" codesign"):
+        p.error("--wave elevation: codesign rebuilds its wave per case from --height and "
+                "--period or --hs and --tp; expected --wave regular, jonswap or pm")
+    if args.wave == "elevation" and getattr(args, "repeat", None) is not None:
+        p.error("--repeat does not apply to --wave elevation: a record repeats over its own "
+                "length")

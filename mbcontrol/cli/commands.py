@@ -106,16 +106,20 @@ def run_hydro(args) -> int:
 
 
 def _wave(args, plant, duration):
-    """The wave the CLI options describe, None for --wave none; notes a spectrum cut by the
-    hydro data's band on stderr."""
-    from ..waves import from_args
+    """The wave the CLI options describe, None for --wave none; notes on stderr a spectrum cut
+    by the hydro data's band, and what a record (--wave elevation --eta FILE) left out,
+    resampled, ramped or repeated over `duration` (s; None: the record's length)."""
+    from ..waves import from_args, from_record
     if args.wave == "none":
         return None
     omega = plant.hydro.omega if plant.hydro is not None else None
     band = (float(omega[0]), float(omega[-1])) if omega is not None else None
-    wave = from_args(args.wave, height=args.height, period=args.period, hs=args.hs,
-                     tp=args.tp, gamma=args.gamma, seed=args.seed, duration=duration,
-                     data_band=band)
+    wave = from_record(args.eta, data_band=band, duration=duration) \
+        if args.wave == "elevation" else \
+        from_args(args.wave, height=args.height, period=args.period, hs=args.hs, tp=args.tp,
+                  gamma=args.gamma, seed=args.seed, duration=duration, data_band=band)
+    for note in wave.settings.get("notes", ()):
+        print(f"mbcontrol: note: {note}", file=sys.stderr)
     headings = plant.hydro.data["wave_direction"].values if plant.hydro is not None else [0.0]
     direction = math.radians(args.direction) if getattr(args, "direction", None) is not None \
         else float(headings[0]) if len(headings) == 1 else 0.0
@@ -134,11 +138,13 @@ def run_simulate(args) -> int:
     plant = _plant(args)
     duration = args.duration
     if args.wave != "none":
-        if duration is None:
+        if duration is None and args.wave != "elevation":      # a record: its own length
             duration = 30 * args.period if args.wave == "regular" and args.period else 600.0
     elif duration is None:
         duration = 60.0
     wave = _wave(args, plant, args.repeat or duration)
+    if duration is None:
+        duration = wave.settings["duration_s"]
     controller = _controller(args, wave)
     params = dict(_key_value(s, "--param") for s in args.param)
     initial = dict(_key_value(s, "--initial", text=True) for s in args.initial)
@@ -360,6 +366,7 @@ def _key_value(item: str, flag: str, text: bool = False):
 
 
 def _print_summary(result: dict, plant) -> None:
+    from ..analysis import tension_lines
     print(f"{result['model']}: {result['duration_s']:.4g} s simulated in "
           f"{result['wall_time_s']:.3g} s ({result['method']}, dt = {result['dt_s']} s)")
     for name, start in result.get("initial", {}).items():
@@ -373,10 +380,17 @@ def _print_summary(result: dict, plant) -> None:
               f"{values['max_stroke']:.4g} {plant.units(pto + '__position')}")
     checks = result.get("validity", {})
     if "bound_W" in checks:
-        print(f"  complex-conjugate bound of this wave {checks['bound_W']:.4g} W (all PTOs, "
-              f"linear theory)")
+        bound = checks["bound_W"]
+        print(f"  complex-conjugate bound of this wave {bound:.4g} W (all PTOs, linear theory)"
+              if bound is not None and math.isfinite(bound) else
+              "  complex-conjugate bound of this wave: unbounded (a component excites a PTO "
+              "where the hydro data give it no radiation damping)")
+    for text in tension_lines(result.get("moorings", {})):
+        print("  " + text)
     if result.get("estimator"):
         print(f"  excitation estimate error {100 * result['estimator']['excitation_error']:.3g} %"
               f" (RMS, against the simulation's true excitation)")
-    print("  result: valid (bound, energy balance, linear-hydrodynamics range checked)"
+    bounded = checks.get("bound_W") is not None and math.isfinite(checks["bound_W"])
+    print(f"  result: valid ({'bound, ' if bounded else ''}energy balance, linear-hydrodynamics "
+          f"range checked{'' if bounded else '; no finite bound to check against'})"
           if result["valid"] else "\n".join(invalid_lines(result["invalid_reasons"])))

@@ -15,7 +15,7 @@ def run_design(args) -> int:
     if args.wave == "none":
         raise InputError("design needs a wave: --wave regular|jonswap|pm")
     repeat = args.duration or 600.0          # a sea's repeat period, s (its components' spacing)
-    wave = _wave(args, plant, repeat)
+    wave = _wave(args, plant, args.duration if args.wave == "elevation" else repeat)
     result = design(plant, wave, args.controller, pto=args.pto, simulate_s=args.duration,
                     dt=args.dt, bounds={"auto": True, "full": "full", "off": False}[args.bounds],
                     limits=not args.unconstrained, robust=args.robust)
@@ -43,6 +43,8 @@ def _simulate_command(args, result, repeat: float) -> str:
     words += ["--wave", args.wave]
     if args.wave == "regular":
         words += ["--height", repr(args.height), "--period", repr(args.period)]
+    elif args.wave == "elevation":          # the record repeats over its own length
+        words += ["--eta", args.eta]
     else:
         words += ["--hs", repr(args.hs), "--tp", repr(args.tp), "--seed", str(args.seed)]
         if args.wave == "jonswap":
@@ -50,7 +52,7 @@ def _simulate_command(args, result, repeat: float) -> str:
     sim = result.simulation
     if sim is not None:
         words += ["--duration", f"{sim['duration_s']:.12g}", "--dt", f"{sim['dt_s']:.12g}"]
-        if args.wave != "regular" and abs(sim["duration_s"] - repeat) > 1e-9 * repeat:
+        if args.wave in ("jonswap", "pm") and abs(sim["duration_s"] - repeat) > 1e-9 * repeat:
             words += ["--repeat", f"{repeat:.12g}"]
         if "repeat period" in sim["summary"]["window"]:      # scored as its bounds are
             words += ["--from", "last-repeat"]
@@ -75,11 +77,12 @@ def _print_design(plant, wave, result, command) -> None:
     X = plant.units(f"{result.pto}__position")
     units = {"damping": f"{F} s/{X}", "stiffness": f"{F}/{X}", "force_max": F, "stroke_max": X,
              "rate_max": f"{F}/s"}
-    sea = (f"a regular wave (H {wave.settings['height']:.6g} m, T {wave.settings['period']:.6g} s)"
+    s = wave.settings
+    sea = (f"a regular wave (H {s['height']:.6g} m, T {s['period']:.6g} s)"
            if wave.kind == "regular" else
-           f"a {wave.kind.upper()} sea (Hs "
-           f"{wave.settings['hs']:.6g} m, Tp {wave.settings['tp']:.6g} s, seed "
-           f"{wave.settings['seed']})")
+           f"the record {s['source']} ({s['duration_s']:.6g} s; Hs {s['hs_m']:.4g} m, Tp "
+           f"{s['tp_s']:.4g} s)" if wave.kind == "record" else
+           f"a {wave.kind.upper()} sea (Hs {s['hs']:.6g} m, Tp {s['tp']:.6g} s, seed {s['seed']})")
     print(f"{plant.name}: {result.name} control of PTO {result.pto!r} designed for {sea}")
     print("  parameters:")
     for key, value in result.parameters.items():

@@ -309,6 +309,21 @@ def _vary(items: list[str]) -> dict:
     return vary
 
 
+def _print_mooring_loads(rows: list) -> None:
+    """MoorDyn moorings: the sea's design loads beside its power, largest over lines and seeds."""
+    if not any("mooring_max_N" in row for row in rows):
+        return
+    print("  mooring loads, the most loaded fairlead (kN; the largest over seeds):")
+    print(f"  {'Hs m':>6s} {'Tp s':>6s} {'max':>9s} {'3-h MPM':>9s}")
+    for row in rows:
+        print(f"  {row['hs']:6.3g} {row['tp']:6.3g} {_kN(row.get('mooring_max_N')):>9s} "
+              f"{_kN(row.get('mooring_mpm_3h_N')):>9s}")
+
+
+def _kN(value) -> str:
+    return f"{value / 1e3:.4g}" if isinstance(value, float) else "-"
+
+
 def _print_summary(summary: dict, store) -> None:
     """The sweep's text report: a row per sea, notes, invalid and failed cases, the annual
     energy with its interval and budget, a farm's q factor."""
@@ -332,6 +347,7 @@ def _print_summary(summary: dict, store) -> None:
               f"{row['energy_flux_W_per_m'] / 1e3:8.3g}{q_text}")
         if "bound_W" in row:
             print(f"         {_design_line(row)}")
+    _print_mooring_loads(summary["seas"])
     for note in summary["notes"]:
         print(f"  note: {note}")
     remedies = []

@@ -17,6 +17,7 @@ from pathlib import Path
 import casadi as ca
 import numpy as np
 
+from ..errors import InputError
 from ..plant import controlled_params
 from ..textsafe import c_string
 from .build import (FMU_FILES, c_array, c_number, compile_library, csrc, generate_casadi,
@@ -33,6 +34,10 @@ def export_plant(plant, wave, out_dir, *, dt: float, model: str | None = None) -
     Names reach the FMU only through `build`'s escaping writers (`identifier`, `variable`,
     `model_description`)."""
     from mbcontrol.sim import rk4_step, wave_terms
+    if getattr(plant, "moordyn", ()):
+        raise InputError(f"{plant.name}: its MoorDyn moorings run beside the plant, not in its "
+                         f"equations; an exported plant would leave the lines out. Export a "
+                         f"scene without them (or with a linear or catenary mooring)")
     ident = identifier(model or plant.name, "plant")
     out_dir = Path(out_dir).resolve()
     out_dir.mkdir(parents=True, exist_ok=True)

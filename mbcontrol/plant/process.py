@@ -22,6 +22,7 @@ from ..scene import DOF_NAMES, Scene, load_scene
 from . import checks, loads, nonlinear
 from .held_pressure import HeldPressure, held_pressure
 from .mechanical import dof_selector, mechanical_matrices
+from .moordyn_loads import coupled_points, moordyn_loads, moordyn_names
 from .ownership import linear_params
 from .pieces import plant_parts
 from .rest import preloads
@@ -49,6 +50,8 @@ class ProcessPlant:
     pressure: tuple = field(default=(), repr=False)
     # [hydro] nonlinear_update = "step": f with the pressure load held (module plant.held_pressure)
     held: HeldPressure | None = field(default=None, repr=False)
+    # MoorDyn moorings' Coupled points: their forces follow the field rows in w
+    moordyn: tuple = field(default=(), repr=False)
     # derived data and compiled code, freed with the plant (module plant.workspace)
     workspace: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
@@ -89,11 +92,19 @@ class ProcessPlant:
         """Excitation w(t) (len(t), n_w) of a wave on this plant's hydro DOFs (and the wave
         field's rows, with nonlinear Froude-Krylov forces)."""
         if self.hydro is None:
-            return np.zeros((np.size(t), 0))
+            return np.zeros((np.size(t), len(self.disturbances)))
         if not self.wave_rows:
-            return self.hydro.excitation(wave, t)
+            return self.padded(self.hydro.excitation(wave, t))
         from ..waves import coefficient_series
         return coefficient_series(wave, self.wave_coefficients(wave), np.atleast_1d(t))
+
+    def padded(self, rows: np.ndarray) -> np.ndarray:
+        """rows (..., n) of the wave's part of w, with zero columns for the rows the wave does
+        not drive (MoorDyn's point forces, filled as a run steps)."""
+        missing = len(self.disturbances) - rows.shape[-1]
+        if missing <= 0:
+            return rows
+        return np.concatenate([rows, np.zeros(rows.shape[:-1] + (missing,), rows.dtype)], -1)
 
     @property
     def wave_rows(self) -> int:
@@ -106,8 +117,8 @@ class ProcessPlant:
         excitation on the hydro DOFs, less the surface model's linear Froude-Krylov force when
         that force is nonlinear (the plant computes it), then the wave field's rows."""
         if not self.wave_rows:
-            return self.hydro.excitation_at(wave.omega, wave.direction)
-        return nonlinear.wave_coefficients(self, wave)
+            return self.padded(self.hydro.excitation_at(wave.omega, wave.direction))
+        return self.padded(nonlinear.wave_coefficients(self, wave))
 
 
 def assemble_plant(scene: Scene | str, hydro: HydroModel | None = None, *,
@@ -141,7 +152,9 @@ def assemble_plant(scene: Scene | str, hydro: HydroModel | None = None, *,
     n_w = len(hydro_dofs)
     n_r = hydro.radiation.A.shape[0] if hydro and radiation else 0
     pressure = nonlinear.pressure_bodies(scene, topo, hydro)
-    w = ca.SX.sym("w", n_w + sum(b.n_rows for b in pressure))
+    moored = coupled_points(scene, topo)                  # MoorDyn's Coupled points
+    n_f = sum(b.n_rows for b in pressure)
+    w = ca.SX.sym("w", n_w + n_f + sum(g.rows for g in moored))
     chi = ca.SX.sym("chi", n_r)
 
     params = loads.Parameters()
@@ -155,10 +168,14 @@ def assemble_plant(scene: Scene | str, hydro: HydroModel | None = None, *,
         tau += hydro_force
     slot = ca.SX.sym("tau_p", tree.n_s)    # the hydrostatic (pressure) load's place in tau
     tau, potential, pto_signals, tensions, (wave_power, ranges), restoring = _body_loads(
-        tau, scene, topo, hydro, (q, s, u, w[n_w:], slot), params, pressure)
+        tau, scene, topo, hydro, (q, s, u, w[n_w:n_w + n_f], slot), params, pressure)
     power["excitation_power"] += wave_power
+    if moored:
+        tau_md, power["mooring_power"] = moordyn_loads(topo, q, s, w[n_w + n_f:], moored)
+        tau += tau_md
     # f sums each surface for its wrench alone; the outputs (restoring) also for its range
-    load = nonlinear.pressure_load(scene, topo, q, w[n_w:], pressure) if pressure else restoring
+    load = nonlinear.pressure_load(scene, topo, q, w[n_w:n_w + n_f], pressure) if pressure \
+        else restoring
     tau_full = ca.substitute(tau, slot, load)
     extra, balance = preloads(scene, topo, (q, s, u, w, chi, tau_full), pto_signals, params,
                               hydro.buoyancy(scene.water) if hydro else {})
@@ -182,13 +199,15 @@ def assemble_plant(scene: Scene | str, hydro: HydroModel | None = None, *,
     coords = list(tree.coordinate_names)
     states = coords + [f"{c}__vel" for c in coords] + [f"radiation_{i}" for i in range(n_r)]
     inputs = [f"u__{pto.name}" for pto in scene.ptos]
-    disturbances = [f"w__{d}" for d in hydro_dofs] + nonlinear.field_names(pressure)
+    disturbances = [f"w__{d}" for d in hydro_dofs] + nonlinear.field_names(pressure) \
+        + moordyn_names(moored)
     f = ca.Function("f", [x, u, w, p], [x_dot], ["x", "u", "w", "p"], ["xdot"])
     h = ca.Function("h", [x, u, w, p], [y], ["x", "u", "w", "p"], ["y"])
     return ProcessPlant(scene, topo, hydro, tuple(states), tuple(inputs), tuple(disturbances),
                         tuple(output_names), tuple(params.names), np.array(params.values),
                         f, h, notes, plant_parts([x, u, w, p], M, tau_full, x_dot[:tree.n_q],
-                                                 chi_dot, radiation_apart), pressure, held)
+                                                 chi_dot, radiation_apart), pressure, held,
+                        moored)
 
 
 def _hydro_loads(hydro, radiation, scale, select, P, s, w, chi):
@@ -305,6 +324,9 @@ def _outputs(scene, topo: Topology, q, s, pto_signals, power, tensions, s_dot, r
     # included, are external: their power is <pto>__power
     values += [power["radiated_power"], power["excitation_power"], power["energy"]]
     names += ["radiated_power", "excitation_power", "energy"]
+    if "mooring_power" in power:         # what MoorDyn's lines put into the bodies
+        values.append(power["mooring_power"])
+        names.append("mooring_power")
     for line, signals in tensions.items():
         values += list(signals)
         names += [f"{line}__tension", f"{line}__span", f"{line}__height"]

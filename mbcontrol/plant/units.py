@@ -4,7 +4,8 @@ from __future__ import annotations
 
 _BODY_UNITS = {"Surge": ("m", "N"), "Sway": ("m", "N"), "Heave": ("m", "N"),
                "Roll": ("rad", "N m"), "Pitch": ("rad", "N m"), "Yaw": ("rad", "N m")}
-_ENERGY_UNITS = {"radiated_power": "W", "excitation_power": "W", "energy": "J"}
+_ENERGY_UNITS = {"radiated_power": "W", "excitation_power": "W", "energy": "J",
+                 "mooring_power": "W"}
 
 
 DRIVETRAIN_SIGNALS = {"current": "A", "voltage": "V", "winding_loss": "W", "friction_loss": "W",
@@ -49,6 +50,8 @@ def signal_unit(plant, signal: str) -> str:
         return "internal"
     if signal.endswith("__field_range"):
         return "1"
+    if signal.startswith("w__moordyn_"):
+        return "N"                      # a force on a Coupled point, n-frame
     if signal.startswith("w__"):
         return _BODY_UNITS[signal.split("__")[-1]][1]
     base = signal[3:] if signal.startswith("u__") else signal

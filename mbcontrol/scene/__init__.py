@@ -10,6 +10,7 @@ from .load import catalogue_dir, list_models, load_scene, resolve
 from .model import (DOF_NAMES, JOINT_TYPES, Body, Drag, Drivetrain, EndStop, Friction, Geometry, HydroSettings,
                     Joint, Mooring, Obstacle, Pto, Scene, Water)
 from .checks import catenary_geometry
+from .moordyn_file import TO_MOORDYN, MoorDynInput, read_moordyn, run_text
 from .parse import parse_scene
 from .reference import in_readme as scene_keys_in_readme
 from .reference import markdown as scene_keys_markdown
@@ -22,4 +23,4 @@ __all__ = ["load_scene", "list_models", "catalogue_dir", "resolve", "parse_scene
            "Friction", "Mooring", "EndStop", "Drag", "Drivetrain", "HydroSettings", "Obstacle",
            "immersed_profile", "immersed_volume", "profile_problem", "catenary_geometry",
            "evaluate_expression", "scene_keys_markdown", "scene_keys_in_readme", "to_si",
-           "UnitError"]
+           "UnitError", "TO_MOORDYN", "MoorDynInput", "read_moordyn", "run_text"]

@@ -186,6 +186,8 @@ class Mooring:
     kind "catenary": a quasi-static elastic catenary line to a seabed anchor
     (mbcontrol.plant.catenary): its tension at the fairlead, from the line's length, axial stiffness
     EA and submerged weight per metre, with seabed contact.
+    kind "moordyn": the lines of a MoorDyn input file (mbcontrol.scene.moordyn_file), stepped by
+    MoorDyn beside the plant (mbcontrol.sim.moordyn); its Coupled points follow `body`.
     """
     name: str
     body: str
@@ -198,6 +200,13 @@ class Mooring:
     EA: float = 0.0                            # N, axial stiffness (catenary)
     weight: float = 0.0                        # N/m, submerged weight (catenary)
     excursion: float | None = None             # m, fairlead motion the force table covers
+    file: str | None = None                    # MoorDyn input file (moordyn), absolute
+    coupled: str = "body"                      # moordyn: Coupled points in the body's frame
+                                               # (about its CoG at rest) or "global"
+    environment: str = "file"                  # moordyn: water density and depth from the
+                                               # MoorDyn file, or "scene" ([water])
+    settle: bool = True                        # moordyn: lines brought to rest at the
+                                               # initial pose before t = 0
 
 
 @dataclass(frozen=True)
@@ -303,6 +312,12 @@ class Scene:
         data.pop("path")
         data["hydro"]["file"] = _file_digest(self.hydro.file)
         data["hydro"]["source"] = Path(self.hydro.source).name if self.hydro.source else None
+        for mooring in data["moorings"]:  # other kinds' digests stay as they were
+            if mooring["kind"] == "moordyn":
+                mooring["file"] = _file_digest(mooring["file"])
+            else:
+                for key in ("file", "coupled", "environment", "settle"):
+                    mooring.pop(key)
         if not data["obstacles"]:       # digests of scenes without obstacles stay as they were
             data.pop("obstacles")
         for body in list(data["bodies"]) + list(data.get("obstacles", ())):

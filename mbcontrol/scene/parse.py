@@ -11,6 +11,7 @@ from ..errors import SceneError
 from .checks import Reader, catenary_geometry, check_topology
 from .model import (DOF_NAMES, JOINT_TYPES, Body, Drag, Drivetrain, EndStop, Friction, Geometry,
                     HydroSettings, Joint, Mooring, Obstacle, Pto, Scene, Water)
+from .moordyn_file import read_moordyn
 from .names import name_from_stem
 from .shapes import displaced_mass, read_profile
 from .template import expand
@@ -42,7 +43,7 @@ def parse_scene(data: dict, path: Path, parameters: dict | None = None) -> Scene
         water=water, bodies=bodies, joints=joints,
         ptos=tuple(_pto(r, kinds) for r in top.tables("pto")),
         frictions=tuple(_friction(r) for r in top.tables("friction")),
-        moorings=tuple(_mooring(r) for r in top.tables("mooring")),
+        moorings=tuple(_mooring(r, path) for r in top.tables("mooring")),
         drags=tuple(_drag(r) for r in top.tables("drag")),
         end_stops=tuple(_end_stop(r, kinds) for r in top.tables("end_stop")),
         hydro=hydro,
@@ -212,10 +213,12 @@ def _friction(r: Reader) -> Friction:
                     velocity_scale=r.positive("velocity_scale", None, default=1e-2))
 
 
-def _mooring(r: Reader) -> Mooring:
-    kind = r.choice("type", ("linear", "catenary"), default="linear")
+def _mooring(r: Reader, path: Path) -> Mooring:
+    kind = r.choice("type", ("linear", "catenary", "moordyn"), default="linear")
     if kind == "catenary":
         return _catenary(r)
+    if kind == "moordyn":
+        return _moordyn(r, path)
     r.allow("name", "type", "body", "point", "stiffness", "damping")
     stiffness = r.vector("stiffness", None)
     damping = r.vector("damping", None, default=(0.0, 0.0, 0.0))
@@ -239,6 +242,17 @@ def _catenary(r: Reader) -> Mooring:
     except ValueError as exc:
         r.fail("anchor", str(exc))
     return m
+
+
+def _moordyn(r: Reader, path: Path) -> Mooring:
+    """A MoorDyn input file whose Coupled points follow `body` (scene.moordyn_file)."""
+    r.allow("name", "type", "body", "file", "coupled", "environment", "settle")
+    file = str((path.parent / r.string("file")).resolve())
+    read_moordyn(file, f"{r.file}: {r.field('file')}")    # checked now: fails at load
+    return Mooring(name=r.name(), body=r.string("body"), point=(0.0, 0.0, 0.0), kind="moordyn",
+                   file=file, coupled=r.choice("coupled", ("body", "global"), default="body"),
+                   environment=r.choice("environment", ("file", "scene"), default="file"),
+                   settle=r.boolean("settle", default=True))
 
 
 def _end_stop(r: Reader, kinds: dict) -> EndStop:

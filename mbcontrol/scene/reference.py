@@ -34,7 +34,8 @@ SECTIONS = {
                       "ideal PTO, `efficiency` applies); the PTO force is the machine's",
     "friction": "`[[friction]]`: joint friction",
     "end_stop": "`[[end_stop]]`: a stiff spring-damper stop on a joint coordinate",
-    "mooring": "`[[mooring]]`: `type = \"linear\"` (springs in x, y, z) or `\"catenary\"`",
+    "mooring": "`[[mooring]]`: `type = \"linear\"` (springs in x, y, z), `\"catenary\"` or "
+               "`\"moordyn\"` (a MoorDyn input file's lines)",
     "drag": "`[[drag]]`: viscous damping of a body, per DOF (m, rad; body frame)",
     "drag.coefficients": "`[drag.coefficients]`: quadratic, F = -c v abs(v), per DOF",
     "drag.linear": "`[drag.linear]`: linear, F = -c v, per DOF",
@@ -144,7 +145,12 @@ MEANING = {
     ("end_stop", "stiffness"): "contact stiffness (N/m or N m/rad)",
     ("end_stop", "damping"): "contact damping (N s/m or N m s/rad)",
     ("mooring", "name"): "its name",
-    ("mooring", "type"): "linear or catenary",
+    ("mooring", "type"): "linear, catenary, or moordyn (MoorDyn's lines, stepped beside the plant)",
+    ("mooring", "file"): "moordyn: the MoorDyn input file (v2, or v1 as WEC-Sim's), from the scene",
+    ("mooring", "coupled"): "moordyn: Coupled points in the body's frame (z up, about its CoG at "
+                            "rest: `body`) or in MoorDyn's frame at rest (`global`)",
+    ("mooring", "environment"): "moordyn: water density and depth of the file or of [water] (`scene`)",
+    ("mooring", "settle"): "moordyn: bring the lines to rest at the initial pose before t = 0",
     ("mooring", "body"): "the moored body",
     ("mooring", "point"): "fairlead, n-frame at rest",
     ("mooring", "stiffness"): "linear: spring per n-frame axis (N/m)",

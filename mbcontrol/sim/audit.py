@@ -16,7 +16,8 @@ ENERGY_MARGIN = 2.0     # a run may not end up with more than twice the energy p
 
 def energy_budget(plant, t, Y):
     """(E - E_0, W_in) per sample (J): the mechanical energy gained, and the work the waves and
-    the PTOs put in, W_in = int (P_exc + sum max(0, -P_pto)) dt (trapezoid).
+    the PTOs put in, W_in = int (P_exc + sum max(0, -P_pto)) dt (trapezoid), and MoorDyn's
+    lines (their power into the bodies, either sign: the lines' energy is not in E).
 
     Radiation (passive, starting at rest), friction, drag and mooring damping only remove
     energy, so a faithful solution has E - E_0 <= W_in (up to its integration error).
@@ -26,6 +27,8 @@ def energy_budget(plant, t, Y):
     if "energy" not in col or any(m.kind == "catenary" for m in plant.scene.moorings):
         return None        # a catenary's elastic and gravity energy is not in the audit
     power_in = Y[:, col["excitation_power"]].copy()
+    if "mooring_power" in col:          # MoorDyn's lines: they store and return energy
+        power_in += Y[:, col["mooring_power"]]
     for pto in plant.scene.ptos:
         power_in += np.maximum(0.0, -Y[:, col[f"{pto.name}__power"]])
     work = np.concatenate([[0.0], np.cumsum(0.5 * (power_in[1:] + power_in[:-1])

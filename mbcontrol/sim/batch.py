@@ -65,6 +65,9 @@ def batch_states(plant, waves=None, params=None, *, duration: float, dt: float,
     spec = integrators.method(method)
     if not spec.fixed_step:
         raise InputError(f"simulate_batch needs a fixed-step method, got {method!r}")
+    if getattr(plant, "moordyn", ()):
+        raise InputError(f"{plant.name}: simulate_batch steps the cases in one compiled call; "
+                         f"its MoorDyn moorings are stepped beside the plant: use sim.simulate")
     waves_list, params_list = _cases(waves, params)
     n_cases = len(waves_list)
     P = np.array([_vector(plant, p) for p in params_list])                 # (cases, np)

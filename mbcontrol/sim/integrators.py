@@ -231,11 +231,12 @@ def excitation_at_nodes(plant, wave, n: int, dt: float, nodes) -> np.ndarray:
             return coefficient_offsets(wave, plant.wave_coefficients(wave), n, dt, nodes)
         if wave.directional:            # a spread sea: each component's own direction
             coeffs = plant.hydro.excitation_at(wave.omega, wave.direction)
-            return coefficient_offsets(wave, coeffs, n, dt, nodes)
+            return plant.padded(coefficient_offsets(wave, coeffs, n, dt, nodes))
         # the data's coefficients: selected once per plant and direction
         coeffs = derived(plant, ("sim.excitation_coefficients", wave.direction),
                          lambda: plant.hydro.excitation_coefficients(wave.direction))
-        return excitation_at_offsets(wave, plant.hydro.omega, coeffs, n, dt, nodes)
+        return plant.padded(excitation_at_offsets(wave, plant.hydro.omega, coeffs, n, dt,
+                                                  nodes))
     except (HydroError, WaveError):
         raise
     except ValueError as exc:

@@ -59,9 +59,10 @@ class _Column:
 
 def can_run(plant, controller, method: str) -> bool:
     """Whether `simulate_arrays` covers this run: no controller, a fixed-step method and no
-    catenary mooring (whose report needs the full record)."""
+    catenary mooring (whose report needs the full record) or MoorDyn mooring (stepped beside
+    the plant, sim.moordyn_run)."""
     return (controller is None and integrators.method(method).fixed_step
-            and not any(m.kind == "catenary" for m in plant.scene.moorings))
+            and not any(m.kind in ("catenary", "moordyn") for m in plant.scene.moorings))
 
 
 def simulate_arrays(plant, wave=None, *, duration: float, dt: float, method: str = "rk4",
@@ -77,6 +78,9 @@ def simulate_arrays(plant, wave=None, *, duration: float, dt: float, method: str
     spec = integrators.method(method)
     if not spec.fixed_step:
         raise InputError(f"simulate_arrays needs a fixed-step method, got {method!r}")
+    if getattr(plant, "moordyn", ()):
+        raise InputError(f"{plant.name}: simulate_arrays steps the plant alone; its MoorDyn "
+                         f"moorings need sim.simulate")
     n = int(round(duration / dt))
     t = np.arange(n + 1) * dt
     p = _parameters(plant, params, None)

@@ -30,6 +30,7 @@ from .alongside import OutputsAlongside
 from .audit import diverged, energy_audit, energy_budget  # noqa: F401 (energy_budget: re-exported)
 from .held import HeldStepper
 from .methods import time_steps
+from .moordyn_run import prepare_moored, run_moored
 from .moorings import mooring_report
 from .protocol import estimation_report, uses_state
 
@@ -57,6 +58,10 @@ def simulate(plant, wave=None, *, duration: float, dt: float | None = None, cont
     rtol = defaults.resolve("sim.rtol", rtol)
     n = time_steps(duration, dt)
     spec = integrators.method(method)
+    if getattr(plant, "moordyn", ()) and not spec.fixed_step:
+        raise InputError(f"{plant.name}: method {method!r} is adaptive, and MoorDyn's lines are "
+                         f"stepped beside the plant at a fixed step (they have no Jacobian for "
+                         f"it); expected a fixed-step method: rk4, rk3, dopri5 or exp-rk4")
     t = np.arange(n + 1) * dt
     p = _parameters(plant, params, controller)
     x0 = plant.x0() if x0 is None else np.asarray(x0, float)
@@ -78,6 +83,9 @@ def simulate(plant, wave=None, *, duration: float, dt: float | None = None, cont
     alongside = None
     if spec.fixed_step:                  # compile first: wall_time_s excludes it
         steps = n if embedded else _steps_per_period(_period(controller, dt), dt)
+        if getattr(plant, "moordyn", ()):    # one step at a time, the points' kinematics
+            steps = 1
+            prepare_moored(plant, compiled)
         integrators.prepare(plant, steps, method, law if embedded else None, compiled)
         alongside = OutputsAlongside(plant, n + 1, p, compiled)
     start = time.perf_counter()
@@ -85,11 +93,12 @@ def simulate(plant, wave=None, *, duration: float, dt: float | None = None, cont
         if spec.fixed_step:
             W_nodes = integrators.excitation_at_nodes(plant, wave, n, dt, spec.nodes)
             p_run = np.concatenate([p, gains]) if embedded and gains is not None else p
-            X, U = _run_fixed(plant, method, controller, x0, W_nodes, p_run, dt=dt, n=n,
-                              law=law if embedded else None, embedded=embedded,
-                              compiled=compiled, check=check, alongside=alongside)
+            X, U, moored = _run_fixed(plant, method, controller, x0, W_nodes, p_run, dt=dt,
+                                      n=n, law=law if embedded else None, embedded=embedded,
+                                      compiled=compiled, check=check, alongside=alongside)
         else:
-            X, U = _run_cvodes(plant, wave, controller, x0, p, dt, n, rtol, check, method)
+            (X, U), moored = _run_cvodes(plant, wave, controller, x0, p, dt, n, rtol, check,
+                                         method), None
     except BaseException:
         if alongside is not None:
             alongside.close(errors=False)
@@ -99,12 +108,7 @@ def simulate(plant, wave=None, *, duration: float, dt: float | None = None, cont
         bar.close()
 
     start = time.perf_counter()
-    if wave is None:
-        W = np.zeros((n + 1, len(plant.disturbances)))
-    elif spec.fixed_step:             # the steps' start nodes already hold w(t_0..t_n-1)
-        W = np.vstack([W_nodes[:, 0], plant.excitation(wave, t[-1:])])
-    else:
-        W = plant.excitation(wave, t)
+    W = _disturbance_record(plant, wave, t, W_nodes if spec.fixed_step else None, moored)
     U_full = np.vstack([U, _last_command(plant, controller, t[-1], X[-1], U, W[-1], p)])
     Y = alongside.finish(X, U_full, W) if alongside is not None \
         else integrators.outputs(plant, X, U_full, W, p, compiled=compiled)
@@ -118,12 +122,35 @@ def simulate(plant, wave=None, *, duration: float, dt: float | None = None, cont
     if not spec.fixed_step:
         ds.attrs["rtol"] = rtol
     ds.attrs["moorings"] = mooring_report(plant, ds)
+    if moored is not None:
+        _add_tensions(ds, moored)
     report = estimation_report(controller)    # an estimator's accuracy
     if report is not None:
         ds.attrs["estimator"] = jsonable(report(t, W))
     if loop is not None:                 # analysis.validity reads it
         ds.attrs["sampled_loop"] = copy.deepcopy(loop)
     return ds
+
+
+def _disturbance_record(plant, wave, t, W_nodes, moored) -> np.ndarray:
+    """w at every sample (n+1, nw): a fixed-step run's start nodes hold w(t_0..t_n-1) (MoorDyn's
+    forces included), then w(t_n); an adaptive run's from the wave."""
+    nw = len(plant.disturbances)
+    if W_nodes is None:
+        return plant.excitation(wave, t) if wave is not None else np.zeros((t.size, nw))
+    W = np.vstack([W_nodes[:, 0], plant.excitation(wave, t[-1:]) if wave is not None
+                   else np.zeros((1, nw))])
+    if moored is not None:            # MoorDyn's forces at t_n
+        W[-1, moored["columns"]] = moored["w_last"]
+    return W
+
+
+def _add_tensions(ds, moored) -> None:
+    """Each MoorDyn line's anchor and fairlead tension (N) as variables, and what MoorDyn ran
+    with in attrs["moordyn"]."""
+    for name, values in moored["tensions"].items():
+        ds[name] = ("time", values, {"units": "N", "long_name": name.replace("__", " ")})
+    ds.attrs["moordyn"] = moored["report"]
 
 
 def _last_command(plant, controller, t, x, U, w, p) -> np.ndarray:
@@ -154,10 +181,19 @@ def _parameters(plant, params, controller) -> np.ndarray:
 def _run_fixed(plant, method, controller, x0, W_nodes, p, *, dt, n, law, embedded, compiled,
                check, alongside):
     nu = len(plant.inputs)
+    if getattr(plant, "moordyn", ()):
+        def command(i, x, u_prev, w):
+            y = np.asarray(plant.h(x, u_prev, w, p[:len(plant.p0)])).ravel()
+            return _command(controller, i * dt, y, x, nu)
+        return run_moored(plant, method, x0, W_nodes, p, dt=dt, n=n, law=law,
+                          compiled=compiled, check=check, alongside=alongside,
+                          command=None if embedded else command,
+                          period_steps=1 if embedded else _steps_per_period(
+                              _period(controller, dt), dt))
     if embedded:
-        return integrators.run_fixed_step(plant, x0, np.zeros((n, nu)), W_nodes, p, dt, method,
-                                          law=law, compiled=compiled, on_chunk=check,
-                                          alongside=alongside)
+        return (*integrators.run_fixed_step(plant, x0, np.zeros((n, nu)), W_nodes, p, dt,
+                                            method, law=law, compiled=compiled, on_chunk=check,
+                                            alongside=alongside), None)
     m = _steps_per_period(_period(controller, dt), dt)
     stepper = HeldStepper(plant, method, m, p, dt, compiled)
     X, U = np.empty((n + 1, plant.nx)), np.empty((n, nu))
@@ -170,7 +206,7 @@ def _run_fixed(plant, method, controller, x0, W_nodes, p, *, dt, n, law, embedde
         X[i + 1:i + k + 1] = stepper.advance(X[i], u_prev, W_nodes[i:i + k])
         check(i + k, X[:i + k + 1])
         alongside.advance(i + k, X, U, W_nodes[:, 0])
-    return X, U
+    return X, U, None
 
 
 def _run_cvodes(plant, wave, controller, x0, p, dt, n, rtol, check, method="cvodes"):

@@ -163,6 +163,29 @@ def failed_record(case, exc: BaseException, start: float) -> dict:
             "wall_time_s": time.perf_counter() - start}
 
 
+def mooring_metrics(run) -> dict:
+    """A MoorDyn run's line loads over its statistics window (N): per line end
+    "<mooring>__line<k>__<end>_{max,mpm_3h}_N", and the case's design loads, the largest over
+    every fairlead: "mooring_max_N" (the record's) and "mooring_mpm_3h_N" (its 3-hour most
+    probable maximum, mbcontrol.analysis.mooring_stats)."""
+    from ...analysis import analysis_window, mooring_summary
+    if not any(str(name).endswith("_tension") for name in getattr(run, "data_vars", ())):
+        return {}
+    out, fairleads = {}, []
+    for mooring, lines in mooring_summary(run, analysis_window(run)).items():
+        for line, ends in lines.items():
+            for end, stats in ends.items():
+                for key in ("max_N", "mpm_3h_N"):
+                    if stats[key] is not None:
+                        out[f"{mooring}__{line}__{end}_{key}"] = float(stats[key])
+            fairleads.append(ends["fairlead"])
+    out["mooring_max_N"] = max(s["max_N"] for s in fairleads)
+    mpm = [s["mpm_3h_N"] for s in fairleads if s["mpm_3h_N"] is not None]
+    if mpm:
+        out["mooring_mpm_3h_N"] = max(mpm)
+    return out
+
+
 def case_record(case, plant, wave, run, start: float) -> dict:
     """A case's record from its run: `run` is a Dataset from `simulate` or a Run from
     `simulate_arrays` (both read as run[name].values and run.attrs), `start` the
@@ -180,6 +203,7 @@ def case_record(case, plant, wave, run, start: float) -> dict:
                 metrics[f"{pto}__{k}"] = float(v)
     metrics["mean_power_W"] = sum(m["mean_power_W"] for m in ptos.values())
     metrics["mean_electrical_power_W"] = sum(m["mean_electrical_power_W"] for m in ptos.values())
+    metrics.update(mooring_metrics(run))
     verdict = assess(run, plant, wave, mean_power_W=metrics["mean_power_W"])
     return {"case": case.key, "metrics": metrics, "valid": verdict["valid"],
             "invalid_reasons": verdict["invalid_reasons"],

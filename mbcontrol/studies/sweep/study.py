@@ -207,6 +207,7 @@ def _summary(ds, seas, run, wall, n_cases) -> dict:
         if "capture_width_ratio" in ds:
             row["capture_width_ratio"] = _plain(ds["capture_width_ratio"].mean("seed")
                                                 .isel(sea=k).values)
+        row.update(_mooring_loads(ds, k))
         rows.append(row)
     weights = np.array([s.weight for s in seas])
     weighted = aep = unchecked = None
@@ -357,6 +358,12 @@ def _nonlinear_row(sea) -> dict:
     return {"nonlinear_cases": escalated,
             "linear_mean_power_W": _plain(sea["mean_power_W__linear"].mean("seed").values)
             if escalated else None}
+
+
+def _mooring_loads(ds, k: int) -> dict:
+    """MoorDyn moorings: sea k's design loads (N), the largest over fairleads and seeds."""
+    return {load: _plain(ds[load].max("seed").isel(sea=k).values)
+            for load in ("mooring_max_N", "mooring_mpm_3h_N") if load in ds}
 
 
 def _plain(values):

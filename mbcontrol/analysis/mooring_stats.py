@@ -1,0 +1,91 @@
+"""Line tension statistics of a run with MoorDyn moorings: what a mooring designer reads.
+
+Per line and end (the fairlead, end B, and the anchor, end A; variables
+"<mooring>__line<k>__<end>_tension", N, in the run's Dataset): mean, standard deviation,
+minimum, maximum, the level exceeded 1 % of the time (p99), and the most probable maximum in
+a three-hour sea state (`MPM_HOURS`), mean + std sqrt(2 ln N) with N = 3 h / Tz the number of
+mean up-crossings (Tz from the record's own up-crossings of its mean): the short-term
+extreme of a narrow-banded Gaussian process (Rayleigh peaks), the design-load estimate of
+mooring standards' quasi-static and dynamic analyses (e.g. DNV-OS-E301 uses the MPM of a
+three-hour storm). It is an estimate under that assumption; the record's own max is beside
+it. A line is "slack" where its tension falls below SLACK_FRACTION of its mean: the first such
+time is reported (snap loads follow slack).
+"""
+from __future__ import annotations
+
+import math
+import re
+
+import numpy as np
+
+MPM_HOURS = 3.0
+SLACK_FRACTION = 0.02
+_NAME = re.compile(r"^(?P<mooring>.+)__line(?P<line>\d+)__(?P<end>anchor|fairlead)_tension$")
+
+
+def tension_statistics(t: np.ndarray, tension: np.ndarray) -> dict:
+    """Statistics of one tension record (N) sampled at times t (s); see the module docstring."""
+    t, x = np.asarray(t, float), np.asarray(tension, float)
+    mean, std = float(np.mean(x)), float(np.std(x))
+    above = x > mean
+    ups = int(np.count_nonzero(~above[:-1] & above[1:]))
+    span = float(t[-1] - t[0]) if t.size > 1 else 0.0
+    out = {"mean_N": mean, "std_N": std, "min_N": float(np.min(x)), "max_N": float(np.max(x)),
+           "p99_N": float(np.percentile(x, 99.0)), "mpm_3h_N": None, "tz_s": None,
+           "slack_at_s": None}
+    if ups >= 2 and std > 0:
+        tz = span / ups
+        crossings = MPM_HOURS * 3600.0 / tz
+        out.update(tz_s=tz, mpm_3h_N=mean + std * math.sqrt(2.0 * math.log(crossings)))
+    slack = np.flatnonzero(x < SLACK_FRACTION * abs(mean))
+    if slack.size:
+        out["slack_at_s"] = float(t[slack[0]])
+    return out
+
+
+def mooring_summary(ds, mask=None) -> dict:
+    """{mooring: {"line<k>": {"fairlead": stats, "anchor": stats}}} over the samples `mask`
+    (None: all) of a Dataset's tension variables; {} without MoorDyn moorings."""
+    t = ds["time"].values
+    keep = slice(None) if mask is None else mask
+    out: dict = {}
+    for name in ds.data_vars:
+        found = _NAME.match(str(name))
+        if not found:
+            continue
+        line = out.setdefault(found["mooring"], {}).setdefault(f"line{found['line']}", {})
+        line[found["end"]] = tension_statistics(t[keep], ds[name].values[keep])
+    return out
+
+
+def slack_lines(summary: dict) -> list[str]:
+    """Warnings for every line end that went slack, with the time."""
+    notes = []
+    for mooring, lines in summary.items():
+        for line, ends in lines.items():
+            for end, stats in ends.items():
+                if stats["slack_at_s"] is not None:
+                    notes.append(f"mooring '{mooring}' {line} went slack at its {end} at "
+                                 f"t = {stats['slack_at_s']:.4g} s (tension below "
+                                 f"{SLACK_FRACTION:.0%} of its mean {stats['mean_N']:.4g} N): "
+                                 f"snap loads follow; check the line's length and pretension")
+    return notes
+
+
+def tension_lines(summary: dict) -> list[str]:
+    """The text report of `mooring_summary`: per mooring a header, then per line its fairlead
+    and its anchor statistics in kN (mean, std, max, p99, 3-hour most probable maximum)."""
+    out = []
+    for mooring, lines in summary.items():
+        out.append(f"mooring {mooring}, tensions in kN (fairlead; anchor): mean, std, max, p99, "
+                   f"3-hour most probable max")
+        for line, ends in lines.items():
+            out.append(f"  {line}: " + "; ".join(_kilonewtons(ends[end])
+                                                  for end in ("fairlead", "anchor")))
+    return out
+
+
+def _kilonewtons(stats: dict) -> str:
+    mpm = stats["mpm_3h_N"]
+    values = (stats["mean_N"], stats["std_N"], stats["max_N"], stats["p99_N"])
+    return ", ".join(f"{v / 1e3:.4g}" for v in values) + (f", {mpm / 1e3:.4g}" if mpm else ", -")
