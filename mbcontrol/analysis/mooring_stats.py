@@ -8,7 +8,7 @@ mean up-crossings (Tz from the record's own up-crossings of its mean): the short
 extreme of a narrow-banded Gaussian process (Rayleigh peaks), the design-load estimate of
 mooring standards' quasi-static and dynamic analyses (e.g. DNV-OS-E301 uses the MPM of a
 three-hour storm). It is an estimate under that assumption; the record's own max is beside
-it. A line is "slack" where its tension falls below SLACK_FRACTION of its mean: the first such
+it, and a record whose max exceeds it is flagged non-Gaussian ("gaussian": false: snap loads). A line is "slack" where its tension falls below SLACK_FRACTION of its mean: the first such
 time is reported (snap loads follow slack).
 """
 from __future__ import annotations
@@ -37,6 +37,9 @@ def tension_statistics(t: np.ndarray, tension: np.ndarray) -> dict:
         tz = span / ups
         crossings = MPM_HOURS * 3600.0 / tz
         out.update(tz_s=tz, mpm_3h_N=mean + std * math.sqrt(2.0 * math.log(crossings)))
+    # a shorter record's max above the Gaussian 3-hour estimate: the load is not Gaussian
+    # (snap loads, a line going slack and taut), and the estimate is not to be trusted
+    out["gaussian"] = out["mpm_3h_N"] is not None and out["max_N"] <= out["mpm_3h_N"]
     slack = np.flatnonzero(x < SLACK_FRACTION * abs(mean))
     if slack.size:
         out["slack_at_s"] = float(t[slack[0]])
@@ -59,10 +62,18 @@ def mooring_summary(ds, mask=None) -> dict:
 
 
 def slack_lines(summary: dict) -> list[str]:
-    """Warnings for every line end that went slack, with the time."""
+    """Warnings for every line end that went slack, with the time, and for every fairlead
+    whose record holds more than its Gaussian 3-hour most probable maximum (snap loads)."""
     notes = []
     for mooring, lines in summary.items():
         for line, ends in lines.items():
+            fairlead = ends["fairlead"]
+            if fairlead["mpm_3h_N"] is not None and not fairlead["gaussian"]:
+                notes.append(f"mooring '{mooring}' {line}: the record's largest fairlead tension "
+                             f"{fairlead['max_N']:.4g} N exceeds its Gaussian 3-hour most "
+                             f"probable maximum {fairlead['mpm_3h_N']:.4g} N: snap loads, not a "
+                             f"Gaussian load; design on the record's extremes (longer runs, "
+                             f"more seeds), not on the estimate")
             for end, stats in ends.items():
                 if stats["slack_at_s"] is not None:
                     notes.append(f"mooring '{mooring}' {line} went slack at its {end} at "

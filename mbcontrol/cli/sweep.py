@@ -313,7 +313,8 @@ def _print_mooring_loads(rows: list) -> None:
     """MoorDyn moorings: the sea's design loads beside its power, largest over lines and seeds."""
     if not any("mooring_max_N" in row for row in rows):
         return
-    print("  mooring loads, the most loaded fairlead (kN; the largest over seeds):")
+    print("  mooring loads, the most loaded fairlead (kN; the largest over seeds; a 3-h MPM below "
+          "the record's max marks snap loads, where it does not hold):")
     print(f"  {'Hs m':>6s} {'Tp s':>6s} {'max':>9s} {'3-h MPM':>9s}")
     for row in rows:
         print(f"  {row['hs']:6.3g} {row['tp']:6.3g} {_kN(row.get('mooring_max_N')):>9s} "

@@ -301,3 +301,23 @@ def test_a_sweep_gives_the_mooring_loads_beside_the_power(capsys, tmp_path):
     assert rows[1]["mooring_max_N"] > rows[0]["mooring_max_N"]       # a higher sea pulls more
     assert main(argv) == 0
     assert "mooring loads, the most loaded fairlead" in capsys.readouterr().out
+
+
+def test_snap_loads_are_flagged_where_the_gaussian_estimate_fails():
+    """A narrow-band Gaussian tension (a random-phase sum about 0.1 Hz, 600 s) stays below its
+    3-hour most probable maximum; the same record with one snap (a line going slack and taut:
+    five times the mean for 0.1 s) does not, and is flagged."""
+    from mbcontrol.analysis import tension_statistics
+    from mbcontrol.analysis.mooring_stats import slack_lines
+    rng = np.random.default_rng(0)
+    t = np.arange(0.0, 600.0, 0.05)
+    f = rng.uniform(0.08, 0.12, 40)
+    x = 2e5 + 1e4 * np.sum(np.cos(2 * np.pi * f[:, None] * t + rng.uniform(0, 6.3, 40)[:, None]),
+                           axis=0) / np.sqrt(20)
+    calm = tension_statistics(t, x)
+    assert calm["gaussian"] and calm["max_N"] < calm["mpm_3h_N"]
+    x[6000:6002] = 1e6
+    snap = tension_statistics(t, x)
+    assert not snap["gaussian"]
+    summary = {"lines": {"line1": {"fairlead": snap, "anchor": calm}}}
+    assert any("snap loads" in note for note in slack_lines(summary))
