@@ -299,8 +299,9 @@ def test_a_sweep_gives_the_mooring_loads_beside_the_power(capsys, tmp_path):
     fairleads = [ds[f"chains__line{k}__fairlead_tension"].values[window].max() for k in (1, 2, 3)]
     assert rows[1]["mooring_max_N"] == pytest.approx(max(fairleads), rel=1e-9)
     assert rows[1]["mooring_max_N"] > rows[0]["mooring_max_N"]       # a higher sea pulls more
-    assert main(argv) == 0
+    assert main(argv + ["--plot", str(tmp_path / "sweep.png")]) == 0    # a loads panel too
     assert "mooring loads, the most loaded fairlead" in capsys.readouterr().out
+    assert (tmp_path / "sweep.png").stat().st_size > 10_000
 
 
 def test_snap_loads_are_flagged_where_the_gaussian_estimate_fails():

@@ -117,8 +117,9 @@ def plot_sweep(ds, summary: dict, path=None):
     """Panels on the same axes, peak period Tp (s) across and Hs (m) up: the power
     matrix (mean power, kW, cells on the real Hs and Tp values, a colourbar), capture width
     (or its ratio) against Tp, a line per Hs, for a weighted list each sea state's
-    annual energy (MWh) as a bubble at its Hs and Tp, and for a --design sweep each sea's
-    mean power as a share of its bound inside the envelope (%). Returns the figure, written to path when
+    annual energy (MWh) as a bubble at its Hs and Tp, for a --design sweep each sea's
+    mean power as a share of its bound inside the envelope (%), and with MoorDyn moorings each
+    sea's largest fairlead tension (kN). Returns the figure, written to path when
     given."""
     import matplotlib.pyplot as plt
 
@@ -126,7 +127,8 @@ def plot_sweep(ds, summary: dict, path=None):
     weighted = summary.get("annual_energy_MWh") is not None
     designed = "bound_W" in ds
     budgeted = summary.get("annual_energy_budget") is not None
-    n = 2 + weighted + designed + budgeted
+    moored = "mooring_max_N" in ds
+    n = 2 + weighted + designed + budgeted + moored
     fig, axes = plt.subplots(1, n, figsize=(5.3 * n, 4.4))
     period = "tp"
     try:
@@ -186,6 +188,8 @@ def plot_sweep(ds, summary: dict, path=None):
                      f"share (area)", fontsize=9)
     if designed:
         _share_of_bound(fig, axes[2 + weighted], ds)
+    if moored:
+        _mooring_loads(fig, axes[2 + weighted + designed], ds)
     if budgeted:
         _budget(axes[-1], summary)
     fig.tight_layout()
@@ -215,6 +219,31 @@ def _share_of_bound(fig, ax, ds):
     ax.set_ylabel("significant wave height Hs, m")
     ax.grid(alpha=0.3)
     ax.set_title("designed per sea: share of the bound", fontsize=9)
+
+
+def _mooring_loads(fig, ax, ds):
+    """MoorDyn moorings: each sea's largest fairlead tension (kN, the largest over seeds) as
+    a dot at its Hs and Tp; seas whose record exceeds its Gaussian 3-hour estimate (snap
+    loads) ringed in red."""
+    over = [d for d in ds["mooring_max_N"].dims if d != "sea"]
+    peak = ds["mooring_max_N"].max(over).values / 1e3
+    ok = np.isfinite(peak)
+    dots = ax.scatter(ds["tp"].values[ok], ds["hs"].values[ok], c=peak[ok], cmap="inferno_r",
+                      s=60, edgecolor="k", lw=0.3)
+    for tp, hs, v in zip(ds["tp"].values[ok], ds["hs"].values[ok], peak[ok]):
+        ax.annotate(f"{v:.0f}", (tp, hs), textcoords="offset points", xytext=(0, 5),
+                    ha="center", fontsize=6)
+    if "mooring_mpm_3h_N" in ds:
+        snap = ok & (peak > ds["mooring_mpm_3h_N"].max(over).values / 1e3)
+        if snap.any():
+            ax.scatter(ds["tp"].values[snap], ds["hs"].values[snap], s=150, facecolor="none",
+                       edgecolor="C3", lw=1.2, label="max above its Gaussian 3-h estimate")
+            ax.legend(fontsize=7, loc="lower right")
+    fig.colorbar(dots, ax=ax, label="largest fairlead tension, kN")
+    ax.set_xlabel("peak period Tp, s")
+    ax.set_ylabel("significant wave height Hs, m")
+    ax.grid(alpha=0.3)
+    ax.set_title("mooring loads: the most loaded fairlead per sea", fontsize=9)
 
 
 def _budget(ax, summary):
