@@ -51,8 +51,9 @@ def simulate(plant, wave=None, *, duration: float, dt: float | None = None, cont
     attrs: wall_time_s is the excitation synthesis and the time-stepping (compilation and
     the output evaluation excluded; output_time_s is the latter: on two cores most of it runs
     alongside the steps, sim.alongside, and output_time_s is what remained after them). A
-    controller with a period and a static law has its held loop checked first (sim.sampled: a RuntimeWarning when
-    unstable; the verdict in attrs["sampled_loop"], which analysis.validity reads).
+    controller with a period and a static law has its held loop checked first (sim.sampled: a
+    RuntimeWarning when unstable; the verdict in attrs["sampled_loop"], which
+    analysis.validity reads).
     """
     dt, method = defaults.resolve("sim.dt", dt), defaults.resolve("sim.method", method)
     rtol = defaults.resolve("sim.rtol", rtol)

@@ -198,27 +198,36 @@ def plot_sweep(ds, summary: dict, path=None):
     return fig
 
 
+def _sea_dots(fig, ax, ds, values, ringed, *, cmap, label, ring_label, title, legend_at,
+              **colour):
+    """Each sea's value as a dot at its Hs and Tp, annotated, with a colourbar; the seas in
+    `ringed` (a mask) ringed in red."""
+    ok = np.isfinite(values)
+    dots = ax.scatter(ds["tp"].values[ok], ds["hs"].values[ok], c=values[ok], cmap=cmap, s=60,
+                      edgecolor="k", lw=0.3, **colour)
+    for tp, hs, v in zip(ds["tp"].values[ok], ds["hs"].values[ok], values[ok]):
+        ax.annotate(f"{v:.0f}", (tp, hs), textcoords="offset points", xytext=(0, 5),
+                    ha="center", fontsize=6)
+    if ringed.any():
+        ax.scatter(ds["tp"].values[ringed], ds["hs"].values[ringed], s=150, facecolor="none",
+                   edgecolor="C3", lw=1.2, label=ring_label)
+        ax.legend(fontsize=7, loc=legend_at)
+    fig.colorbar(dots, ax=ax, label=label)
+    ax.set_xlabel("peak period Tp, s")
+    ax.set_ylabel("significant wave height Hs, m")
+    ax.grid(alpha=0.3)
+    ax.set_title(title, fontsize=9)
+
+
 def _share_of_bound(fig, ax, ds):
     """--design: each sea's mean power over its bound inside the envelope (%), a dot at its
     Hs and Tp; seas where no setting stayed inside ringed in red."""
     over = [d for d in ds["mean_power_W"].dims if d != "sea"]
     share = 100 * (ds["mean_power_W"].mean(over) / ds["bound_W"].mean(over)).values
-    ok = np.isfinite(share)
-    dots = ax.scatter(ds["tp"].values[ok], ds["hs"].values[ok], c=share[ok], cmap="cividis",
-                      vmin=0, vmax=100, s=60, edgecolor="k", lw=0.3)
-    for tp, hs, v in zip(ds["tp"].values[ok], ds["hs"].values[ok], share[ok]):
-        ax.annotate(f"{v:.0f}", (tp, hs), textcoords="offset points", xytext=(0, 5),
-                    ha="center", fontsize=6)
-    outside = ~ds["inside_envelope"].all(over).values
-    if outside.any():
-        ax.scatter(ds["tp"].values[outside], ds["hs"].values[outside], s=140, facecolor="none",
-                   edgecolor="C3", lw=1.2, label="no setting inside the envelope")
-        ax.legend(fontsize=7, loc="upper left")
-    fig.colorbar(dots, ax=ax, label="mean power / bound inside the envelope, %")
-    ax.set_xlabel("peak period Tp, s")
-    ax.set_ylabel("significant wave height Hs, m")
-    ax.grid(alpha=0.3)
-    ax.set_title("designed per sea: share of the bound", fontsize=9)
+    _sea_dots(fig, ax, ds, share, ~ds["inside_envelope"].all(over).values, cmap="cividis",
+              vmin=0, vmax=100, label="mean power / bound inside the envelope, %",
+              ring_label="no setting inside the envelope", legend_at="upper left",
+              title="designed per sea: share of the bound")
 
 
 def _mooring_loads(fig, ax, ds):
@@ -227,23 +236,11 @@ def _mooring_loads(fig, ax, ds):
     loads) ringed in red."""
     over = [d for d in ds["mooring_max_N"].dims if d != "sea"]
     peak = ds["mooring_max_N"].max(over).values / 1e3
-    ok = np.isfinite(peak)
-    dots = ax.scatter(ds["tp"].values[ok], ds["hs"].values[ok], c=peak[ok], cmap="inferno_r",
-                      s=60, edgecolor="k", lw=0.3)
-    for tp, hs, v in zip(ds["tp"].values[ok], ds["hs"].values[ok], peak[ok]):
-        ax.annotate(f"{v:.0f}", (tp, hs), textcoords="offset points", xytext=(0, 5),
-                    ha="center", fontsize=6)
-    if "mooring_mpm_3h_N" in ds:
-        snap = ok & (peak > ds["mooring_mpm_3h_N"].max(over).values / 1e3)
-        if snap.any():
-            ax.scatter(ds["tp"].values[snap], ds["hs"].values[snap], s=150, facecolor="none",
-                       edgecolor="C3", lw=1.2, label="max above its Gaussian 3-h estimate")
-            ax.legend(fontsize=7, loc="lower right")
-    fig.colorbar(dots, ax=ax, label="largest fairlead tension, kN")
-    ax.set_xlabel("peak period Tp, s")
-    ax.set_ylabel("significant wave height Hs, m")
-    ax.grid(alpha=0.3)
-    ax.set_title("mooring loads: the most loaded fairlead per sea", fontsize=9)
+    snap = np.isfinite(peak) & (peak > ds["mooring_mpm_3h_N"].max(over).values / 1e3) \
+        if "mooring_mpm_3h_N" in ds else np.zeros(peak.shape, bool)
+    _sea_dots(fig, ax, ds, peak, snap, cmap="inferno_r", label="largest fairlead tension, kN",
+              ring_label="max above its Gaussian 3-h estimate", legend_at="best",
+              title="mooring loads: the most loaded fairlead per sea")
 
 
 def _budget(ax, summary):
