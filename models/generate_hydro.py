@@ -123,8 +123,23 @@ def ship_fits(names=None) -> int:
     stale = [p for p in out.glob("radiation_*.npz") if p.name not in wanted and not names]
     for path in stale:
         path.unlink()
+    _ship_statics(out.parent)
     print(f"models/radiation_fits: {len(wanted)} fits ({len(stale)} stale removed)")
     return 0
+
+
+def _ship_statics(models: Path) -> None:
+    """The MoorDyn statics of the catalogue's lines files, beside them (plant.moordyn_statics)."""
+    import json
+    from mbcontrol.atomic import write_bytes
+    from mbcontrol.plant.moordyn_statics import STATICS_SERVED, shipped_statics
+    shipped = {}
+    for lines, key, statics in STATICS_SERVED:
+        if Path(lines).resolve().parent == models.resolve():
+            shipped.setdefault(lines, {})[key] = statics
+    for lines, entries in shipped.items():
+        write_bytes(shipped_statics(lines), json.dumps(entries, indent=1).encode())
+        print(f"{shipped_statics(lines).name}: {len(entries)} statics")
 
 
 def main(argv=None) -> int:

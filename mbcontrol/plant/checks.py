@@ -47,13 +47,6 @@ def _unrestored(scene, tree, stiffness) -> list[str]:
             j = names.index(f"{joint.name}__{dof}")
             if np.max(np.abs(stiffness[:, j])) <= NO_RESTORING * scale:
                 found.append(f"{joint.child}__{dof}")
-                if any(m.kind == "moordyn" and m.body == joint.child for m in scene.moorings):
-                    warnings.warn(
-                        f"{scene.path}: body '{joint.child}' has no restoring in {dof} in the "
-                        f"linear model: its MoorDyn lines restore it in simulation, but their "
-                        f"stiffness is not in the linear model yet, so linearisation, design "
-                        f"and Bode plots see it free in {dof}", RuntimeWarning, stacklevel=4)
-                    continue
                 warnings.warn(
                     f"{scene.path}: body '{joint.child}' has no restoring in {dof} (free joint "
                     f"'{joint.name}'): no hydrostatics, mooring, PTO spring or end stop resists "

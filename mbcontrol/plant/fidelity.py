@@ -293,13 +293,15 @@ def linearised_plant(plant: ProcessPlant) -> ProcessPlant:
     # evaluating at z = 0 with p symbolic folds every constant: only p-dependent entries remain
     at_rest = ca.Function("at_rest", [z, p], [f, ca.jacobian(f, z), y, ca.jacobian(y, z),
                                               *hessians])
-    f0, Jf, y0, Jy, *H = at_rest(ca.DM.zeros(z.shape[0]), p)
-    y_lin = y0 + ca.mtimes(Jy, z)
+    rest = np.concatenate([plant.x0(), np.zeros(z.shape[0] - plant.nx)])
+    f0, Jf, y0, Jy, *H = at_rest(ca.DM(rest), p)
+    dz = z - ca.DM(rest)            # rest: the scene's pose, or where mooring lines hold it
+    y_lin = y0 + ca.mtimes(Jy, dz)
     terms = [ca.SX.zeros(1)] * len(plant.outputs)
     for i, Hi in zip(quadratic, H):
-        terms[i] = 0.5 * ca.mtimes([z.T, Hi, z])
+        terms[i] = 0.5 * ca.mtimes([dz.T, Hi, dz])
     y_lin += ca.vertcat(*terms)
-    f_fun = ca.Function("f", [x, u, w, p], [f0 + ca.mtimes(Jf, z)], ["x", "u", "w", "p"],
+    f_fun = ca.Function("f", [x, u, w, p], [f0 + ca.mtimes(Jf, dz)], ["x", "u", "w", "p"],
                         ["xdot"])
     h_fun = ca.Function("h", [x, u, w, p], [y_lin], ["x", "u", "w", "p"], ["y"])
     notes = dict(plant.notes)

@@ -22,7 +22,8 @@ from ..scene import DOF_NAMES, Scene, load_scene
 from . import checks, loads, nonlinear
 from .held_pressure import HeldPressure, held_pressure
 from .mechanical import dof_selector, mechanical_matrices
-from .moordyn_loads import coupled_points, moordyn_loads, moordyn_names
+from .moordyn_loads import (coupled_points, moordyn_loads, moordyn_names, moored_rest,
+                            say_moored_rest)
 from .ownership import linear_params
 from .pieces import plant_parts
 from .rest import preloads
@@ -52,6 +53,8 @@ class ProcessPlant:
     held: HeldPressure | None = field(default=None, repr=False)
     # MoorDyn moorings' Coupled points: their forces follow the field rows in w
     moordyn: tuple = field(default=(), repr=False)
+    # the rest state when it is not the scene's pose (MoorDyn lines' pull: moordyn_loads)
+    rest: np.ndarray | None = field(default=None, repr=False)
     # derived data and compiled code, freed with the plant (module plant.workspace)
     workspace: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
@@ -75,8 +78,9 @@ class ProcessPlant:
         return self.topology.tree.n_q
 
     def x0(self) -> np.ndarray:
-        """The rest state (all bodies at their scene pose, still water)."""
-        return np.zeros(self.nx)
+        """The rest state: still water, all bodies at their scene pose, or where MoorDyn lines'
+        pull holds them (plant.moordyn_loads.moored_rest)."""
+        return np.zeros(self.nx) if self.rest is None else self.rest.copy()
 
     def params(self, **overrides) -> np.ndarray:
         """Parameter vector with named overrides, e.g. params(hinge_pto__damping=3.0)."""
@@ -170,8 +174,10 @@ def assemble_plant(scene: Scene | str, hydro: HydroModel | None = None, *,
     tau, potential, pto_signals, tensions, (wave_power, ranges), restoring = _body_loads(
         tau, scene, topo, hydro, (q, s, u, w[n_w:n_w + n_f], slot), params, pressure)
     power["excitation_power"] += wave_power
-    if moored:
-        tau_md, power["mooring_power"] = moordyn_loads(topo, q, s, w[n_w + n_f:], moored)
+    lines_pull = 0          # MoorDyn lines' quasi-static part: after the balance of weight
+    if moored:              # and buoyancy (plant.rest), which it moves (moored_rest)
+        lines_pull, tau_md, power["mooring_power"] = moordyn_loads(topo, q, s, w[n_w + n_f:],
+                                                                   moored)
         tau += tau_md
     # f sums each surface for its wrench alone; the outputs (restoring) also for its range
     load = nonlinear.pressure_load(scene, topo, q, w[n_w:n_w + n_f], pressure) if pressure \
@@ -179,7 +185,7 @@ def assemble_plant(scene: Scene | str, hydro: HydroModel | None = None, *,
     tau_full = ca.substitute(tau, slot, load)
     extra, balance = preloads(scene, topo, (q, s, u, w, chi, tau_full), pto_signals, params,
                               hydro.buoyancy(scene.water) if hydro else {})
-    tau, tau_full = tau + extra, tau_full + extra
+    tau, tau_full = tau + extra + lines_pull, tau_full + extra + lines_pull
 
     M = tree.mass_matrix(q, added_mass)
     notes = checks.rest_checks(scene, topo, q, s, u, w, chi, tau_full, M, params)
@@ -203,11 +209,16 @@ def assemble_plant(scene: Scene | str, hydro: HydroModel | None = None, *,
         + moordyn_names(moored)
     f = ca.Function("f", [x, u, w, p], [x_dot], ["x", "u", "w", "p"], ["xdot"])
     h = ca.Function("h", [x, u, w, p], [y], ["x", "u", "w", "p"], ["y"])
+    rest = None
+    if moored:
+        rest = moored_rest(scene, f, (tree.n_q, tree.n_s, len(states), u.shape[0], w.shape[0]),
+                           np.array(params.values))
+        notes["moored_rest"] = say_moored_rest(scene, states, rest)
     return ProcessPlant(scene, topo, hydro, tuple(states), tuple(inputs), tuple(disturbances),
                         tuple(output_names), tuple(params.names), np.array(params.values),
                         f, h, notes, plant_parts([x, u, w, p], M, tau_full, x_dot[:tree.n_q],
                                                  chi_dot, radiation_apart), pressure, held,
-                        moored)
+                        moored, rest)
 
 
 def _hydro_loads(hydro, radiation, scale, select, P, s, w, chi):

@@ -137,7 +137,7 @@ def preloads(scene, topo, parts, pto_signals, params, buoyancy):
             extra += pto_signals[pto.name][3] * sym
             record["preloads"][pto.name] = float(value)
         if found:
-            _say_once(f"{scene.name}: preload = \"balance\" holds rest: "
+            say_once(f"{scene.name}: preload = \"balance\" holds rest: "
                       + ", ".join(f"{n} {v:.6g}" for n, v in record["preloads"].items())
                       + f" (N or N m) against {_describe(scene, worst)}")
         residual = residual + D @ f0
@@ -148,7 +148,7 @@ def preloads(scene, topo, parts, pto_signals, params, buoyancy):
 _SAID: set[str] = set()
 
 
-def _say_once(message: str) -> None:
+def say_once(message: str) -> None:
     """A status line once per process: a plant is assembled twice when its radiation fit is
     judged by the device's response (the device is the plant without radiation states)."""
     if message not in _SAID:

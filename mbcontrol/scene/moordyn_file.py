@@ -272,7 +272,7 @@ def run_text(data: MoorDynInput, coupled_at_rest: np.ndarray, overrides: dict,
     positions (MoorDyn frame, m; one row per coupled point, in file order), the file's options
     with `overrides` (lower-case name -> number or word) and ours: no console or file output.
     drag_scale multiplies every drag coefficient (lines' Cd and CdAx, points' CdA): a
-    heavily damped twin settles to rest fast (mbcontrol.sim.moordyn_system)."""
+    heavily damped twin settles to rest fast (mbcontrol.plant.moordyn_system)."""
     rows = ["--------------------- MoorDyn Input File ------------------------------------",
             "written by mbcontrol from " + re.sub(r"[^\w./+-]", "_", Path(data.path).name),
             "----------------------- LINE TYPES ------------------------------------------",

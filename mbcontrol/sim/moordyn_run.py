@@ -2,9 +2,10 @@
 
 Per step of dt from t_i: the Coupled points' positions and velocities at t_i (from the state
 x_i) go to MoorDyn, which advances its lines to t_i + dt, sub-cycling at its own time step
-(the file's dtM), and returns the forces on the points at t_i + dt; the plant's compiled step
-then sees each point force vary linearly from F_i to F_i+1 across its stages (the rows of w
-at the method's nodes; mbcontrol.plant.moordyn_loads). MoorDyn extrapolates the points'
+(the file's dtM), and returns the forces on the points at t_i + dt. The plant holds the lines'
+quasi-static part itself (mbcontrol.plant.moordyn_loads), so MoorDyn supplies the remainder:
+its force less that part, which the plant's compiled step sees vary linearly from R_i to R_i+1
+across its stages (the rows of w at the method's nodes). MoorDyn extrapolates the points'
 motion over its step from their position and velocity at t_i, as it does in WEC-Sim and
 OpenFAST. So the coupling is explicit, first order in dt, and any fixed-step method of the
 plant can run it; adaptive ones cannot (MoorDyn has no Jacobian for them), and are refused.
@@ -15,13 +16,14 @@ fairlead end), N, as "<mooring>__line<k>__anchor_tension" and "...__fairlead_ten
 from __future__ import annotations
 
 import numpy as np
+from scipy.linalg import block_diag
 
 from ..plant import derived, moordyn_kinematics
 from ..scene import TO_MOORDYN
 from .compiled import compile_function
 from .integrators import _chunk_function, step_extras
 from .methods import METHODS
-from .moordyn_system import MoorDynSystem
+from ..plant import MoorDynSystem
 
 CHECK_EVERY = 512        # steps between divergence checks and hand-overs of outputs
 
@@ -59,6 +61,10 @@ class MooredRun:
             self.close()
             raise
         self._sign = np.tile(TO_MOORDYN, n_points)           # flat MoorDyn <-> n-frame
+        # the plant's own quasi-static part of the lines, F_0 + J (P - P_0), flat, n-frame
+        self._pull = np.concatenate([g.pull.T.ravel() for g in plant.moordyn])
+        self._at = np.concatenate([g.rest.T.ravel() for g in plant.moordyn])
+        self._stiffness = block_diag(*[g.stiffness for g in plant.moordyn])
         first = len(plant.disturbances) - 3 * n_points
         self.columns = slice(first, len(plant.disturbances))       # the rows of w it fills
         self.names = [f"{s.name}__line{line.id}__{end}_tension" for s in self.systems
@@ -73,10 +79,10 @@ class MooredRun:
     def forces(self, x, t: float, dt: float) -> np.ndarray:
         """MoorDyn stepped from t to t + dt from the points at state x (dt = 0: no step);
         the point forces at the end, flat in w's order (N, n-frame)."""
-        if dt <= 0:
-            return np.concatenate([s.forces().T.ravel() for s in self.systems])
         self._x[:] = x
         self._buffer._eval()
+        if dt <= 0:
+            return np.concatenate([s.forces().T.ravel() for s in self.systems])
         P = (self._P * TO_MOORDYN).ravel()           # MoorDyn's frame, flat [x1 y1 z1 ...]
         V = (self._V * TO_MOORDYN).ravel()
         if len(self.systems) == 1:
@@ -85,6 +91,14 @@ class MooredRun:
                             V[3 * span.start:3 * span.stop].tolist(), t, dt)
                 for s, span in zip(self.systems, self._spans)]
         return np.concatenate(flat) * self._sign
+
+    def remainder(self, x, t: float, dt: float) -> np.ndarray:
+        """`forces` less the plant's own quasi-static part of the lines at the points'
+        positions at t + dt (MoorDyn's: moved on from x at their velocity): what the plant
+        takes in its MoorDyn rows of w."""
+        F = self.forces(x, t, dt)
+        P = self._P.ravel() + max(dt, 0.0) * self._V.ravel()
+        return F - (self._pull + self._stiffness @ (P - self._at))
 
     def tensions(self) -> np.ndarray:
         """Anchor then fairlead tension of every line, mooring by mooring (N), in `names` order."""
@@ -143,9 +157,9 @@ def run_moored(plant, method, x0, W_nodes, p, *, dt, n, law, compiled, check, al
     tensions = np.empty((n + 1, len(moored.names)))
     cols, u = moored.columns, np.zeros(len(plant.inputs))
     try:
-        f_now, tensions[0] = moored.forces(x0, 0.0, 0.0), moored.tensions()
+        f_now, tensions[0] = moored.remainder(x0, 0.0, 0.0), moored.tensions()
         for i in range(n):
-            f_next = moored.forces(X[i], i * dt, dt)
+            f_next = moored.remainder(X[i], i * dt, dt)
             W_nodes[i, :, cols] = f_now + nodes * (f_next - f_now)
             if command is not None and i % period_steps == 0:
                 u = command(i, X[i], u, W_nodes[i, 0])

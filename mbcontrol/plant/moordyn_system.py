@@ -77,6 +77,19 @@ def _said(log: Path, lines: int = 6) -> str:
     return " | ".join(keep[-lines:])[:600]
 
 
+def input_texts(data, environment: dict, P0) -> tuple[str, str]:
+    """(the run's input file, its settling twin's: SETTLE_DRAG times the drag at dtM over
+    SETTLE_DT_DIVISOR) with the Coupled points at the n-frame positions P0 (3, n) and the
+    environment the run takes (`environment`)."""
+    overrides = {"WtrDnsty": environment["water_density_kg_m3"],
+                 "WtrDpth": environment["depth_m"], "g": environment["g_m_s2"]}
+    rest = np.asarray(P0).T * TO_MOORDYN
+    dtm = data.option("dtM")
+    twin = run_text(data, rest, {**overrides, **({"dtM": dtm / SETTLE_DT_DIVISOR} if dtm else {})},
+                    SETTLE_DRAG)
+    return run_text(data, rest, overrides), twin
+
+
 class MoorDynSystem:
     """One mooring's MoorDyn system, its Coupled points initialised at n-frame positions P0
     (3, n) with velocities V0 (m, m/s)."""
@@ -86,14 +99,12 @@ class MoorDynSystem:
         self.md = library()
         data = read_moordyn(mooring.file, f"{scene.path}: mooring '{mooring.name}'.file")
         self.data = data
-        self.environment = _environment(scene, mooring, data)
-        overrides = {"WtrDnsty": self.environment["water_density_kg_m3"],
-                     "WtrDpth": self.environment["depth_m"], "g": self.environment["g_m_s2"]}
+        self.environment = environment_of(scene, mooring, data)
         self._folder = tempfile.TemporaryDirectory(prefix="mbcontrol-moordyn-")
         folder = Path(self._folder.name)
         path, self.log = folder / "lines.txt", folder / "moordyn.log"
-        rest = np.asarray(P0).T * TO_MOORDYN
-        path.write_text(run_text(data, rest, overrides))
+        text, twin = input_texts(data, self.environment, P0)
+        path.write_text(text)
         self.n_points = P0.shape[1]
         self.handle, self.settled = None, None
         try:
@@ -101,9 +112,6 @@ class MoorDynSystem:
                 self.handle = self.md.Create(str(path))
                 self.md.Init(self.handle, self._md(P0), self._md(V0))
                 if mooring.settle:
-                    dtm = data.option("dtM")
-                    twin = run_text(data, rest, {**overrides, **(
-                        {"dtM": dtm / SETTLE_DT_DIVISOR} if dtm else {})}, SETTLE_DRAG)
                     self.settled = self._settled(twin, folder / "settle.txt", P0)
         except RuntimeError:
             self.close()
@@ -122,7 +130,7 @@ class MoorDynSystem:
         from ..cache import cache_dir, load_or_make
         from ..atomic import write_bytes
         key = hashlib.sha256(twin.encode() + np.asarray(P0, float).tobytes()
-                             + _version(self.md).encode()).hexdigest()
+                             + moordyn_version(self.md).encode()).hexdigest()
         report = {}
 
         def make(path):
@@ -239,7 +247,7 @@ class MoorDynSystem:
         self._folder.cleanup()
 
 
-def _version(md) -> str:
+def moordyn_version(md) -> str:
     try:
         from importlib.metadata import version
         return version("moordyn")
@@ -247,7 +255,7 @@ def _version(md) -> str:
         return getattr(md, "__version__", "unknown")
 
 
-def _environment(scene, mooring, data) -> dict:
+def environment_of(scene, mooring, data) -> dict:
     """Water density, depth and gravity MoorDyn runs with: the file's (MoorDyn's defaults
     where it gives none), or the scene's [water] with environment = "scene"."""
     if mooring.environment == "scene":
