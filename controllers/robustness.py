@@ -59,6 +59,14 @@ def share_explained(plant, wave, pto: str, predicted_W: float, name: str) -> dic
     if not cc or inside is None or predicted_W is None:
         out["why"] = "no bound inside the envelope (the sea alone leaves it)"
         return out
+    if math.isinf(cc):          # components where the data give the PTO no damping
+        out["why"] = "the complex-conjugate bound of this wave is unbounded (see the bounds)"
+        if math.isfinite(inside) and inside > 0:
+            out["why"] += (f"; the law predicts {100 * predicted_W / inside:.3g} % of the "
+                           f"bound inside the linear model's envelope ({inside / 1e3:.4g} kW"
+                           + (f", {', '.join(b['binding'])} binding" if b["binding"] else "")
+                           + ")")
+        return out
     law = "a damper" if name == "passive" else "a damper and spring"
     parts = [f"the law predicts {100 * predicted_W / cc:.3g} % of the complex-conjugate bound"]
     if b["binding"]:

@@ -45,6 +45,10 @@ class NotPassiveError(MbcontrolError, ValueError):
     """The PTO's intrinsic impedance has Re Z_i < 0: the device would create energy."""
 
 
+class UnboundedError(MbcontrolError, ValueError):
+    """A wave excites the PTO where Re Z_i = 0 (no radiation damping): an infinite bound."""
+
+
 @dataclass(frozen=True)
 class Thevenin:
     """One PTO's Thevenin equivalent on a frequency grid, exp(-i omega t) phasors.
@@ -129,14 +133,15 @@ def complex_conjugate_bound(plant, wave, pto: str | None = None, params=None) ->
     For a regular wave or an irregular sea (components add: power is mean over the repeat
     period, cross terms between distinct frequencies average out). Linear theory, no force or
     stroke limit: the optimal velocity V = F_e A / (2 Re Z_i) is in phase with the equivalent
-    excitation.
+    excitation. Raises UnboundedError, naming the components, where Re Z_i = 0 (the bound is
+    infinite there: `ports.multiport_bound` says inf, `mbcontrol simulate` "unbounded").
     """
+    from .ports import undamped_note
     th = pto_thevenin(plant, wave.omega, pto, wave.direction, params)
     R = th.impedance.real
-    if np.any(R <= 0):
-        raise NotPassiveError(f"{plant.name}: Re Z_i = 0 at some wave frequency: the "
-                              f"unconstrained bound is infinite there")
     E = th.excitation * _wave_phasors(wave)
+    if np.any(R <= 0):             # as ports.multiport_bound (simulate's check): inf
+        raise UnboundedError(f"{plant.name}: {undamped_note(wave, R <= 0, th.pto)}")
     velocity = E / (2 * R)
     force = -E * np.conj(th.impedance) / (2 * R)
     per = np.abs(E) ** 2 / (8 * R)

@@ -156,38 +156,54 @@ def envelope_bound(plant, wave, pto: str, *, share: float = ENVELOPE_SHARE,
     share limit_i). The other PTOs hold the laws `params` gives them (base: none). Returns
     {"bound_W", "unconstrained_W", "share", "binding": [names of the items at their limit]}.
     The PTO's force and stroke limits are not in it (so it bounds a law that also meets them).
+
+    A component that excites the PTO where the hydro data give it no radiation damping
+    (Re Y <= 0: BEM damping repaired to zero, as the sphere's above 11.5 rad/s, which a
+    measured record's FFT reaches) makes the unconstrained bound infinite, as
+    `ports.multiport_bound` (and so `mbcontrol simulate`) declares it: unconstrained_W is
+    inf and "unbounded" states which components (`ports.undamped_note`). The envelope still
+    caps the force there, so bound_W stays finite when the programme has an optimum (inf when
+    no envelope item limits those components).
     """
     import cvxpy as cp
 
     from ..plant import controlled_params
-    from .ports import port_responses
+    from .ports import port_responses, undamped_note
     base = controlled_params(plant, params, whole=[pto], linear=True)
     Y, H = port_responses(plant, wave.omega, [pto], wave.direction, base)
     y, h = Y[:, 0, 0], H[:, 0] * np.asarray(wave.amplitude, float)
-    unconstrained = float(np.sum(np.abs(h) ** 2 / (8 * y.real)))
+    damped = y.real > 0
+    per = np.where(damped, np.abs(h) ** 2 / (8 * np.where(damped, y.real, 1.0)),
+                   np.where(h != 0, np.inf, 0.0))
+    unconstrained = float(np.sum(per))
+    out = {"unconstrained_W": unconstrained, "share": share, "binding": []}
+    if not math.isfinite(unconstrained):
+        out["unbounded"] = undamped_note(wave, ~damped & (h != 0), pto)
     env = envelope_response(plant, wave, pto, params=base)
     if not env.items:
-        return {"bound_W": unconstrained, "unconstrained_W": unconstrained, "share": share,
-                "binding": []}
+        return {"bound_W": unconstrained, **out}
     U = cp.Variable(y.size, complex=True)
-    # scaled: force by the optimum's RMS, power by the unconstrained bound
-    f_scale = float(np.sqrt(np.mean(np.abs(h / (2 * y.real)) ** 2))) or 1.0
-    power = -0.5 * (cp.sum(cp.multiply(y.real * f_scale ** 2, cp.square(cp.abs(U))))
+    # scaled: force by the optimum's RMS, power by the unconstrained bound (over the damped
+    # components: the others have neither)
+    rms = np.abs(h[damped] / (2 * y.real[damped]))
+    f_scale = (float(np.sqrt(np.mean(rms ** 2))) if rms.size else 0.0) or 1.0
+    p_scale = float(np.sum(per[damped])) or 1.0
+    power = -0.5 * (cp.sum(cp.multiply(np.maximum(y.real, 0.0) * f_scale ** 2,
+                                       cp.square(cp.abs(U))))
                     + cp.real(cp.sum(cp.multiply(np.conj(h) * f_scale, U))))
     radius = share * env.limits * (1.0 if env.regular else 1 / np.sqrt(2))
     cons = [cp.norm(cp.multiply(env.G[:, i] * f_scale, U) + env.H[:, i] * env.amplitude, 2)
             <= radius[i] for i in range(len(env.items))]
-    problem = cp.Problem(cp.Maximize(power / unconstrained), cons)
+    problem = cp.Problem(cp.Maximize(power / p_scale), cons)
     problem.solve(solver=cp.CLARABEL)
+    if problem.status in (cp.UNBOUNDED, cp.UNBOUNDED_INACCURATE):
+        return {"bound_W": math.inf, **out, "status": problem.status}
     if problem.status not in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE):
         # infeasible: the free wave alone takes the device outside (relative heave of a
         # body held still is the sea itself): no force keeps it inside
-        return {"bound_W": None, "unconstrained_W": unconstrained, "share": share,
-                "binding": [], "status": problem.status}
+        return {"bound_W": None, **out, "status": problem.status}
     force = np.asarray(U.value) * f_scale
     sig = env.significant(force)
-    binding = [item.name for item, s, r in zip(env.items, sig, share * env.limits)
-               if s >= 0.999 * r]
-    return {"bound_W": float(problem.value * unconstrained), "unconstrained_W": unconstrained,
-            "share": share, "binding": binding}
-
+    out["binding"] = [item.name for item, s, r in zip(env.items, sig, share * env.limits)
+                      if s >= 0.999 * r]
+    return {"bound_W": float(problem.value * p_scale), **out}

@@ -113,6 +113,21 @@ def multiport_bound(plant, wave, params=None, responses=None) -> MultiportBound:
                           velocity, ptos)
 
 
+def undamped_note(wave, undamped, pto: str) -> str:
+    """What makes a bound infinite, in words: the components of `wave` flagged in `undamped`
+    (bool, per component) excite PTO `pto` where the hydro data give it no radiation damping
+    (the rule of `multiport_bound`), with their band and share of the wave's variance."""
+    omega = np.atleast_1d(np.asarray(wave.omega, float))
+    power = np.asarray(wave.amplitude, float) ** 2 * np.ones(omega.size)
+    undamped = np.asarray(undamped, bool)
+    share = float(power[undamped].sum() / power.sum()) if power.sum() > 0 else 0.0
+    return (f"the complex-conjugate bound of this wave is unbounded: {int(undamped.sum())} of "
+            f"its {omega.size} components ({omega[undamped].min():.4g}.."
+            f"{omega[undamped].max():.4g} rad/s, {share:.2g} of its variance) excite PTO "
+            f"{pto!r} where the hydro data give it no radiation damping (BEM data repaired to "
+            f"zero, or past the mesh's range); cut the wave's band, or extend the data")
+
+
 def window_mean_power(bound: MultiportBound, start: float, end: float) -> float:
     """The optimal forces' mean absorbed power over [start, end] s of this realisation (W),
     exactly: the cross terms between components that a finite record does not average out,

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import json
+import math
 import sys
 
 from ..errors import InputError
@@ -25,9 +26,25 @@ def run_design(args) -> int:
                           "simulate_command": command}, indent=2, allow_nan=False))
     else:
         _print_design(plant, wave, result, command)
-    for note in result.warnings:
+    checked = [] if result.simulation is None else \
+        result.simulation["summary"].get("validity_warnings", [])
+    for note in dict.fromkeys([*result.warnings, *checked]):   # as `simulate` warns, once
         print(f"mbcontrol: warning: {note}", file=sys.stderr)
     return 0
+
+
+def _unbounded(result) -> bool:
+    """Is the wave's complex-conjugate bound infinite: as the tuner's share found it (a
+    linear law), else as the closed-loop run's validity check did (simulate's criterion)?"""
+    cc = (result.tuner.get("share") or {}).get("complex_conjugate_W")
+    if cc is not None:
+        return math.isinf(cc)
+    checks = {} if result.simulation is None else result.simulation["summary"]["validity"]
+    return "bound_W" in checks and not _finite(checks["bound_W"])
+
+
+def _finite(value) -> bool:
+    return value is not None and math.isfinite(value)
 
 
 def _simulate_command(args, result, repeat: float) -> str:
@@ -107,7 +124,8 @@ def _print_design(plant, wave, result, command) -> None:
     reference = b.get("constrained_kind") == "reference"   # not a bound on what was simulated
     if reference:
         constrained += " (a reference, not a bound: see below)"
-    print(f"  bounds: complex-conjugate {_power(b['complex_conjugate_W'])}; constrained "
+    conjugate = "unbounded" if _unbounded(result) else _power(b["complex_conjugate_W"])
+    print(f"  bounds: complex-conjugate {conjugate}; constrained "
           f"({limits}) {constrained}")
     if reference:
         print(f"    why a reference: {b['constrained_kind_reason']}")
@@ -119,39 +137,48 @@ def _print_design(plant, wave, result, command) -> None:
     if b.get("total_complex_conjugate_W") is not None:
         print(f"  bound on all PTOs together (multiport complex-conjugate): "
               f"{_power(b['total_complex_conjugate_W'])}")
-    m = result.metrics
-    if m is None:
-        print("  not simulated (see the warning)")
-    else:
-        sim = result.simulation
-        pct = result.percent_of_bound
-        kind = {"constrained": "reference" if b.get("constrained_kind") == "reference"
-                else "bound"}
-        share = ", ".join(f"{v:.1f} % of the {k.replace('_', '-')} {kind.get(k, 'bound')}"
-                          for k, v in pct.items() if v is not None and k != "electrical")
-        print(f"  simulated ({sim['duration_s']:.4g} s, dt {sim['dt_s']:.4g} s, nonlinear plant): "
-              f"mean absorbed power {_power(m['mean_power_W'])} ({share})")
-        if "mean_winding_loss_W" in m:
-            print(f"    mean electrical power {_power(m['mean_electrical_power_W'])} "
-                  f"({pct['electrical']:.1f} % of the electrical bound), winding loss "
-                  f"{_power(m['mean_winding_loss_W'])}, peak current {m['max_current_A']:.4g} A, "
-                  f"peak voltage {m['max_voltage_V']:.4g} V")
-        if "total_mean_power_W" in m:
-            print(f"    all PTOs together: {_power(m['total_mean_power_W'])} "
-                  f"({pct['total_complex_conjugate']:.1f} % of their bound)")
-        print(f"    max force {m['max_force']:.4g} {F}, max stroke {m['max_stroke']:.4g} {X}, "
-              f"peak/mean power {m['papr']:.3g}, samples outside the limits "
-              f"{100 * m['violation_fraction']:.3g} %")
-        estimator = sim["summary"].get("estimator")
-        if estimator:
-            print(f"    excitation estimate error {100 * estimator['excitation_error']:.3g} % "
-                  f"(RMS, against the simulation's true excitation, after "
-                  f"{estimator['window_start_s']:.4g} s)")
-        print("    result: valid (bound, energy balance, linear-hydrodynamics range checked)"
-              if result.valid else "\n".join(invalid_lines(result.invalid_reasons, "    ")))
+    _print_simulated(result, F, X)
     if result.envelope_lifted is not None:
         _print_lifted(result.envelope_lifted, units)
     print(f"  re-run: {command}")
+
+
+def _print_simulated(result, F: str, X: str) -> None:
+    """The closed-loop run's lines: power against each finite bound, peaks, verdict."""
+    b, m = result.bound, result.metrics
+    if m is None:
+        print("  not simulated (see the warning)")
+        return
+    sim = result.simulation
+    pct = result.percent_of_bound
+    kind = {"constrained": "reference" if b.get("constrained_kind") == "reference"
+            else "bound"}
+    share = ", ".join(f"{v:.1f} % of the {k.replace('_', '-')} {kind.get(k, 'bound')}"
+                      for k, v in pct.items() if v is not None and k != "electrical") \
+        or "no finite bound to set it against"
+    print(f"  simulated ({sim['duration_s']:.4g} s, dt {sim['dt_s']:.4g} s, nonlinear plant): "
+          f"mean absorbed power {_power(m['mean_power_W'])} ({share})")
+    if "mean_winding_loss_W" in m:
+        print(f"    mean electrical power {_power(m['mean_electrical_power_W'])} "
+              f"({pct['electrical']:.1f} % of the electrical bound), winding loss "
+              f"{_power(m['mean_winding_loss_W'])}, peak current {m['max_current_A']:.4g} A, "
+              f"peak voltage {m['max_voltage_V']:.4g} V")
+    if "total_mean_power_W" in m:
+        print(f"    all PTOs together: {_power(m['total_mean_power_W'])} "
+              f"({pct['total_complex_conjugate']:.1f} % of their bound)")
+    print(f"    max force {m['max_force']:.4g} {F}, max stroke {m['max_stroke']:.4g} {X}, "
+          f"peak/mean power {m['papr']:.3g}, samples outside the limits "
+          f"{100 * m['violation_fraction']:.3g} %")
+    estimator = sim["summary"].get("estimator")
+    if estimator:
+        print(f"    excitation estimate error {100 * estimator['excitation_error']:.3g} % "
+              f"(RMS, against the simulation's true excitation, after "
+              f"{estimator['window_start_s']:.4g} s)")
+    bounded = _finite(sim["summary"]["validity"].get("bound_W"))   # as `simulate` says
+    print(f"    result: valid ({'bound, ' if bounded else ''}energy balance, "
+          f"linear-hydrodynamics range checked"
+          f"{'' if bounded else '; no finite bound to check against'})"
+          if result.valid else "\n".join(invalid_lines(result.invalid_reasons, "    ")))
 
 
 def _tidy(value) -> str:

@@ -4,10 +4,10 @@ in finite depth, site files (weighted sea lists, NDBC buoy spectra, occurrence t
 annual energy.
 
 Modules, one concept each: `spectra`, `dispersion`, `synthesis`, `realisation`, `record` (a
-measured elevation file as a wave), `excitation`, `spreading`, `flux`, `sites`, `annual`,
-`local_field` (the incident field near a body as Chebyshev series, for nonlinear Froude-Krylov
-forces). Everything public is re-exported here (`from mbcontrol.waves import irregular`).
-The package imports no stage of the flow.
+measured elevation record, a file or a series, as a wave), `excitation`, `spreading`, `flux`,
+`sites`, `annual`, `local_field` (the incident field near a body as Chebyshev series, for
+nonlinear Froude-Krylov forces). Everything public is re-exported here (`from mbcontrol.waves
+import irregular`). The package imports no stage of the flow.
 """
 from .annual import HOURS_PER_YEAR, annual_energy_MWh, bin_seas
 from .dispersion import group_velocities, group_velocity, wavenumber
@@ -16,9 +16,9 @@ from .excitation import (coefficient_offsets, coefficient_series, excitation_at_
 from .local_field import LocalField, band_field, choose_field, field_rows_offsets, field_rows_series
 from .direct_field import direct_elevation, direct_pressure
 from .flux import deep_water_flux, energy_flux, spectrum_energy_flux
-from .realisation import (DEFAULT_BAND, Wave, band_limits, from_args, from_elevation,
-                          irregular, regular, repeat_period, variance_outside)
-from .record import from_record, read_elevation
+from .realisation import (DEFAULT_BAND, Wave, band_limits, from_args, irregular, regular,
+                          repeat_period, variance_outside)
+from .record import from_elevation, from_record, read_elevation
 from .sites import (SPREAD_MAX_DEG, WEIGHT_SUM_TOLERANCE, SeaState, grid, occurrence,
                     read_ndbc_spectra, read_seas, read_year_weights, site_energy_flux)
 from .spreading import Spreading, component_directions, spread_from_s

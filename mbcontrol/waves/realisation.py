@@ -1,5 +1,6 @@
-"""Wave realisations: regular waves, irregular seas with seeded random phases, measured records;
-and the one rule that keeps a spectrum's components inside a band (`band_limits`).
+"""Wave realisations: regular waves, irregular seas with seeded random phases (measured records,
+files or series: `waves.record`); and the one rule that keeps a spectrum's components inside a
+band (`band_limits`).
 
 Convention (as the hydro data, `exp(-i omega t)`): a wave of components (omega_i, a_i, phi_i)
 has the elevation at the n-frame origin eta(t) = sum a_i cos(omega_i t + phi_i) (m, positive
@@ -26,7 +27,7 @@ DEFAULT_BAND = (0.3, 4.0)       # an irregular sea's components: 0.3 to 4 times 
 @dataclass(frozen=True)
 class Wave:
     """A sum of regular components: frequencies (rad/s), amplitudes (m), phases (rad)."""
-    kind: str                                    # "regular" | "jonswap" | "pm" | "components"
+    kind: str                            # "regular" | "jonswap" | "pm" | "record" | "components"
     omega: np.ndarray
     amplitude: np.ndarray
     phase: np.ndarray
@@ -211,42 +212,6 @@ def from_args(kind: str, *, height=None, period=None, hs=None, tp=None, gamma=3.
         return irregular(hs, tp, gamma=gamma, seed=seed, duration=duration, kind=kind,
                          data_band=data_band)
     raise WaveError(f"unknown wave type {kind!r}; expected regular, jonswap or pm")
-
-
-def from_elevation(t, eta, *, band: tuple[float, float] | None = None,
-                   ramp_time: float = 0.0, direction: float = 0.0) -> Wave:
-    """A wave reproducing a measured elevation record eta(t) at the n-frame origin (m, up).
-
-    t must be uniform. The record is decomposed by FFT into components omega_k = 2 pi k / T
-    (T = record length): exactly the periodic extension of the record. Components outside
-    `band` (rad/s; e.g. the hydro data's) and the mean are dropped, and the fraction of the
-    variance dropped is recorded in settings["dropped_variance"]. Excitation from this wave
-    equals the (non-causal) convolution of the record with the excitation impulse response.
-    """
-    t, eta = np.asarray(t, float), np.asarray(eta, float)
-    if t.ndim != 1 or t.size != eta.size or t.size < 4:
-        raise WaveError("from_elevation: expected 1-D t and eta of equal length (>= 4)")
-    step = t[1] - t[0]
-    if not np.allclose(np.diff(t), step, rtol=1e-6, atol=0):
-        raise WaveError("from_elevation: t must be uniformly spaced")
-    n = t.size
-    spectrum = np.fft.rfft(eta - eta.mean())
-    k = np.arange(spectrum.size)
-    d_omega = 2 * np.pi / (n * step)
-    omega = k * d_omega
-    amplitude = 2 * np.abs(spectrum) / n
-    if n % 2 == 0:
-        amplitude[-1] /= 2                       # the Nyquist term is not doubled
-    phase = np.angle(spectrum) - omega * t[0]    # the record may start at t0 != 0
-    keep = k > 0
-    if band is not None:
-        keep &= (omega >= band[0]) & (omega <= band[1])
-    total = np.sum(amplitude[k > 0] ** 2)
-    dropped = 1 - np.sum(amplitude[keep] ** 2) / total if total > 0 else 0.0
-    settings = {"record_s": float(n * step), "samples": int(n), "mean_m": float(eta.mean()),
-                "dropped_variance": float(dropped)}
-    return Wave("elevation", omega[keep], amplitude[keep], phase[keep], direction, ramp_time,
-                settings, d_omega)
 
 
 def repeat_period(wave) -> tuple[float, np.ndarray]:

@@ -1,4 +1,5 @@
-"""A measured free-surface elevation record as a wave (WEC-Sim's "elevationImport").
+"""A measured free-surface elevation record as a wave (WEC-Sim's "elevationImport"): a file or
+an elevation series (t, eta).
 
 The file: two columns, time (s) and free-surface elevation (m, positive up) at the scene's
 origin, separated by whitespace or commas; one header line (no number in it) may come before
@@ -15,14 +16,17 @@ by linear interpolation, with a RuntimeWarning naming the file, the old step ran
 step (linear interpolation damps high frequencies: at half the Nyquist frequency by up to
 29 %, for a new sample midway between two old ones; little where the old steps only jitter).
 
-`from_record` decomposes the record (mean removed) by one FFT at its own resolution: components
-omega_k = 2 pi k / T, T = N dt, k = 1..N/2, so that `Wave.elevation` reproduces the record at
-its sample times to round-off, time measured from the record's first sample (the simulation's
-t = 0). The wave repeats with period T: a longer run repeats the record (allowed; noted).
-Tests: tests/waves/test_record.py.
+`from_record` (a file, or arrays) and `from_elevation` (arrays) run one decomposition: the
+record, mean removed, by one FFT at its own resolution: components omega_k = 2 pi k / T,
+T = N dt, k = 1..N/2, so that `Wave.elevation` reproduces the record at its sample times to
+round-off; from_record measures time from the record's first sample (the simulation's t = 0),
+from_elevation keeps the series' own time unless asked. The wave repeats with period T: a
+longer run repeats the record (allowed; noted). Tests: tests/waves/test_record.py,
+tests/test_waves_excitation.py.
 """
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import io
 import math
@@ -178,48 +182,80 @@ def _checked(t, eta, name: str, where) -> tuple[np.ndarray, np.ndarray, dict]:
 def from_record(path_or_arrays, *, data_band=None, ramp_time: float | None = None,
                 duration: float | None = None) -> Wave:
     """The wave (kind "record") of a measured elevation record: a file (see the module
-    docstring) or a pair of arrays (t s, eta m) checked alike.
+    docstring) or a pair of arrays (t s, eta m) checked alike, decomposed as `from_elevation`
+    does, with time measured from the record's first sample (the simulation's t = 0).
 
     Components omega_k = 2 pi k / T (T = N dt, k = 1..N/2) from one FFT of the record, mean
     removed: `elevation(t - t0)` reproduces the record at its sample times to round-off (t0 its
-    first time; the simulation's t = 0 is the record's first sample). data_band = (lo, hi)
-    rad/s (the hydro data's): components outside are dropped, their share of the variance in
-    settings["record_outside_data"]. ramp_time (s): None chooses one: none when the record
-    starts at rest (|eta| under REST_FRACTION of its std over its first half mean zero-crossing
-    period Tz, the components kept), else RAMP_TZ Tz. duration (s): the run's, when known; a
-    run longer than T repeats the record (settings["repeats"]). settings: source, sha256 (of
-    the file's bytes), samples, dt_s, duration_s, t0_s, hs_m (4 std), tp_s (peak of the
-    periodogram; "tp" too, which `Wave.period` reads), tz_s, mean_m, and "notes": sentences on
-    what was left out, resampled, ramped or repeated.
+    first time). data_band = (lo, hi) rad/s (the hydro data's): components outside are
+    dropped, their share of the variance in settings["record_outside_data"]. ramp_time (s):
+    None chooses one: none when the record starts at rest (|eta| under REST_FRACTION of its
+    std over its first half mean zero-crossing period Tz, the components kept), else RAMP_TZ
+    Tz. duration (s): the run's, when known; a run longer than T repeats the record
+    (settings["repeats"]). settings: source, sha256 (of the file's bytes), samples, dt_s,
+    duration_s, t0_s, hs_m (4 std), tp_s (peak of the periodogram; "tp" too, which
+    `Wave.period` reads), tz_s, mean_m, and "notes": sentences on what was left out,
+    resampled, ramped or repeated.
     """
     if isinstance(path_or_arrays, (str, os.PathLike)):
         t, eta, info = _read(path_or_arrays)
     else:
         t, eta, info = _arrays(path_or_arrays)
+    return _decompose(t, eta, info, band=data_band, ramp_time=ramp_time, duration=duration)
+
+
+def from_elevation(t, eta, *, band=None, ramp_time: float | None = 0.0, direction: float = 0.0,
+                   duration: float | None = None, from_start: bool = False) -> Wave:
+    """A wave (kind "record") reproducing an elevation series eta(t) at the n-frame origin (m,
+    up): the array-level `from_record`, the one decomposition both run (arrays checked as a
+    file's columns are: finite, strictly increasing, evenly sampled or resampled with a
+    warning, long enough; a flat or impossibly steep series refused).
+
+    One FFT, mean removed: components omega_k = 2 pi k / T (T = N dt), exactly the periodic
+    extension of the series; components outside `band` (rad/s, e.g. the hydro data's) are
+    dropped, their share of the variance in settings["record_outside_data"]. Time is the
+    series' own: `elevation(t)` reproduces eta at the given t to round-off (phases referred to
+    t = 0), unless from_start (from_record's convention: t = 0 is the first sample). ramp_time:
+    none by default (None: chosen as from_record chooses it); direction: rad. Excitation from
+    this wave equals the (non-causal) circular convolution of the series with the excitation
+    impulse response (tests/test_waves_excitation.py).
+    """
+    t, eta, info = _arrays((t, eta))
+    return _decompose(t, eta, info, band=band, ramp_time=ramp_time, duration=duration,
+                      direction=direction, from_start=from_start)
+
+
+def _decompose(t, eta, info: dict, *, band, ramp_time, duration, direction: float = 0.0,
+               from_start: bool = True) -> Wave:
+    """The wave of a checked, evenly sampled series (t, eta), `info` its provenance
+    ({"source", "sha256", ...}): see from_record (settings) and from_elevation (time)."""
     name, n = info["source"], t.size
     dt = float(t[-1] - t[0]) / (n - 1)
     mean = float(np.mean(eta))
-    spectrum = np.fft.rfft(eta - mean)
-    k = np.arange(1, spectrum.size)
-    omega = k * (2 * np.pi / (n * dt))
-    power = 2 * np.abs(spectrum[1:]) ** 2 / n ** 2          # each component's variance, m^2
-    if n % 2 == 0:
-        power[-1] /= 2                                        # the Nyquist term is one cosine
+    spectrum = np.fft.rfft(eta - mean)[1:]
+    omega = np.arange(1, spectrum.size + 1) * (2 * np.pi / (n * dt))
+    amplitude = 2 * np.abs(spectrum) / n
+    power = 2 * np.abs(spectrum) ** 2 / n ** 2                # each component's variance, m^2
+    if n % 2 == 0:                # the Nyquist term X_N/2 (-1)^n / N is one cosine: not doubled
+        amplitude[-1] /= 2
+        power[-1] /= 2
     total = float(power.sum())
     if not total > 0:
         raise WaveError(f"{name}: the elevation is constant ({mean:.6g} m); expected a wave "
                         f"record (for still water: --wave none)")
-    keep = np.ones(k.size, bool) if data_band is None else \
-        (omega >= data_band[0]) & (omega <= data_band[1])
+    keep = np.ones(omega.size, bool) if band is None else \
+        (omega >= band[0]) & (omega <= band[1])
     settings = {**info, "samples": int(n), "dt_s": dt, "duration_s": n * dt,
                 "t0_s": float(t[0]), "hs_m": 4 * math.sqrt(total),
                 "tp_s": float(2 * np.pi / omega[np.argmax(power)]), "mean_m": mean, "notes": []}
     settings["tp"] = settings["tp_s"]
-    _check_kept(settings, keep, power, data_band)
-    kept = np.where(np.r_[False, keep], spectrum, 0)
-    tz = 2 * np.pi * math.sqrt(power[keep].sum() / np.sum(power[keep] * omega[keep] ** 2))
-    settings["tz_s"] = tz
-    ramp_time = _ramp(settings, np.fft.irfft(kept, n), dt, ramp_time)
+    _check_kept(settings, keep, power, band)
+    settings["tz_s"] = 2 * np.pi * math.sqrt(power[keep].sum()
+                                             / np.sum(power[keep] * omega[keep] ** 2))
+    phase = np.angle(spectrum) - (0.0 if from_start else omega * float(t[0]))
+    wave = Wave("record", omega[keep], amplitude[keep], phase[keep], direction, 0.0, settings,
+                2 * np.pi / (n * dt))
+    ramp_time = _ramp(settings, wave, dt, ramp_time, math.sqrt(power[keep].sum()))
     if abs(mean) > MEAN_FRACTION * math.sqrt(total):
         settings["notes"].append(f"{name}: the record's mean, {mean:.4g} m, is left out (the "
                                  f"model's still water level is its own)")
@@ -229,11 +265,7 @@ def from_record(path_or_arrays, *, data_band=None, ramp_time: float | None = Non
             f"{name}: the run ({duration:.6g} s) is longer than the record ({n * dt:.6g} s): "
             f"the record repeats {settings['repeats']:.3g} times, with a step of "
             f"{eta[0] - eta[-1]:.3g} m where it wraps")
-    amplitude = 2 * np.abs(spectrum[1:]) / n
-    if n % 2 == 0:
-        amplitude[-1] /= 2                                    # X_N/2 (-1)^n / N: not doubled
-    return Wave("record", omega[keep], amplitude[keep], np.angle(spectrum[1:][keep]), 0.0,
-                ramp_time, settings, 2 * np.pi / (n * dt))
+    return dataclasses.replace(wave, ramp_time=ramp_time)
 
 
 def _arrays(pair) -> tuple[np.ndarray, np.ndarray, dict]:
@@ -269,7 +301,7 @@ def _check_kept(settings: dict, keep, power, data_band) -> None:
         raise WaveError(f"{name}: {int(keep.sum())} components "
                         f"{'in all' if data_band is None else 'inside the data band'}, more "
                         f"than {MAX_COMPONENTS} (one per 1 / T Hz); expected a shorter record "
-                        f"or a narrower data_band")
+                        f"or a narrower band")
     if data_band is None:
         return
     outside = float(power[~keep].sum() / power.sum())
@@ -286,13 +318,13 @@ def _check_kept(settings: dict, keep, power, data_band) -> None:
             f"data ({data_band[0]:.3g}..{data_band[1]:.3g} rad/s) and is left out")
 
 
-def _ramp(settings: dict, start, dt: float, ramp_time: float | None) -> float:
-    """The ramp (s): the given one, else none when the kept record `start` (m, from t = 0)
-    is at rest over its first half Tz, else RAMP_TZ Tz; settings say which and why."""
+def _ramp(settings: dict, wave: Wave, dt: float, ramp_time: float | None, std: float) -> float:
+    """The ramp (s): the given one, else none when the kept wave (unramped; std its standard
+    deviation, m) is at rest over its first half Tz from t = 0, sampled every dt, else
+    RAMP_TZ Tz; settings say which and why."""
     tz, name = settings["tz_s"], settings["source"]
     first = max(2, math.ceil(0.5 * tz / dt))
-    level = float(np.max(np.abs(start[:first])))
-    std = float(np.std(start))
+    level = float(np.max(np.abs(wave.elevation(np.arange(first) * dt))))
     settings["start_m"] = level
     if ramp_time is not None:
         if not (math.isfinite(ramp_time) and ramp_time >= 0):

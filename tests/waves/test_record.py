@@ -85,6 +85,25 @@ def test_a_record_drives_the_sphere_as_the_spectral_sea_does():
     assert wave.settings["record_outside_data"] < 1e-12
 
 
+
+def test_from_elevation_is_the_same_decomposition_on_its_own_clock():
+    """`from_elevation` (arrays) and `from_record` run one decomposition: the same components,
+    settings and checks; from_elevation's time is the series' own (a record starting at
+    t0 = 40 s: its phases differ by omega t0), from_record's starts at the first sample."""
+    from mbcontrol.waves import from_elevation
+    _, t, eta = _sea_and_record()
+    record = from_record((t + 40.0, eta), data_band=(0.05, 12.0), ramp_time=0.0)
+    same = from_elevation(t + 40.0, eta, band=(0.05, 12.0), from_start=True)
+    own = from_elevation(t + 40.0, eta, band=(0.05, 12.0))
+    assert np.array_equal(same.omega, record.omega) and np.array_equal(same.phase, record.phase)
+    assert np.array_equal(own.amplitude, record.amplitude)
+    # the same settings but the level at the wave's t = 0 (the rest check, start_m)
+    assert {**own.settings, "start_m": 0} == {**record.settings, "start_m": 0}
+    assert np.max(np.abs(own.elevation(t + 40.0) - (eta - eta.mean()))) < 1e-12
+    assert np.max(np.abs(record.elevation(t) - (eta - eta.mean()))) < 1e-12
+    with pytest.raises(WaveError, match=r"arrays: sample 5, column 2"):
+        from_elevation(t, np.where(np.arange(t.size) == 5, np.nan, eta))
+
 GOOD_ROWS = 100                    # 100 samples at 0.2 s: 20 s, above both minimums
 
 
