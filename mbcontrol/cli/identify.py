@@ -53,6 +53,12 @@ structures (--candidate NAME=SPEC,SPEC...): each series predicted by a fit on th
 held-out RMS relative amplitude error per channel and pooled, the best (fewest parameters
 within 1 %) marked.
 
+A measured elevation record (simulate's --wave elevation --eta FILE) is not an input here:
+every run is a regular wave of one frequency (from its file name), its wave at the model is
+rebuilt from the calibration runs without the model (a probe beside the model measures the
+waves it diffracts and radiates too, not the incident wave), and each cost compares motions
+at that frequency over whole periods of it.
+
 Example:
   mbcontrol identify flume_section --data ../shared/data/tank/scenario_c/5*.csv.xz \\
       --validate ../shared/data/tank/scenario_c/6*.csv.xz --out out/identify

@@ -7,116 +7,8 @@ import sys
 from .. import defaults
 from ..errors import InputError
 from .describe import default_help
+from .helptext import SWEEP_HELP
 from .messages import without_remedies
-
-SWEEP_HELP = """Simulate a model in closed loop over sea states (an Hs x Tp grid or a weighted
-list), wave seeds and varied settings, and report power, capture width and annual energy.
-
-Each case is a JONSWAP sea simulated for --duration s with the chosen controller (default:
-the scene's PTO law); its metrics are those of `simulate --json` (mean and electrical power,
-PAPR, F98, stroke, limit violations). Cases run on a local Dask cluster (--workers N, default
-one per core; 0 runs them in this process) or on an existing one (--scheduler ADDRESS).
-With --store DIR each finished case is kept in DIR/cases, so an interrupted sweep resumes
-where it stopped and a rerun with the same inputs computes nothing; DIR/sweep.nc holds the
-labelled result (xarray). --vary NAME=v1,v2 adds a dimension: NAME is a scene parameter,
-a plant parameter, a setting of the controller, or `direction` (wave headings in degrees, among
-the hydro data's).
-
-Short-crested seas: a --seas file's columns `direction` (degrees, NED: where the waves travel
-to, +x towards +y) and `spread` (degrees, the directional spread sigma, the circular standard
-deviation), per sea, or --spread DEG for every sea (it overrides the file's), with the
-spreading function --spreading cos2s (default; one s = 2 / sigma^2 - 1) or mitsuyasu (Goda's
-s_max (f / fp)^5 below the peak, ^-2.5 above; sigma at the peak). Each component travels in
-its own direction, drawn stratified from the spreading function; the hydro data need headings
-around the mean (mbcontrol.hydro.headings_for_spread: mean +- 3 sigma on 15 deg steps, or the
-whole circle, which then keeps the whole spreading function).
-
-A farm: --isolated NAME=VALUE (scene parameters that make one device out of the farm's scene,
-e.g. n=1 for array_grid) also runs the lone device over the same cases and reports the q-factor
-per sea, q = farm power / (devices x power of one device alone), and the same ratio of the annual
-energies (module mbcontrol.studies.farm).
-
-The --json summary is a contract: {"model", "cases", "computed", "reused", "wall_time_s",
-"valid_cases", "invalid_cases", "invalid": [{"hs", "tp", "seed", "reasons"}], "failed_cases",
-"failed": [{"hs", "tp", "seed", "reasons"}], "notes", "seas": [{"hs", "tp", "weight",
-"mean_power_W", "capture_width_m", "energy_flux_W_per_m", "invalid_cases", "failed_cases",
-...}], "weighted_mean_power_W", "annual_energy_MWh",
-"annual_energy_coverage", "annual_energy_unchecked_MWh", "provenance":
-{"model", "version", "scene_sha256", "hydro_sha256", "radiation_sha256", "controller",
-"settings", "amplitudes"}, and with --isolated "farm": {"devices", "isolated_devices",
-"isolated_scene_params", "q_factor", "annual_energy_isolated_MWh", "q_annual",
-"isolated_invalid_cases", "isolated_wall_time_s"} and "q_factor" per sea, and with
---nonlinear invalid per sea "nonlinear_cases" (cases whose linear run left the linear
-range and ran on the nonlinear plant) and "linear_mean_power_W" (those linear runs' mean,
-INVALID, for comparison; null where none), and with
---design per sea "settings" (the tuned values), "predicted_power_W", "bound_W",
-"percent_of_bound", "inside_envelope" and "meets_robustness_floors", and with a PTO
-rated_power "rated_power_W" (the weighted figures then cap each sea's power at it), and with
---seeds N >= 2 per sea "valid_seeds", "mean_power_stderr_W" and "mean_power_ci95_W" [lo,
-hi] (Student's t over the valid seeds) with "power_std_W", "power_min_W", "power_max_W"
-(IEC TS 62600-100 Annex D's per-bin statistics), and for a linear law (the scene's PTO law,
-passive, reactive; nothing varied) per sea "spectral_cv" (one record's mean power: its
-standard deviation over records / mean, from the frequency-domain solution), "bandwidth_hz"
-(B_s of the power density), "effective_samples" (valid seeds / cv^2) and
-"spectral_stderr_W" and "expected_power_W" (linear theory's, for a spread sea the
-spreading-weighted sum over directions), per sea "direction_deg", "spread_deg" and
-"spreading" when given, and for a weighted list "annual_energy_ci95_MWh" [lo, hi] and
-"annual_energy_budget": {"components": [{"component" (statistical, model, radiation_fit,
-parameters, resource), "type" (A or B), "over_seas" (quadrature, linear, one term),
-"std_MWh" (null when absent), "dof", "source", "absent" (why not, or null),
-"share_of_variance"}], "combined_std_MWh", "effective_dof", "coverage_factor", "method"},
-and with --identified per sea "model_std_W" and "parameter_std_W"}
-(per sea, means over the valid seeds; lists over the varied values when --vary
-is given; weighted figures only for a weighted --seas file; a sea with no valid case counts
-as producing nothing there, the share of the year that is valid is annual_energy_coverage,
-and annual_energy_unchecked_MWh is the figure the failed cases would have given).
-
-Error bars: --seeds N (N >= 2) gives each sea its standard error and 95 % interval over
-records; --amplitudes random makes each record a real sea's (Rayleigh amplitudes: what a
-20-minute measured record scatters by; use --duration 1200 as IEC's sea tests do), while the
-default deterministic amplitudes estimate the expected power. The annual energy's budget adds,
-in quadrature, the statistical part (each sea's standard error over its seeds, or with one
-seed of a linear law the spectral estimate), the radiation fit's effect (linear laws), the
-model's error and the parameters' covariance of an identification (--identified
-summary.json: its values are run, its calibrated error (else its validation error) is the
-model error, its covariance goes through linear theory's sensitivities), and the resource's interannual variability when
-the --seas file has weights_<year> columns; a part that cannot be evaluated is listed as
-absent with the reason.
-
-Every case is checked like `simulate`'s results (power bound of its own wave, energy
-balance, linear-hydrodynamics range); a case that fails is counted and listed, never
-averaged. A case whose run raises (a divergence, a solver that gave up) is a result too:
-counted in failed_cases with its sea, seed and reason, never averaged; the other cases run
-and the JSON and store are written. Controllers run causally: an MPC forecasts the excitation from what it measures
-(AR) unless --set forecast=known (an oracle: a non-causal upper bound, labelled so in
-provenance.settings). A store remembers the inputs it was made from (content hashes of the
-scene, hydro data and radiation fit, and the package version) and refuses others.
---set values are numbers, true/false, none or words (--set forecast=ar).
-
-Per-sea design: with --design the controller is tuned for each sea state as `mbcontrol
-design` tunes it for one (passive, reactive: linear theory within the PTO's force and stroke
-limits and inside the linear model's envelope: each body's predicted significant heave
-relative to the surface within 90 % of its mean draft, roll and pitch within 90 % of 30 deg;
-latching, declutching: their simulated tuners; mpc: a horizon of one peak period). A sea where
-no setting stays inside is flagged (inside_envelope false; the closest setting runs). bound_W
-is the most any PTO force could absorb in that sea inside the same envelope (linear theory,
-mbcontrol.analysis.envelope), so percent_of_bound says how much a law leaves. --set values
-override the tuned ones. --robust keeps a reactive law within the robustness floors (gain
-margin 2, phase margin 30 deg at the least; otherwise laws below them are only flagged,
-meets_robustness_floors). Without --design, a damped law named with no settings absorbs
-nothing, and says so on stderr.
-
-Examples:
-  mbcontrol sweep rm3 --hs 1 2 3 --tp 8 10 12 --duration 300 --store out/rm3 --plot pm.png
-  mbcontrol sweep oswec --seas ../shared/data/sites/pacwave_cluster_32.csv --width 18 --json
-  mbcontrol sweep rm3 --seas ../shared/data/sites/pacwave_cluster_32.csv --controller reactive \
-      --design --json
-  mbcontrol sweep sphere --hs 1 2 3 --tp 8 10 --controller passive --set damping=4e5 \
-      --seeds 4 --amplitudes random --json
-  mbcontrol sweep oswec --seas ../shared/data/sites/pacwave_cluster_32.csv --spread 30 --json
-  mbcontrol sweep array_grid --scene-param n=3 --scene-param scale=25 --isolated n=1 \
-      --seas ../shared/data/sites/pacwave_cluster_32.csv --vary direction=0,45
-"""
 
 
 def add_parser(sub) -> None:
@@ -128,6 +20,11 @@ def add_parser(sub) -> None:
     seas.add_argument("--hs", type=float, nargs="+", help="significant wave heights, m")
     seas.add_argument("--seas", metavar="FILE.csv",
                       help="sea states: columns Hm0 and Tp (or Te), optional weights")
+    seas.add_argument("--records", metavar="DIR",
+                      help="measured seas: every file of DIR a free-surface elevation record\n"
+                           "(two columns, time s and elevation m, as simulate's --eta), one\n"
+                           "case each, run for its own length unless --duration; no annual\n"
+                           "energy (records have no weights)")
     p.add_argument("--tp", type=float, nargs="+", help="peak periods, s (with --hs)")
     p.add_argument("--gamma", type=float, default=3.3, help="JONSWAP peak enhancement (3.3)")
     p.add_argument("--controller", help="controller name (default: the scene's PTO law)")
@@ -264,7 +161,7 @@ def run_sweep(args) -> int:
         years = read_year_weights(args.seas) if args.seas else None
         ds, summary = sweep(args.model, seas, scene_params=scene_params, design=args.design,
                             robust=args.robust, identified=args.identified, years=years,
-                            nonlinear=args.nonlinear, **common)
+                            nonlinear=args.nonlinear, records=args.records, **common)
     if args.plot:
         from ..studies.sweep import plot_sweep
         plot_sweep(ds, summary, args.plot)
@@ -282,8 +179,19 @@ FAILED_EXIT = 4      # cases failed to run (diverged or raised): the sweep is in
 
 
 def _seas(args) -> list:
-    """The seas of --hs/--tp (a grid) or --seas (a site file), spread as asked."""
+    """The seas of --hs/--tp (a grid) or --seas (a site file), spread as asked; None for
+    --records (the sweep reads the folder)."""
     from ..studies.sweep import grid, read_seas
+    if args.records is not None:
+        given = [flag for flag, value in (("--tp", args.tp), ("--spread", args.spread),
+                                          ("--spreading", args.spreading),
+                                          ("--isolated", args.isolated))
+                 if value not in (None, [])]
+        if given:
+            raise InputError(f"{given[0]} with --records: a record is one measured sea, "
+                             f"long-crested at a point, of one device's scene; leave "
+                             f"{given[0]} out")
+        return None
     if args.hs is not None:
         if not args.tp:
             raise InputError("--hs needs --tp (the grid's peak periods)")
@@ -318,7 +226,20 @@ def _print_mooring_loads(rows: list) -> None:
     print(f"  {'Hs m':>6s} {'Tp s':>6s} {'max':>9s} {'3-h MPM':>9s}")
     for row in rows:
         print(f"  {row['hs']:6.3g} {row['tp']:6.3g} {_kN(row.get('mooring_max_N')):>9s} "
-              f"{_kN(row.get('mooring_mpm_3h_N')):>9s}")
+              f"{_kN(row.get('mooring_mpm_3h_N')):>9s}{_record(row)}")
+
+
+def _measured(summary: dict) -> bool:
+    """A sweep over measured records (--records): its rows carry their file names."""
+    return any("record" in row for row in summary["seas"])
+
+
+def _record(row: dict, before: str = "  ") -> str:
+    """A record's file name for a line of the text report (escaped: a name is data, and
+    control characters must not reach the terminal); "" for a sea state."""
+    from ..textsafe import plain_text
+    name = row.get("record")
+    return "" if name is None else before + " " + plain_text(name, 60)
 
 
 def _kN(value) -> str:
@@ -332,7 +253,7 @@ def _print_summary(summary: dict, store) -> None:
           f"{summary['reused']} reused) in {summary['wall_time_s']:.1f} s")
     farm = summary.get("farm")
     print(f"  {'Hs m':>6s} {'Tp s':>6s} {'weight':>8s} {'power kW':>10s} {'CW m':>8s} {'J kW/m':>8s}"
-          + (f" {'q':>6s}" if farm else ""))
+          + (f" {'q':>6s}" if farm else "") + ("   record" if _measured(summary) else ""))
     for row in summary["seas"]:
         power = row["mean_power_W"]
         text = f"{power / 1e3:10.4g}" if isinstance(power, float) else "  (varied)"
@@ -345,7 +266,7 @@ def _print_summary(summary: dict, store) -> None:
         q = row.get("q_factor")
         q_text = "" if not farm else f" {q:6.3f}" if isinstance(q, float) else "  (varied)"
         print(f"  {row['hs']:6.3g} {row['tp']:6.3g} {weight} {text} {cw_text} "
-              f"{row['energy_flux_W_per_m'] / 1e3:8.3g}{q_text}")
+              f"{row['energy_flux_W_per_m'] / 1e3:8.3g}{q_text}{_record(row)}")
         if "bound_W" in row:
             print(f"         {_design_line(row)}")
     _print_mooring_loads(summary["seas"])
@@ -357,7 +278,7 @@ def _print_summary(summary: dict, store) -> None:
             reasons, found = without_remedies(str(case["reasons"]))
             remedies += [r for r in found if r not in remedies]
             print(f"  {label} Hs {case['hs']:.3g} m, Tp {case['tp']:.3g} s, seed "
-                  f"{case['seed']}: {reasons}")
+                  f"{case['seed']}{_record(case, ' record')}: {reasons}")
         if len(summary[key]) > 10:
             print(f"  ... and {len(summary[key]) - 10} more {label.lower()} cases (--json lists all)")
     for remedy in remedies:

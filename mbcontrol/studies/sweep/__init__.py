@@ -4,15 +4,19 @@ matrices, capture widths, annual energy at a site.
 
 Modules: `cases` (seas, grids, the seas CSV, cases and their keys), `store` (records on disk,
 the assembled Dataset), `runner` (serial and Dask execution), `power` (power matrix),
-`study` (`sweep`), `plots`. The seas, energy flux, annual energy, NDBC spectra and occurrence
-tables are `mbcontrol.waves`' (re-exported here).
+`study` (`sweep`), `made_by` (its provenance), `plots`, `records` (a folder of measured
+elevation records as the seas).
+The seas, energy flux, annual energy, NDBC spectra and occurrence tables are
+`mbcontrol.waves`' (re-exported here).
 """
 from ...waves import (SeaState, annual_energy_MWh, energy_flux, grid, occurrence, read_seas,
                      site_energy_flux)
 from .budget import table as budget_table
 from .plots import plot_sweep
 from .power import power_matrix
+from .records import MeasuredSea, read_records
 from .study import sweep
 
 __all__ = ["sweep", "SeaState", "grid", "read_seas", "energy_flux", "annual_energy_MWh",
-           "power_matrix", "occurrence", "site_energy_flux", "budget_table", "plot_sweep"]
+           "power_matrix", "occurrence", "site_energy_flux", "budget_table", "plot_sweep",
+           "MeasuredSea", "read_records"]

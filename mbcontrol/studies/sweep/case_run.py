@@ -58,13 +58,18 @@ def run_case(case) -> dict:
     case.nonlinear: "scene" runs the scene as it is; "always" the nonlinear plant; "invalid"
     the linear one, then, where that run leaves the linear range (an INVALID reason whose
     remedy is the nonlinear model), the nonlinear plant with the same controller: its record
-    is the case's, with "model": "nonlinear" and the linear run's under "linear"."""
+    is the case's, with "model": "nonlinear" and the linear run's under "linear". A case of a
+    measured record (case.record, --records) runs in that record's wave (`records.record_wave`)."""
     params, scene_params, settings = case.resolved()
     scene_key = tuple(sorted(scene_params.items()))
     plant = _plant(case.model, scene_key, case.nonlinear == "always")
     direction = None if case.direction_deg is None else math.radians(case.direction_deg)
-    wave = sea_wave(plant, case.sea, case.duration, seed=case.seed, direction=direction,
-                    amplitudes=case.amplitudes)
+    if case.record:                       # a measured record (--records): its own wave
+        from .records import record_wave
+        wave = record_wave(plant, case)
+    else:
+        wave = sea_wave(plant, case.sea, case.duration, seed=case.seed, direction=direction,
+                        amplitudes=case.amplitudes)
     designed = None
     start = time.perf_counter()
     if case.design:      # tuned for this sea; settings given with --set take precedence

@@ -44,6 +44,8 @@ class Case:
     robust: bool = False                # ... within the robustness floors (--robust)
     amplitudes: str = "deterministic"   # or "random": Rayleigh amplitudes (waves.irregular)
     nonlinear: str = "scene"            # "always", "invalid": the nonlinear plant (run_case)
+    record: str = ""                    # a measured record's path (--records; not in the key)
+    record_sha256: str = ""             # ... and the hash of its bytes (in the key)
 
     @property
     def key(self) -> str:
@@ -51,7 +53,10 @@ class Case:
         the case's settings and the content of its inputs (scene, hydro data, radiation fit,
         package version; `mbcontrol.plant.provenance`), so an edited scene never reuses a
         stored result."""
-        record = {k: v for k, v in asdict(self).items() if k not in ("index", "roles")}
+        record = {k: v for k, v in asdict(self).items() if k not in ("index", "roles",
+                                                                       "record")}
+        if not record["record_sha256"]:    # a sea state's case keeps the key it had before
+            record.pop("record_sha256")
         for flag in ("design", "robust"):  # the keys of stores made before they existed
             if not record[flag]:
                 record.pop(flag)

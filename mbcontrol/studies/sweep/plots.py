@@ -134,9 +134,10 @@ def plot_sweep(ds, summary: dict, path=None):
     try:
         table = power_matrix(ds, period=period) / 1e3
         spread = spread_95(summary) if ds["mean_power_W"].ndim == 2 else None
-        if np.isfinite(table.values).mean() >= 0.5:
+        measured = "record" in ds.coords        # records: never a grid, whatever their number
+        if np.isfinite(table.values).mean() >= 0.5 and not measured:
             _matrix(fig, axes[0], ds, table, period, spread)
-        else:                       # a site's scattered list: each sea state where it lies
+        else:                       # a site's scattered list, records: each sea where it lies
             _scattered(fig, axes[0], ds, spread)
         n_bad = summary.get("invalid_cases", 0)
         law = _controller(summary, designed)
@@ -144,7 +145,9 @@ def plot_sweep(ds, summary: dict, path=None):
                           + (" (± 95 % spread)" if spread is not None
                              and np.isfinite(spread).any() else "")
                           + (f"\n{n_bad} invalid cases left out (red crosses / hatched)"
-                             if n_bad else ""), fontsize=9)
+                             if n_bad else "")
+                          + ("\nmeasured records, each at its Hs (4 std) and Tp (periodogram "
+                             "peak)" if measured else ""), fontsize=9)
     except ValueError as exc:                       # other quantities varied: no single table
         axes[0].text(0.5, 0.5, str(exc), ha="center", va="center", wrap=True, fontsize=8)
         axes[0].set_axis_off()

@@ -15,8 +15,9 @@ import xarray as xr
 from ... import defaults
 from ...errors import InputError
 from ...plant import provenance
-from ...results import jsonable
 from .cases import build_cases, roles_for
+from .made_by import sweep_provenance
+from .records import label_summary, measured_seas, with_records
 from ...waves import annual_energy_MWh, site_energy_flux
 from .runner import execute, keep_plant
 from .store import CaseStore, assemble
@@ -31,7 +32,7 @@ def sweep(model: str, seas, *, seeds: int = 1, vary: dict | None = None, params=
           store=None, workers: int | None = 0, scheduler: str | None = None,
           width: float | None = None, progress: bool = True, design: bool = False,
           robust: bool = False, amplitudes: str = "deterministic", identified=None,
-          years: dict | None = None, nonlinear: str = "scene"):
+          years: dict | None = None, nonlinear: str = "scene", records=None):
     """Run a sweep and return (Dataset, summary).
 
     seas: SeaStates (`cases.grid`, `cases.read_seas`); vary: name -> values (scene
@@ -52,12 +53,14 @@ def sweep(model: str, seas, *, seeds: int = 1, vary: dict | None = None, params=
     sea on the nonlinear plant: [hydro] hydrostatics = froude_krylov = "nonlinear") or
     "invalid" (the linear plant, and the nonlinear one only for seas whose linear run leaves
     the linear range, with the same controller; those cases are marked nonlinear_model and
-    keep the linear run's power as mean_power_W__linear)."""
+    keep the linear run's power as mean_power_W__linear). records: a folder of measured
+    elevation records, one sea each, instead of `seas` (None): every file checked before any
+    case runs, duration left out each record's own length (`records`; no annual energy)."""
     from mbcontrol.controllers import REGISTRY
 
     from ...plant import build_plant
     from ...scene import load_scene
-    start = time.perf_counter()
+    start, given_duration = time.perf_counter(), duration
     duration = defaults.resolve("sweep.duration", duration)
     dt, method = defaults.resolve("sweep.dt", dt), defaults.resolve("sweep.method", method)
     vary = {k: list(v) for k, v in (vary or {}).items()}
@@ -77,24 +80,24 @@ def sweep(model: str, seas, *, seeds: int = 1, vary: dict | None = None, params=
         raise InputError(f"--param {unknown[0]}: not a parameter of {scene.name}; it has "
                          f"{', '.join(plant.parameters)}")
     inputs = {"model": scene.name, **provenance(plant)}
+    measured = measured_seas(records, plant, given_duration, seeds=seeds,
+                             amplitudes=amplitudes, seas=seas)
+    seas = seas if measured is None else [r.sea for r in measured]
     cases = build_cases(model, seas, seeds=seeds, vary=vary, roles=roles, params=params,
                         scene_params=scene_params, controller=controller, settings=settings,
                         duration=duration, dt=dt, method=method, inputs=inputs,
                         design=design, robust=robust, amplitudes=amplitudes,
                         nonlinear=nonlinear)
+    if measured is not None:
+        cases = with_records(cases, measured)
     case_store = CaseStore(store, inputs)
     run = execute(cases, case_store, workers=workers, scheduler=scheduler, progress=progress)
     depth, rho, g = scene.water.depth, scene.water.rho, scene.water.g
-    made_by = {**inputs, "controller": controller,
-               "settings": resolved_settings(controller, settings, vary, roles),
-               "amplitudes": amplitudes}
-    if nonlinear != "scene":
-        made_by["nonlinear"] = nonlinear
-    if identified is not None:
-        made_by["identified"] = identified["source"]
-    if design:
-        made_by["settings"] = {"designed_per_sea": True, "robust": bool(robust),
-                               "given": dict(settings or {})}
+    made_by = sweep_provenance(inputs, controller, settings, vary, roles, amplitudes=amplitudes,
+                               nonlinear=nonlinear, identified=identified, design=design,
+                               robust=robust, measured=measured)
+    if measured is not None:
+        duration = given_duration             # None: each record's own (per sea in the rows)
     attrs = {"model": scene.name, "controller": controller, "settings": dict(settings or {}),
              "provenance": made_by,
              "params": dict(params or {}), "scene_params": dict(scene_params or {}),
@@ -105,8 +108,11 @@ def sweep(model: str, seas, *, seeds: int = 1, vary: dict | None = None, params=
     if scene.ptos and math.isfinite(rated):
         attrs["rated_power_W"] = float(rated)
     ds = assemble(cases, case_store, seas, vary, seeds, attrs)
-    J = np.array([site_energy_flux(s, depth, rho, g) for s in seas])   # the site's own J if given
-    ds["energy_flux_W_per_m"] = ("sea", J)
+    if measured is not None:                  # its file name per sea
+        ds = ds.assign_coords(record=("sea", [r.name for r in measured]))
+    J = [s.j if measured is not None else site_energy_flux(s, depth, rho, g)  # a record's own,
+         for s in seas]                                                       # a site's own
+    ds["energy_flux_W_per_m"] = ("sea", np.array(J, float))
     ds["capture_width_m"] = ds["mean_power_W"] / ds["energy_flux_W_per_m"]
     if width:
         ds["capture_width_ratio"] = ds["capture_width_m"] / width
@@ -120,9 +126,12 @@ def sweep(model: str, seas, *, seeds: int = 1, vary: dict | None = None, params=
     if why:
         summary["notes"].insert(0, why)
     from .uncertainty import add_uncertainty
-    add_uncertainty(summary, ds, seas, plant, controller=controller, settings=settings,
-                    params=params, duration=duration, amplitudes=amplitudes,
-                    identified=identified, years=years)
+    if measured is not None:                  # no JONSWAP sea to take linear theory over
+        label_summary(summary, measured)
+    else:
+        add_uncertainty(summary, ds, seas, plant, controller=controller, settings=settings,
+                        params=params, duration=duration, amplitudes=amplitudes,
+                        identified=identified, years=years)
     summary["provenance"] = made_by
     if "rated_power_W" in ds.attrs:
         summary["rated_power_W"] = float(ds.attrs["rated_power_W"])
@@ -150,31 +159,6 @@ def _keep_nonlinear_plant(model: str, scene, scene_key: tuple, nonlinear: str) -
     if nonlinear != "scene":
         from ...plant import build_plant, with_nonlinear_pressure
         keep_plant(model, scene_key, build_plant(with_nonlinear_pressure(scene)), True)
-
-
-def resolved_settings(controller, settings, vary=None, roles=None) -> dict:
-    """The controller's settings as its cases run them, defaults included (its describe()
-    without run statistics; e.g. an MPC's forecast), for provenance; varied settings are
-    listed by name as "varied"."""
-    if controller is None:
-        return {}
-    import inspect
-
-    from mbcontrol.controllers import REGISTRY, make
-
-    from ...waves import regular
-    given = dict(settings or {})
-    if "wave" in inspect.signature(REGISTRY[controller]).parameters:
-        given.setdefault("wave", regular(1.0, 10.0))   # as the cases hand it a sea; its
-    try:                                                 # settings do not depend on which
-        described = make(controller, **given).describe()
-    except (TypeError, ValueError, AttributeError, KeyError):
-        described = dict(settings or {})  # a controller that describes itself only once reset
-    described = {k: v for k, v in described.items() if k not in ("stats", "name")}
-    for name, role in (roles or {}).items():
-        if role == "setting":
-            described[name] = "varied"
-    return jsonable(described)
 
 
 def _summary(ds, seas, run, wall, n_cases) -> dict:
