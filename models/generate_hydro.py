@@ -132,7 +132,7 @@ def _ship_statics(models: Path) -> None:
     """The MoorDyn statics of the catalogue's lines files, beside them (plant.moordyn_statics)."""
     import json
     from mbcontrol.atomic import write_bytes
-    from mbcontrol.plant.moordyn_statics import STATICS_SERVED, shipped_statics
+    from mbcontrol.plant import STATICS_SERVED, shipped_statics
     shipped = {}
     for lines, key, statics in STATICS_SERVED:
         if Path(lines).resolve().parent == models.resolve():

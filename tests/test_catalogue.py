@@ -115,9 +115,9 @@ def test_linearisation_matches_frequency_domain(name):
 # fit off: measured 5.3 % of the peak (amplitude) and 6.8 % (ratio) since issue 20's fits (2.3 %
 # and 3.2 % before: its heave group then got more states, retargeted with the others); sway and
 # roll are held to 2 %
-# rm3_moored's surge and pitch: its lines' stiffness gives the device surge and pitch modes
-# (66 s, 39 s) whose response at 0.4 rad/s its fit meets to 10 % at best (guide: catalogue
-# fits); measured 2.75 % (surge) and 2.20 % (pitch) of the peak there, heave 0.26 %
+# rm3_moored's surge and pitch: its lines' stiffness gives the device a surge mode (66 s,
+# barely damped), and its fit meets the device's response at 0.4 rad/s to 10 % at best (guide:
+# catalogue fits); measured 2.75 % (surge) and 2.20 % (pitch) of the peak there, heave 0.26 %
 KNOWN_LTI_SHORTFALL = {("flume_section", "heave"): 0.07,
                        ("rm3_moored", "plate_motion__Surge"): 0.03,
                        ("rm3_moored", "plate_motion__Pitch"): 0.03}

@@ -66,6 +66,7 @@ TABLES = {
     "rm3 at PacWave South, reactive, designed per sea": ("measured", "--amplitudes random"),
     "PacWave South, 32 seas × 600 s, passive designed per sea": ("measured", "--spread 30"),
     "segments (lower/upper)": ("measured", "benchmarks/moordyn_rm3.py"),
+    "RM3 in WEC-Sim's record, 40-360 s": ("measured", "tests/sim/test_moordyn_wecsim.py"),
 }
 MODEL_TABLES = {"mbcontrol (method, dt, radiation tol)": ("measured", "benchmarks/speed.py"),
                 "C step median / p99 / max (us)": ("measured", "benchmarks/export_step.py"),

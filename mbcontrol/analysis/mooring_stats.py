@@ -8,8 +8,10 @@ mean up-crossings (Tz from the record's own up-crossings of its mean): the short
 extreme of a narrow-banded Gaussian process (Rayleigh peaks), the design-load estimate of
 mooring standards' quasi-static and dynamic analyses (e.g. DNV-OS-E301 uses the MPM of a
 three-hour storm). It is an estimate under that assumption; the record's own max is beside
-it, and a record whose max exceeds it is flagged non-Gaussian ("gaussian": false: snap loads). A line is "slack" where its tension falls below SLACK_FRACTION of its mean: the first such
-time is reported (snap loads follow slack).
+it, and a record whose max exceeds it is flagged non-Gaussian ("gaussian": false: snap
+loads). A line is "slack" where its tension falls below SLACK_FRACTION of its mean: the first
+such time is reported (snap loads follow slack). Lines that reached their breaking load or
+the sea bed are the run's own record (sim.moordyn_events), reported by `event_notes`.
 """
 from __future__ import annotations
 
@@ -80,6 +82,29 @@ def slack_lines(summary: dict) -> list[str]:
                                  f"t = {stats['slack_at_s']:.4g} s (tension below "
                                  f"{SLACK_FRACTION:.0%} of its mean {stats['mean_N']:.4g} N): "
                                  f"snap loads follow; check the line's length and pretension")
+    return notes
+
+
+def line_events(ds) -> dict:
+    """The run's breaking loads reached and sea-bed contact (sim.moordyn_events): {mooring:
+    {line: {"breaking_load_at_s", "end", "tension_N"} and/or {"bed_contact_at_s"}}}."""
+    from ..results import record
+    return record(ds.attrs, "moordyn_events", {}) or {}
+
+
+def event_notes(events: dict) -> list[str]:
+    """Warnings for every line that reached its breaking load or the sea bed, with the time."""
+    notes = []
+    for mooring, lines in events.items():
+        for line, happened in lines.items():
+            if "breaking_load_at_s" in happened:
+                notes.append(f"mooring '{mooring}' {line} reached its breaking load at its "
+                             f"{happened['end']} at t = {happened['breaking_load_at_s']:.4g} s "
+                             f"(tension {happened['tension_N']:.4g} N); the run kept it intact, "
+                             f"so what follows is not the damaged mooring's response")
+            if "bed_contact_at_s" in happened:
+                notes.append(f"mooring '{mooring}' {line}, clear of the sea bed at the start, "
+                             f"reached it at t = {happened['bed_contact_at_s']:.4g} s")
     return notes
 
 

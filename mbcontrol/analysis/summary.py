@@ -8,7 +8,7 @@ import numpy as np
 
 from ..results import jsonable, record, run_info
 from .metrics import _BODY_KEYS, analysis_window, pto_metrics, signal_stats, statistics_window
-from .mooring_stats import mooring_summary, slack_lines
+from .mooring_stats import event_notes, line_events, mooring_summary, slack_lines
 from .validity import assess
 
 
@@ -27,10 +27,11 @@ def summary(ds, plant) -> dict:
     ptos = {pto.name: jsonable({**pto_metrics(ds, pto), "valid": verdict["valid"],
                                 "invalid_reasons": verdict["invalid_reasons"]})
             for pto in plant.scene.ptos}
-    moorings = mooring_summary(ds, mask)
+    moorings, events = mooring_summary(ds, mask), line_events(ds)
     return {"model": ds.attrs["model"], "valid": verdict["valid"],
             "invalid_reasons": verdict["invalid_reasons"],
-            "validity_warnings": verdict["warnings"] + slack_lines(moorings), "wave": run.wave,
+            "validity_warnings": verdict["warnings"] + slack_lines(moorings)
+            + event_notes(events), "wave": run.wave,
             "duration_s": float(ds.attrs["duration_s"]), "dt_s": float(ds.attrs["dt_s"]),
             "wall_time_s": float(ds.attrs["wall_time_s"]), "method": ds.attrs["method"],
             "window_start_s": stats_window["start_s"], "window_end_s": stats_window["end_s"],
@@ -40,6 +41,7 @@ def summary(ds, plant) -> dict:
                                                         "radiation_sha256")},
             "dofs": dofs, "bodies": bodies, "ptos": ptos, **({"moorings": jsonable(moorings)}
                                                               if moorings else {}),
+            **({"mooring_events": jsonable(events)} if events else {}),
             "validity": jsonable(verdict["checks"])}
 
 

@@ -120,6 +120,7 @@ class MoorDynSystem:
         self.lines = [self.md.GetLine(self.handle, i + 1) for i in range(len(data.lines))]
         import cmoordyn             # the wrapper's own calls, without its per-call list copies
         self._step, self._tension = cmoordyn.step, cmoordyn.line_get_node_ten
+        self._node_position = cmoordyn.line_get_node_pos
         self._last_node = [self.md.GetLineNumberNodes(l) - 1 for l in self.lines]
         self.dt_mooring = data.option("dtM")
 
@@ -217,12 +218,12 @@ class MoorDynSystem:
         """`step` in MoorDyn's own terms, for the run's loop: flat lists [x1 y1 z1 x2 ...] in
         its frame in, its flat forces (3n,) out (the frame conversion is the caller's)."""
         try:
-            f = np.array(self._step(self.handle, x, v, t, dt))
+            forces = self._step(self.handle, x, v, t, dt)
         except RuntimeError as exc:
             raise self._failed(t, str(exc)) from None
-        if not np.isfinite(f).all():
+        if not math.isfinite(sum(forces)):       # a NaN or an inf anywhere: 1 us, not 2
             raise self._failed(t, "non-finite forces on the Coupled points")
-        return f
+        return np.array(forces)
 
     def _failed(self, t: float, what: str) -> SimulationError:
         dtm = f"{self.dt_mooring:g} s" if self.dt_mooring else "its default"
@@ -238,6 +239,13 @@ class MoorDynSystem:
             out[0, j] = math.hypot(*ten(line, 0))
             out[1, j] = math.hypot(*ten(line, last))
         return out
+
+    def bed_clearance(self, j: int) -> float:
+        """Height of line j's lowest node above the sea bed (m; MoorDyn's bed is flat at the
+        run's depth)."""
+        position = self._node_position
+        return min(position(self.lines[j], i)[2] for i in range(self._last_node[j] + 1)) \
+            + self.environment["depth_m"]
 
     def close(self) -> None:
         if self.handle is not None:

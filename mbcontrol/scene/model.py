@@ -207,6 +207,8 @@ class Mooring:
                                                # MoorDyn file, or "scene" ([water])
     settle: bool = True                        # moordyn: lines brought to rest at the
                                                # initial pose before t = 0
+    breaking_load: float | None = None         # moordyn: N, every line's; reaching it is
+                                               # reported (None: not checked)
 
 
 @dataclass(frozen=True)
@@ -313,6 +315,8 @@ class Scene:
         data["hydro"]["file"] = _file_digest(self.hydro.file)
         data["hydro"]["source"] = Path(self.hydro.source).name if self.hydro.source else None
         for mooring in data["moorings"]:  # other kinds' digests stay as they were
+            if mooring["breaking_load"] is None:
+                mooring.pop("breaking_load")
             if mooring["kind"] == "moordyn":
                 mooring["file"] = _file_digest(mooring["file"])
             else:

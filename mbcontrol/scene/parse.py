@@ -246,13 +246,21 @@ def _catenary(r: Reader) -> Mooring:
 
 def _moordyn(r: Reader, path: Path) -> Mooring:
     """A MoorDyn input file whose Coupled points follow `body` (scene.moordyn_file)."""
-    r.allow("name", "type", "body", "file", "coupled", "environment", "settle")
+    r.allow("name", "type", "body", "file", "coupled", "environment", "settle", "breaking_load")
     file = str((path.parent / r.string("file")).resolve())
     read_moordyn(file, f"{r.file}: {r.field('file')}")    # checked now: fails at load
     return Mooring(name=r.name(), body=r.string("body"), point=(0.0, 0.0, 0.0), kind="moordyn",
                    file=file, coupled=r.choice("coupled", ("body", "global"), default="body"),
                    environment=r.choice("environment", ("file", "scene"), default="file"),
-                   settle=r.boolean("settle", default=True))
+                   settle=r.boolean("settle", default=True),
+                   breaking_load=_breaking_load(r))
+
+
+def _breaking_load(r: Reader) -> float | None:
+    value = r.number("breaking_load", "force", default=None)
+    if value is not None and not (value > 0 and math.isfinite(value)):
+        r.fail("breaking_load", f"expected a finite positive force (N), got {value}")
+    return value
 
 
 def _end_stop(r: Reader, kinds: dict) -> EndStop:

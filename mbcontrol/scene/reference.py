@@ -105,8 +105,7 @@ MEANING = {
                              "reflected inertia, friction and stiffness, gear^2 (J a + b v + "
                              "K x): WecOptTool's PTO force); bounds, tuners, design and the MPC "
                              "hold it",
-    ("pto", "stroke_max"): "stroke limit: a length (prismatic, between points) or an angle "
-                           "(revolute)",
+    ("pto", "stroke_max"): "stroke limit: a length (prismatic, between points) or an angle (revolute)",
     ("pto", "efficiency"): "drivetrain efficiency in (0, 1] (electrical power)",
     ("pto", "rated_power"): "rated power: the most mean power the PTO delivers in a sea "
                             "(mechanical; electrical with a drivetrain or an efficiency): the "
@@ -151,6 +150,7 @@ MEANING = {
                             "rest: `body`) or in MoorDyn's frame at rest (`global`)",
     ("mooring", "environment"): "moordyn: water density and depth of the file or of [water] (`scene`)",
     ("mooring", "settle"): "moordyn: bring the lines to rest at the initial pose before t = 0",
+    ("mooring", "breaking_load"): "moordyn: each line's breaking load (N): reaching it is reported",
     ("mooring", "body"): "the moored body",
     ("mooring", "point"): "fairlead, n-frame at rest",
     ("mooring", "stiffness"): "linear: spring per n-frame axis (N/m)",
@@ -397,4 +397,3 @@ def in_readme(readme: str) -> str:
     if not found or END not in rest:
         raise InputError(f"README: expected the markers {BEGIN.strip()} and {END}")
     return head + BEGIN + markdown() + END + rest.partition(END)[2]
-

@@ -23,6 +23,7 @@ from ..scene import TO_MOORDYN
 from .compiled import compile_function
 from .integrators import _chunk_function, step_extras
 from .methods import METHODS
+from .moordyn_events import LineEvents
 from ..plant import MoorDynSystem
 
 CHECK_EVERY = 512        # steps between divergence checks and hand-overs of outputs
@@ -61,10 +62,12 @@ class MooredRun:
             self.close()
             raise
         self._sign = np.tile(TO_MOORDYN, n_points)           # flat MoorDyn <-> n-frame
-        # the plant's own quasi-static part of the lines, F_0 + J (P - P_0), flat, n-frame
-        self._pull = np.concatenate([g.pull.T.ravel() for g in plant.moordyn])
-        self._at = np.concatenate([g.rest.T.ravel() for g in plant.moordyn])
+        # the plant's own quasi-static part of the lines, F_0 + J (P - P_0) = offset + J P,
+        # flat, n-frame
         self._stiffness = block_diag(*[g.stiffness for g in plant.moordyn])
+        self._offset = np.concatenate([g.pull.T.ravel() for g in plant.moordyn]) \
+            - self._stiffness @ np.concatenate([g.rest.T.ravel() for g in plant.moordyn])
+        self._moved = np.empty(3 * n_points)
         first = len(plant.disturbances) - 3 * n_points
         self.columns = slice(first, len(plant.disturbances))       # the rows of w it fills
         self.names = [f"{s.name}__line{line.id}__{end}_tension" for s in self.systems
@@ -97,8 +100,12 @@ class MooredRun:
         positions at t + dt (MoorDyn's: moved on from x at their velocity): what the plant
         takes in its MoorDyn rows of w."""
         F = self.forces(x, t, dt)
-        P = self._P.ravel() + max(dt, 0.0) * self._V.ravel()
-        return F - (self._pull + self._stiffness @ (P - self._at))
+        moved = self._moved
+        np.multiply(self._V.ravel(), max(dt, 0.0), out=moved)
+        moved += self._P.ravel()
+        F -= self._offset
+        F -= self._stiffness @ moved
+        return F
 
     def tensions(self) -> np.ndarray:
         """Anchor then fairlead tension of every line, mooring by mooring (N), in `names` order."""
@@ -148,10 +155,12 @@ def run_moored(plant, method, x0, W_nodes, p, *, dt, n, law, compiled, check, al
     """Integrate n steps with the moorings: (X (n+1, nx), U (n, nu), record). W_nodes gets
     the point forces in its MoorDyn rows. command(i, x, u_prev, w) -> u: a Python controller
     asked every `period_steps` steps (None: u = 0, or the compiled `law`). record: the
-    tensions (n+1, n_lines*2) by name, the MoorDyn rows of w at t_n, and the report."""
+    tensions (n+1, n_lines*2) by name, the MoorDyn rows of w at t_n, the report, and the
+    lines' breakage and bed contact (sim.moordyn_events)."""
     nodes = np.asarray(METHODS[method].nodes)[:, None]
     step = _OneStep(plant, method, law, p, dt, compiled)
     moored = MooredRun(plant, x0, compiled)
+    events = LineEvents(plant, moored)
     X, U = np.empty((n + 1, plant.nx)), np.zeros((n, len(plant.inputs)))
     X[0] = x0
     tensions = np.empty((n + 1, len(moored.names)))
@@ -165,12 +174,14 @@ def run_moored(plant, method, x0, W_nodes, p, *, dt, n, law, compiled, check, al
                 u = command(i, X[i], u, W_nodes[i, 0])
             step(X[i], u, W_nodes[i], X[i + 1], U[i])
             tensions[i + 1] = moored.tensions()
+            if events.watching:
+                events.after_step(i + 1, (i + 1) * dt, tensions[i + 1])
             f_now = f_next
             if (i + 1) % CHECK_EVERY == 0 or i + 1 == n:
                 check(i + 1, X[:i + 2])
                 if alongside is not None:
                     alongside.advance(i + 1, X, U, W_nodes[:, 0])
         return X, U, {"tensions": dict(zip(moored.names, tensions.T)), "w_last": f_now,
-                      "columns": cols, "report": moored.report()}
+                      "columns": cols, "report": moored.report(), "events": events.record}
     finally:
         moored.close()

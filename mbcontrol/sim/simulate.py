@@ -147,11 +147,12 @@ def _disturbance_record(plant, wave, t, W_nodes, moored) -> np.ndarray:
 
 
 def _add_tensions(ds, moored) -> None:
-    """Each MoorDyn line's anchor and fairlead tension (N) as variables, and what MoorDyn ran
-    with in attrs["moordyn"]."""
+    """Each MoorDyn line's anchor and fairlead tension (N) as variables, what MoorDyn ran
+    with in attrs["moordyn"], the lines' breakage and bed contact in attrs["moordyn_events"]."""
     for name, values in moored["tensions"].items():
         ds[name] = ("time", values, {"units": "N", "long_name": name.replace("__", " ")})
     ds.attrs["moordyn"] = moored["report"]
+    ds.attrs["moordyn_events"] = moored["events"]
 
 
 def _last_command(plant, controller, t, x, U, w, p) -> np.ndarray:

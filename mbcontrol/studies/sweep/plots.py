@@ -201,10 +201,10 @@ def plot_sweep(ds, summary: dict, path=None):
     return fig
 
 
-def _sea_dots(fig, ax, ds, values, ringed, *, cmap, label, ring_label, title, legend_at,
-              **colour):
+def _sea_dots(fig, ax, ds, values, ringed, *, cmap, label, ring_label, title, **colour):
     """Each sea's value as a dot at its Hs and Tp, annotated, with a colourbar; the seas in
-    `ringed` (a mask) ringed in red."""
+    `ringed` (a mask) ringed in red, said in a legend below the axes (inside, it would hide a
+    sea: a site's largest seas sit in a corner)."""
     ok = np.isfinite(values)
     dots = ax.scatter(ds["tp"].values[ok], ds["hs"].values[ok], c=values[ok], cmap=cmap, s=60,
                       edgecolor="k", lw=0.3, **colour)
@@ -214,8 +214,9 @@ def _sea_dots(fig, ax, ds, values, ringed, *, cmap, label, ring_label, title, le
     if ringed.any():
         ax.scatter(ds["tp"].values[ringed], ds["hs"].values[ringed], s=150, facecolor="none",
                    edgecolor="C3", lw=1.2, label=ring_label)
-        ax.legend(fontsize=7, loc=legend_at)
+        ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.14), frameon=False)
     fig.colorbar(dots, ax=ax, label=label)
+    ax.margins(y=0.1)                      # the top sea's label inside the axes
     ax.set_xlabel("peak period Tp, s")
     ax.set_ylabel("significant wave height Hs, m")
     ax.grid(alpha=0.3)
@@ -229,7 +230,7 @@ def _share_of_bound(fig, ax, ds):
     share = 100 * (ds["mean_power_W"].mean(over) / ds["bound_W"].mean(over)).values
     _sea_dots(fig, ax, ds, share, ~ds["inside_envelope"].all(over).values, cmap="cividis",
               vmin=0, vmax=100, label="mean power / bound inside the envelope, %",
-              ring_label="no setting inside the envelope", legend_at="upper left",
+              ring_label="no setting inside the envelope",
               title="designed per sea: share of the bound")
 
 
@@ -242,7 +243,7 @@ def _mooring_loads(fig, ax, ds):
     snap = np.isfinite(peak) & (peak > ds["mooring_mpm_3h_N"].max(over).values / 1e3) \
         if "mooring_mpm_3h_N" in ds else np.zeros(peak.shape, bool)
     _sea_dots(fig, ax, ds, peak, snap, cmap="inferno_r", label="largest fairlead tension, kN",
-              ring_label="max above its Gaussian 3-h estimate", legend_at="best",
+              ring_label="max above its Gaussian 3-h estimate",
               title="mooring loads: the most loaded fairlead per sea")
 
 
