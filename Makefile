@@ -63,6 +63,7 @@ bench: $(VENV)/.installed-test
 	$(PY) benchmarks/oes_sphere.py --out $(OUT)/bench/oes_sphere
 	$(PY) benchmarks/mathieu_spar.py --out $(OUT)/bench/mathieu
 	$(PY) benchmarks/moordyn_rm3.py --out $(OUT)/bench/moordyn_rm3
+	$(PY) benchmarks/startup.py --out $(OUT)/bench/startup
 	$(PY) benchmarks/radiation_fit.py --tols 0.1 0.05 0.02 0.01 --out $(OUT)/bench/radiation_barge
 	$(PY) benchmarks/radiation_fit.py --file models/rm3_hydro.nc --omega-max 3.0 \
 	    --tols 0.1 0.05 0.02 0.01 --out $(OUT)/bench/radiation_rm3

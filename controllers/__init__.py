@@ -8,24 +8,57 @@ they respect are here too. Tuning by name, bounding, simulating and scoring is a
 `mbcontrol.studies.design`.
 """
 from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import TYPE_CHECKING
+
 from mbcontrol.errors import UnknownName
+from mbcontrol.lazy import face
 
-from .base import Controller
-from .impedance import electrical_optimum
-from .joint import joint_tuning, other_laws
-from .latching import Declutching, Latching, mean_power, optimal_declutch, optimal_latch_time
-from .limits import command_limit, linear_range
-from .margins import loop_margins
-from .mpc import Mpc
-from .nmpc import Nmpc
-from .passive import Passive, optimal_damping
-from .reactive import Reactive, reactive_tuning
-from .robustness import robustness as loop_robustness
-from .robustness import share_explained
-from .tuning import OutsideEnvelope
+if TYPE_CHECKING:
+    from .base import Controller
 
-REGISTRY = {"passive": Passive, "reactive": Reactive, "latching": Latching,
-            "declutching": Declutching, "mpc": Mpc, "nmpc": Nmpc}
+# name -> (module, its name there): loaded on first use, so that the command line can list
+# the laws (REGISTRY's names) without importing python-control, CasADi and the hydrodynamics
+_WHERE = {
+    "Controller": ("base", "Controller"), "electrical_optimum": ("impedance", "electrical_optimum"),
+    "joint_tuning": ("joint", "joint_tuning"), "other_laws": ("joint", "other_laws"),
+    "Declutching": ("latching", "Declutching"), "Latching": ("latching", "Latching"),
+    "mean_power": ("latching", "mean_power"), "optimal_declutch": ("latching", "optimal_declutch"),
+    "optimal_latch_time": ("latching", "optimal_latch_time"),
+    "command_limit": ("limits", "command_limit"), "linear_range": ("limits", "linear_range"),
+    "loop_margins": ("margins", "loop_margins"), "Mpc": ("mpc", "Mpc"), "Nmpc": ("nmpc", "Nmpc"),
+    "Passive": ("passive", "Passive"), "optimal_damping": ("passive", "optimal_damping"),
+    "Reactive": ("reactive", "Reactive"), "reactive_tuning": ("reactive", "reactive_tuning"),
+    "loop_robustness": ("robustness", "robustness"),
+    "share_explained": ("robustness", "share_explained"),
+    "OutsideEnvelope": ("tuning", "OutsideEnvelope"),
+}
+
+
+__getattr__, __dir__ = face(__name__, globals(), _WHERE)
+
+
+class _Registry(Mapping):
+    """Law name -> its class, each class imported when first asked for (its names are free)."""
+
+    def __init__(self, classes: dict):
+        self._classes = classes
+
+    def __getitem__(self, name):
+        if name not in self._classes:
+            raise KeyError(name)
+        return __getattr__(self._classes[name])
+
+    def __iter__(self):
+        return iter(self._classes)
+
+    def __len__(self):
+        return len(self._classes)
+
+
+REGISTRY = _Registry({"passive": "Passive", "reactive": "Reactive", "latching": "Latching",
+                      "declutching": "Declutching", "mpc": "Mpc", "nmpc": "Nmpc"})
 
 
 def make(name: str, **settings) -> Controller:

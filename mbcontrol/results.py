@@ -25,10 +25,14 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-import xarray as xr
+
+from typing import TYPE_CHECKING
 
 from .errors import InputError, MbcontrolError
 from .atomic import atomic_path
+
+if TYPE_CHECKING:                # xarray costs 1.9 s to import: only where a Dataset is made
+    import xarray as xr
 
 ENCODED_ATTRS = "mbc_encoded_attrs"
 
@@ -136,6 +140,7 @@ def read_dataset(path) -> xr.Dataset:
     path = Path(path)
     if not path.is_file():
         raise DataFileError(f"{path}: no such file (expected a netCDF file mbcontrol wrote)")
+    import xarray as xr
     try:
         with xr.open_dataset(path, engine="netcdf4") as raw:
             return decode(raw.load())
@@ -155,6 +160,7 @@ def encode(ds: xr.Dataset) -> xr.Dataset:
     for name in list(out.data_vars):
         da = out[name]
         if np.iscomplexobj(da.values):
+            import xarray as xr
             split = xr.concat([da.real, da.imag], dim="complex").transpose("complex", *da.dims)
             split.attrs = _encode_attrs(da.attrs)
             out[name] = split

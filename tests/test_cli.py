@@ -177,12 +177,31 @@ def test_simulate_warns_of_an_unstable_sampled_loop_and_exits_3(capsys):
 def test_the_toolboxs_warnings_read_as_sentences():
     import os
 
-    from mbcontrol.cli import _format_warning
+    from mbcontrol.cli.messages import format_warning
     ours = os.path.join(os.sep, "x", "mbcontrol", "cli", "commands.py")
-    assert _format_warning("it diverges", RuntimeWarning, ours, 95) == \
+    assert format_warning("it diverges", RuntimeWarning, ours, 95) == \
         "mbcontrol: warning: it diverges\n"
     theirs = os.path.join(os.sep, "x", "numpy", "lib.py")
-    assert "RuntimeWarning" in _format_warning("overflow", RuntimeWarning, theirs, 1)
+    assert "RuntimeWarning" in format_warning("overflow", RuntimeWarning, theirs, 1)
+
+
+def test_a_warning_raised_from_two_places_is_said_once(capsys):
+    """Issue 58: the same warning from two places (a plant built twice, a fit read back) was
+    printed twice; a command says it once, and the next command says it again."""
+    import warnings
+
+    from mbcontrol.cli import main
+    from mbcontrol.cli.messages import said_once
+    said = []
+    show = said_once(lambda message, *rest, **kw: said.append(str(message)))
+    for line in (10, 20, 30):
+        show(RuntimeWarning("the fit misses its tolerance"), RuntimeWarning, "store.py", line)
+    show(RuntimeWarning("another"), RuntimeWarning, "store.py", 10)
+    assert said == ["the fit misses its tolerance", "another"]
+    before = warnings.showwarning
+    with pytest.raises(SystemExit):
+        main(["--version"])
+    assert warnings.showwarning is before              # the caller's hook comes back
 
 
 def test_version_and_python_m(capsys):

@@ -13,7 +13,8 @@ ROOT = Path(__file__).resolve().parents[1]
 STAGES = ("scene", "multibody", "hydro", "plant", "sim", "analysis", "controllers", "studies",
           "export", "cli")
 # modules every stage may use; they import no stage themselves
-COMMON = ("errors", "results", "waves", "plotting", "cache", "console", "atomic", "defaults", "lti", "textsafe")
+COMMON = ("errors", "results", "waves", "plotting", "cache", "console", "atomic", "defaults", "lti", "textsafe",
+          "lazy")
 # top-level programs that drive the whole flow: may import any stage, none may import them
 DRIVERS = ("cli", "demo", "models", "__main__")   # __main__: python -m mbcontrol
 MAX_LINES = 400          # the house rule: a module past ~400 lines is two modules

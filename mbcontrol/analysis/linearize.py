@@ -1,7 +1,9 @@
 """Exact linearisation of a ProcessPlant into a named python-control StateSpace.
 
 The model is in deviation coordinates about an operating point (x0, u0, w0, p), which must be
-an equilibrium: f(x0, u0, w0, p) = 0 to within `tol`. Jacobians are CasADi's exact ones, built
+an equilibrium: f(x0, u0, w0, p) = 0 to within `tol`, by default EQUILIBRIUM_SHARE of gravity
+(m/s^2, rad/s^2: a load left at rest of that share of a body's weight; a BEM file's displaced
+volume printed to 7 digits leaves 4e-7). Jacobians are CasADi's exact ones, built
 once per plant. Note that a smoothed Coulomb friction linearises to its slope at v = 0,
 coulomb / velocity_scale; pass params={"<friction>__coulomb": 0} to leave it out.
 """
@@ -18,8 +20,11 @@ if TYPE_CHECKING:       # python-control costs 2.5 s to import: only where it is
     import control
 
 
+EQUILIBRIUM_SHARE = 1e-6
+
+
 def linearize(plant, *, x0=None, u0=None, w0=None, params=None, inputs=None, outputs=None,
-              tol: float = 1e-8) -> control.StateSpace:
+              tol: float | None = None) -> control.StateSpace:
     """Linear model about an equilibrium, with the plant's signal names.
 
     inputs/outputs: names to keep (default: every u and w; every output). params: dict of
@@ -32,12 +37,17 @@ def linearize(plant, *, x0=None, u0=None, w0=None, params=None, inputs=None, out
     w0 = np.zeros(len(plant.disturbances)) if w0 is None else np.asarray(w0, float)
     p = plant.params(**params) if isinstance(params, dict) else (
         plant.p0 if params is None else np.asarray(params, float))
+    g = plant.scene.water.g
+    tol = EQUILIBRIUM_SHARE * g if tol is None else tol
     residual = np.asarray(plant.f(x0, u0, w0, p)).ravel()
     if np.max(np.abs(residual), initial=0.0) > tol:
         worst = np.argsort(-np.abs(residual))[:3]
-        listing = ", ".join(f"{plant.states[i]}' = {residual[i]:.3g}" for i in worst)
+        listing = ", ".join(f"{plant.states[i]}' = {residual[i]:.3g} ({residual[i] / g:.2g} g)"
+                            for i in worst)
         raise LinearizationError(f"{plant.name}: the operating point is not an equilibrium "
-                                 f"(largest residuals: {listing}; tolerance {tol:g})")
+                                 f"(largest residuals: {listing}; tolerance {tol:.3g}, "
+                                 f"{tol / g:.2g} of gravity): weight and buoyancy, or the "
+                                 f"static loads, do not balance there")
     A, Bu, Bw, C, Du, Dw = (np.asarray(M) for M in jacobians(plant)(x0, u0, w0, p))
     all_inputs = list(plant.inputs) + list(plant.disturbances)
     B, D = np.hstack([Bu, Bw]), np.hstack([Du, Dw])

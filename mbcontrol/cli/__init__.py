@@ -43,19 +43,8 @@ from .codesign import add_parser as add_codesign_parser
 from .export import add_parser as add_export_parser
 from .helptext import BENCH_HELP, DESIGN_HELP, SIMULATE_HELP
 from .identify import add_parser as add_identify_parser
-from .messages import refusal
+from .messages import format_warning, refusal, said_once
 from .sweep import add_parser as add_sweep_parser
-
-
-def _format_warning(message, category, filename, lineno, line=None) -> str:
-    """The toolbox's own warnings as sentences for the user, without the source line that
-    issued them; anything else (numpy, a dependency) in Python's usual form."""
-    if os.sep + "mbcontrol" + os.sep in filename or os.sep + "controllers" + os.sep in filename:
-        return f"mbcontrol: warning: {message}\n"
-    return _python_format(message, category, filename, lineno, line)
-
-
-_python_format = warnings.formatwarning
 
 
 def _version() -> str:
@@ -69,13 +58,14 @@ def _version() -> str:
 def main(argv=None) -> int:
     import logging
     logger = logging.getLogger("mbcontrol")
-    previous, warnings.formatwarning = warnings.formatwarning, _format_warning
+    previous, warnings.formatwarning = warnings.formatwarning, format_warning
+    shown, warnings.showwarning = warnings.showwarning, said_once(warnings.showwarning)
     level, bars = logger.level, os.environ.get("TQDM_DISABLE")
     quiet = defaults.get("log.quiet") if defaults.source("log.quiet") == "set" else None
     try:
         return _main(argv)
     finally:                     # a caller (a test, a notebook) gets its settings back
-        warnings.formatwarning = previous
+        warnings.formatwarning, warnings.showwarning = previous, shown
         logger.setLevel(level)
         if quiet is None:
             defaults.reset("log.quiet")

@@ -3,7 +3,9 @@ next), and that a command could not run (one line and its exit status)."""
 from __future__ import annotations
 
 import errno
+import os
 import re
+import warnings
 
 from ..atomic import ENVIRONMENT_ERRNOS, environment_problem
 from ..cache import EntrySetAside
@@ -50,3 +52,27 @@ def refusal(exc: BaseException) -> tuple[int | None, str]:
                          f"free some space, or fix the permissions of the folders the command "
                          f"writes, or write elsewhere (for the cache: "
                          f"MBCONTROL_CACHE=/another/folder)")
+
+
+def format_warning(message, category, filename, lineno, line=None) -> str:
+    """The toolbox's own warnings as sentences for the user, without the source line that
+    issued them; anything else (numpy, a dependency) in Python's usual form."""
+    if os.sep + "mbcontrol" + os.sep in filename or os.sep + "controllers" + os.sep in filename:
+        return f"mbcontrol: warning: {message}\n"
+    return _PYTHON_FORMAT(message, category, filename, lineno, line)
+
+
+_PYTHON_FORMAT = warnings.formatwarning
+
+
+def said_once(show):
+    """`show` (warnings.showwarning) that says each warning once per command: the same text
+    from two places (a plant assembled twice, a fit read back from the cache) is one warning."""
+    said = set()
+
+    def show_once(message, category, filename, lineno, file=None, line=None):
+        key = (category, str(message))
+        if key not in said:
+            said.add(key)
+            show(message, category, filename, lineno, file, line)
+    return show_once

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 from pathlib import Path
 
 import numpy as np
@@ -54,13 +55,16 @@ def converted_source(scene) -> tuple[str, xr.Dataset]:
                    f"where needed and mapped to the body frames; cached afterwards", __name__)
             # only the DOFs the scene declares (e.g. heave for sliders): asymmetric or non-passive
             # data in DOFs the scene never moves must not block it
+            # defects above the radiation fit's band are repaired with a warning, not refused
+            options = {**({"band_max": h.fit_omega_max} if math.isfinite(h.fit_omega_max) else {}),
+                       **h.source_options}
             if named:
                 data = read_hydro(path, body_names=named, dofs=[f"{b}__{d}" for b in named for d in h.dofs],
-                                  **h.source_options)
+                                  **options)
                 mapping = {b: {"scene_body": b, "by": "[hydro] source_bodies"} for b in named}
             else:
                 mapping = {}
-                data = _renamed(read_hydro(path, dofs=_by_position(scene, mapping), **h.source_options),
+                data = _renamed(read_hydro(path, dofs=_by_position(scene, mapping), **options),
                                 mapping)
                 data.attrs["notes"] = list(data.attrs["notes"]) + [_mapping_text(mapping)]
             framed = to_scene_frames(data, {b: np.asarray(c) for b, c in cogs.items()})

@@ -28,7 +28,7 @@ def simulate_batch(plant, waves=None, params=None, *, duration: float, dt: float
     Returns a Dataset over (case, time) with every plant output, and the states over
     (case, time, state_name); attrs: wall_time_s (excitation + stepping of all cases).
     """
-    from .simulate import energy_audit
+    from .run import energy_audit
     waves_list, params_list = _cases(waves, params)
     t, X, P, wall = batch_states(plant, waves_list, params_list, duration=duration, dt=dt,
                                  method=method, x0=x0, compiled=compiled)

@@ -23,7 +23,7 @@ import numpy as np
 from ..errors import InputError
 from ..plant import derived
 from . import integrators
-from .simulate import _divergence_check, _parameters, _warn_stiff, energy_audit
+from .run import _divergence_check, _parameters, _warn_stiff, energy_audit
 
 
 class Run:

@@ -10,13 +10,9 @@ import math
 import warnings
 from dataclasses import dataclass
 
-import casadi as ca
 import numpy as np
-import scipy.linalg
-from scipy.sparse.csgraph import connected_components
 
 from ..errors import InputError
-from ..plant import derived
 
 
 @dataclass(frozen=True)
@@ -91,10 +87,13 @@ def radiation_split(plant):
     The plant's radiation states are the last n_r states with chi' = A_r chi + B_r nu_h; A_r
     is in real modal form (1x1 and 2x2 blocks), so exp(A_r tau) has the same small blocks.
     """
+    from ..plant import derived          # here: the method registry is read at start-up
     return derived(plant, ("sim.radiation_split",), lambda: _radiation_split(plant))
 
 
 def _radiation_split(plant):
+    import casadi as ca       # here, as scipy below: the registry is read at start-up
+    from scipy.sparse.csgraph import connected_components
     A = plant.hydro.radiation_matrices()[0] if plant.hydro is not None else np.zeros((0, 0))
     n_r = sum(1 for s in plant.states if s.startswith("radiation_"))
     if A.shape[0] != n_r:
@@ -122,6 +121,7 @@ def _expm_small(M: np.ndarray) -> np.ndarray:
     if M.shape == (1, 1):
         return np.exp(M)
     if M.shape != (2, 2):
+        import scipy.linalg
         return scipy.linalg.expm(M)
     # exp(M) = e^{m} (cosh(d) I + sinh(d)/d (M - m I)), m = tr/2, d^2 = det-free discriminant
     m = 0.5 * (M[0, 0] + M[1, 1])

@@ -113,7 +113,7 @@ def stability_limit(plant, method: str, wave=None, *, duration: float, dt_lo: fl
         except SimulationError:
             return False
 
-    from .simulate import simulate as simulate_fn
+    from .run import simulate as simulate_fn
     if not stable(dt_lo):
         raise SimulationError(f"{plant.name}: method {method!r} already fails at dt_lo = "
                               f"{dt_lo:g} s; give a smaller dt_lo")

@@ -179,8 +179,10 @@ def _check_finite(ds, src, notes):
     return ds
 
 
-def _symmetry(ds, src, record, notes, *, tol, force):
-    """Symmetrise A-family and B; error (or forced symmetrisation) above ``tol``."""
+def _symmetry(ds, src, record, notes, *, tol, force, band_max=None):
+    """Symmetrise A-family and B; error (or forced symmetrisation) above ``tol``, unless every
+    such asymmetry lies above ``band_max`` (rad/s: the radiation fit's band, the scene's
+    fit_omega_max), where it is symmetrised with a warning."""
     dofs = [str(d) for d in ds["radiating_dof"].values]
     families = {"added_mass": ("added_mass", "added_mass_zero", "added_mass_inf"),
                 "radiation_damping": ("radiation_damping",)}
@@ -205,9 +207,19 @@ def _symmetry(ds, src, record, notes, *, tol, force):
                 msg = (f"{src}: {v} is not symmetric: relative asymmetry {worst:.3g} > {tol:g} at {where} "
                        f"(X[force {dofs[i]}, motion {dofs[j]}] = {vals[0]:.6g}, transposed entry {vals[1]:.6g}); "
                        "expected reciprocity (X = Xᵀ)")
-                if not force:
-                    raise HydroError(msg + " — pass force_symmetric=True to symmetrise it anyway")
-                warnings.warn(msg + "; symmetrised because force_symmetric=True", HydroCleaningWarning, stacklevel=4)
+                outside = band_max is not None and x.ndim == 3 and float(
+                    diff[ds["omega"].values <= band_max].max(initial=0.0)) <= tol
+                if not (force or outside):
+                    raise HydroError(msg + f" — set [hydro] source_options = {{ force_symmetric = true }} "
+                                     f"in the scene to symmetrise it (Python: force_symmetric=True), or "
+                                     f"[hydro] fit_omega_max below {w:.3g} rad/s if the device's seas lie "
+                                     f"below it" if w is not None else msg + " — set [hydro] "
+                                     "source_options = { force_symmetric = true } in the scene to "
+                                     "symmetrise it (Python: force_symmetric=True)")
+                why = ("force_symmetric = true" if force else
+                       f"it lies above the radiation fit's band ([hydro] fit_omega_max = {band_max:g} "
+                       f"rad/s; set [hydro] source_options = {{ force_symmetric = true }} to say so)")
+                warnings.warn(msg + f"; symmetrised because {why}", HydroCleaningWarning, stacklevel=4)
                 info["forced"] = True
             set_force_first(ds, v, 0.5 * (x + np.swapaxes(x, -1, -2)))
             record.setdefault("symmetrised", {})[v] = info
@@ -222,7 +234,7 @@ def _symmetry(ds, src, record, notes, *, tol, force):
 def clean(ds: xr.Dataset, *, source: str, asym_tol: float = ASYM_TOL, force_symmetric: bool = False,
           negative_damping: str = "repair", diag_tol: float = DIAG_TOL, eig_tol: float = EIG_TOL,
           max_interp_run: int = MAX_INTERP_RUN, end_zero_tol: float = END_ZERO_TOL, dofs=None,
-          omega_range=None) -> xr.Dataset:
+          omega_range=None, band_max: float | None = None) -> xr.Dataset:
     """Check a data-frame dataset and repair what can be repaired, recording every change.
 
     Steps (each error is a HydroError naming ``source`` and the problem):
@@ -239,7 +251,9 @@ def clean(ds: xr.Dataset, *, source: str, asym_tol: float = ASYM_TOL, force_symm
        naming the variable and the first bad frequency. A(0)/A(∞) may be all NaN (absent).
     4. Symmetry of A(ω), A(0), A(∞), B(ω): relative asymmetry max|S - Sᵀ| of the scaled matrix
        (module docs). Up to ``asym_tol`` the matrix is replaced by (X + Xᵀ)/2 and the largest
-       asymmetry is recorded; above it, error — unless ``force_symmetric`` (then warn and record).
+       asymmetry is recorded; above it, error — unless ``force_symmetric``, or every such
+       asymmetry lies above ``band_max`` (rad/s, the scene's fit_omega_max: where the radiation
+       fit does not look); then warn and record.
        The hydrostatic stiffness is left as stored (WAMIT's C46, C56 are legitimately one-sided).
     5. Negative damping (e.g. irregular frequencies): a frequency is flagged when a scaled diagonal
        B_kk < -``diag_tol`` or the smallest eigenvalue of the scaled symmetric B < -``eig_tol``
@@ -273,7 +287,8 @@ def clean(ds: xr.Dataset, *, source: str, asym_tol: float = ASYM_TOL, force_symm
     if omega_range is not None:
         ds = _crop(ds, src, omega_range, notes)
     ds = _check_finite(ds, src, notes)
-    _symmetry(ds, src, record, notes, tol=float(asym_tol), force=bool(force_symmetric))
+    _symmetry(ds, src, record, notes, tol=float(asym_tol), force=bool(force_symmetric),
+              band_max=band_max)
     ds = repair_negative_damping(ds, src, record, notes, diag_tol=float(diag_tol), eig_tol=float(eig_tol),
                                  max_run=int(max_interp_run), end_zero_tol=float(end_zero_tol), mode=negative_damping)
     ds.attrs.setdefault("source", src)   # rho, g, frame: set by the reader's layout

@@ -121,8 +121,9 @@ def repair_negative_damping(ds, src, record, notes, *, diag_tol, eig_tol, max_ru
                 raise HydroError(
                     f"{src}: negative radiation damping {where}: {fmt_omega(w[k0])} to {fmt_omega(w[k1])}, DOFs "
                     f"{[dofs[j] for j in off]}, min scaled eigenvalue {before:.3g}; expected B(ω) positive "
-                    f"semi-definite. It {why} — pass negative_damping='project' to use the nearest positive "
-                    "semi-definite matrix there, or fix the BEM run")
+                    f"semi-definite. It {why} — set [hydro] source_options = {{ negative_damping = "
+                    f"\"project\" }} in the scene (Python: negative_damping='project') to use the nearest "
+                    "positive semi-definite matrix there, or fix the BEM run")
             for i in idx:
                 B[i] = _nearest_psd(B[i], scale)
             off = list(range(len(dofs)))
