@@ -20,7 +20,7 @@ from mbcontrol.plant import build_plant
 from mbcontrol.scene import load_scene
 from mbcontrol.sim import sampled as sim_sampled
 from mbcontrol.sim import simulate
-from mbcontrol.sim.simulate import _parameters
+from mbcontrol.sim.run import _parameters
 
 SLIDER = """\
 name = "slider"
