@@ -212,6 +212,9 @@ def _add_hydro(sub) -> None:
                    help="judge the fit by the device's response or by the kernel's own error "
                         "(default: the scene's [hydro] fit_judged_by)")
     p.add_argument("--json", action="store_true", help="print the report as JSON")
+    p.add_argument("--plot", metavar="FILE.png",
+                   help="draw A(ω), B(ω) and |F_ex(ω)| per DOF: the data, and the fitted\n"
+                        "radiation model over them")
     p.set_defaults(run=run_hydro)
 
 

@@ -102,6 +102,10 @@ def run_hydro(args) -> int:
                 if response:
                     print(f"  its response error (not what judges this fit): {response['error']:.2%} at "
                           f"{response['omega']:.4g} rad/s, most the {response['what']}")
+    if args.plot:
+        from ..hydro import hydro_figure
+        print(f"  figure: {hydro_figure(plant.hydro, args.plot, name=plant.name, fit_omega_max=plant.scene.hydro.fit_omega_max)}",
+              file=sys.stderr if args.json else sys.stdout)
     return 0
 
 

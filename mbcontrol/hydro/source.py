@@ -35,6 +35,31 @@ MATCH_RADIUS = 0.5
 MATCH_FLOOR = 0.05      # m: the radius of a body without displaced volume (a fixed, dry part)
 
 
+def _check_frame(scene, path, framed) -> None:
+    """A scene written z-up (WEC-Sim's convention) rather than NED is refused: the file states
+    each body's CoG, and a scene CoG that is its mirror in z (|z| more than FRAME_TOL apart from
+    it, within FRAME_TOL of -z) is that CoG written z-up."""
+    from ..errors import SceneError
+    if "source_cog" not in framed:
+        return
+    for body in framed["body"].values:
+        stated = float(framed["source_cog"].sel(body=body).values[2])
+        given = float(framed["cog"].sel(body=body).values[2])
+        tol = max(FRAME_TOL_M, FRAME_TOL * abs(stated))
+        if abs(stated) > tol and abs(given + stated) <= tol < abs(given - stated):
+            raise SceneError(
+                f"{scene.path}: body '{body}': cog z = {given:g} m, but {path.name} states its "
+                f"CoG at z = {stated:g} m in mbcontrol's frame ({-stated:g} m z-up, as the file "
+                f"writes it): the scene looks written z-up, as WEC-Sim's input files are. "
+                f"mbcontrol scenes are NED (x forward, y to starboard, z down, origin on the "
+                f"still water): write every point with y and z negated (a CoG 0.72 m below "
+                f"the water is z = 0.72)")
+
+
+# a scene CoG mirrored in z from the file's own, within 1 cm or 5 %: written z-up
+FRAME_TOL_M, FRAME_TOL = 0.01, 0.05
+
+
 def converted_source(scene) -> tuple[str, xr.Dataset]:
     """(description, body-frame dataset) of the scene's [hydro] source, converted once and
     cached. The dataset's attrs say what was read ("converted_from"), what the readers
@@ -68,6 +93,7 @@ def converted_source(scene) -> tuple[str, xr.Dataset]:
                                 mapping)
                 data.attrs["notes"] = list(data.attrs["notes"]) + [_mapping_text(mapping)]
             framed = to_scene_frames(data, {b: np.asarray(c) for b, c in cogs.items()})
+            _check_frame(scene, path, framed)
             framed.attrs["converted_from"] = path.name
             framed.attrs["body_mapping"] = json.dumps(mapping)
             write_netcdf_atomic(framed, cached)
@@ -97,10 +123,15 @@ def _by_position(scene, mapping: dict):
                      f"{np.round(point, 4).tolist()} m)")
             if len(near) != 1:
                 problem = ("is farther than" if not near else "has more than one scene body within")
+                mirrored = [n for n, c in cogs.items()
+                            if np.linalg.norm(point - c * np.array([1.0, -1.0, -1.0])) <= radius]
+                hint = (f"; scene body {mirrored[0]!r} with y and z negated lies within it: the scene "
+                        f"looks written z-up, as WEC-Sim's input files are, and mbcontrol scenes are "
+                        f"NED (z down)" if not near and mirrored else "")
                 raise HydroError(
                     f"{scene.path}: [hydro] source_bodies is not given and {where} {problem} {radius:.3g} m "
-                    f"(half its size, V^(1/3)/2) of a scene body's CoG; candidates: {listing}. Name the "
-                    f"scene body of each BEM body, in file order: [hydro] source_bodies = [...]")
+                    f"(half its size, V^(1/3)/2) of a scene body's CoG; candidates: {listing}{hint}. Name "
+                    f"the scene body of each BEM body, in file order: [hydro] source_bodies = [...]")
             if near[0] in claimed:
                 raise HydroError(
                     f"{scene.path}: [hydro] source_bodies is not given and BEM bodies {claimed[near[0]]!r} "
