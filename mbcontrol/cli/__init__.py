@@ -35,10 +35,10 @@ import warnings
 from .. import defaults
 from ..errors import MbcontrolError
 from ..sim import METHODS
-from .commands import (run_bench, run_fidelity, run_hydro, run_linearize, run_models,
-                       run_simulate)
+from .commands import run_bench, run_fidelity, run_hydro, run_models, run_simulate
 from .describe import default_help, run_defaults, run_keys
 from .design import run_design
+from .linearize import run_linearize
 from .codesign import add_parser as add_codesign_parser
 from .export import add_parser as add_export_parser
 from .helptext import BENCH_HELP, DESIGN_HELP, SIMULATE_HELP

@@ -250,34 +250,6 @@ def run_fidelity(args) -> int:
     return 0
 
 
-def run_linearize(args) -> int:
-    from ..analysis import linearize
-    plant = _plant(args)
-    params = dict(_key_value(s, "--param") for s in args.param)
-    sys_ = linearize(plant, params=params or None)
-    poles = np.linalg.eigvals(np.asarray(sys_.A))
-    pairs = [tuple(p.split(":", 1)) for p in args.pair] or [
-        (f"u__{p.name}", f"{p.name}__velocity") for p in plant.scene.ptos]
-    if args.bode:
-        from ..plotting import bode
-        omega = np.logspace(np.log10(max(plant.hydro.omega[0], 0.05)) if plant.hydro else -1,
-                            np.log10(plant.hydro.omega[-1]) if plant.hydro else 2, 400)
-        bode(sys_, pairs, omega, path=args.bode)
-    info = {"model": plant.name, "n_states": int(sys_.nstates), "states": sys_.state_labels,
-            "inputs": sys_.input_labels, "outputs": sys_.output_labels,
-            "poles": [[float(p.real), float(p.imag)] for p in poles],
-            "stable": bool(np.all(poles.real < 0)), "bode": args.bode}
-    if args.json:
-        print(json.dumps(info, indent=2))
-    else:
-        print(f"{plant.name}: {sys_.nstates} states, {sys_.ninputs} inputs, {sys_.noutputs} "
-              f"outputs; {'stable' if info['stable'] else 'NOT stable'} (max pole real part "
-              f"{poles.real.max():.3g})")
-        if args.bode:
-            print(f"Bode plot written to {args.bode}")
-    return 0
-
-
 def _controller(args, wave=None):
     """The --controller with its --set settings. A controller that takes a `wave` (a
     predictive controller's preview) is handed the simulated one, as `design` does."""

@@ -129,7 +129,15 @@ def plot_sweep(ds, summary: dict, path=None):
     budgeted = summary.get("annual_energy_budget") is not None
     moored = "mooring_max_N" in ds
     n = 2 + weighted + designed + budgeted + moored
-    fig, axes = plt.subplots(1, n, figsize=(5.3 * n, 4.4))
+    # two panels a row: a page (A4) wide, whatever the number of panels (in one row, a site's
+    # five were 27 inches wide)
+    cols = min(n, 2)
+    fig, grid = plt.subplots(-(-n // cols), cols, figsize=(5.6 * cols, 4.4 * -(-n // cols)),
+                             squeeze=False)
+    axes = list(grid.ravel())
+    for spare in axes[n:]:
+        spare.set_axis_off()
+    axes = axes[:n]
     period = "tp"
     try:
         table = power_matrix(ds, period=period) / 1e3
@@ -151,7 +159,36 @@ def plot_sweep(ds, summary: dict, path=None):
     except ValueError as exc:                       # other quantities varied: no single table
         axes[0].text(0.5, 0.5, str(exc), ha="center", va="center", wrap=True, fontsize=8)
         axes[0].set_axis_off()
-    ax = axes[1]
+    _capture_width(fig, axes[1], ds, summary)
+    if weighted:
+        ax = axes[2]
+        power = ds["mean_power_W"].mean([d for d in ds["mean_power_W"].dims if d != "sea"])
+        energy = np.nan_to_num(ds["weight"].values * power.values * 8766 / 1e6)
+        size = 400 * energy / max(energy.max(), 1e-300) + 4
+        bubbles = ax.scatter(ds["tp"].values, ds["hs"].values, s=size, c=energy,
+                             cmap="magma_r", edgecolor="k", lw=0.4)
+        fig.colorbar(bubbles, ax=ax, label="energy per year, MWh")
+        ax.set_xlabel("peak period Tp, s")
+        ax.set_ylabel("significant wave height Hs, m")
+        ax.grid(alpha=0.3)
+        ax.set_title(f"annual energy {summary['annual_energy_MWh']:.4g} MWh: each sea state's "
+                     f"share (area)", fontsize=9)
+    if designed:
+        _share_of_bound(fig, axes[2 + weighted], ds)
+    if moored:
+        _mooring_loads(fig, axes[2 + weighted + designed], ds)
+    if budgeted:
+        _budget(axes[-1], summary)
+    fig.tight_layout()
+    if path is not None:
+        save(fig, path)
+    return fig
+
+
+def _capture_width(fig, ax, ds, summary):
+    """Capture width (or its ratio) against Tp: a line per Hs for a grid, a dot per sea
+    coloured by Hs for a site's list."""
+    import matplotlib.pyplot as plt
     ratio = "capture_width_ratio" if "capture_width_ratio" in ds else "capture_width_m"
     values = ds[ratio].mean([d for d in ds[ratio].dims if d != "sea"])
     # a marker per Hs, largest first: a linear law's capture width does not depend on Hs,
@@ -176,29 +213,6 @@ def plot_sweep(ds, summary: dict, path=None):
     ax.grid(alpha=0.3)
     ax.set_title("capture width" + (", valid cases only" if summary.get("invalid_cases")
                                     else ""), fontsize=9)
-    if weighted:
-        ax = axes[2]
-        power = ds["mean_power_W"].mean([d for d in ds["mean_power_W"].dims if d != "sea"])
-        energy = np.nan_to_num(ds["weight"].values * power.values * 8766 / 1e6)
-        size = 400 * energy / max(energy.max(), 1e-300) + 4
-        bubbles = ax.scatter(ds["tp"].values, ds["hs"].values, s=size, c=energy,
-                             cmap="magma_r", edgecolor="k", lw=0.4)
-        fig.colorbar(bubbles, ax=ax, label="energy per year, MWh")
-        ax.set_xlabel("peak period Tp, s")
-        ax.set_ylabel("significant wave height Hs, m")
-        ax.grid(alpha=0.3)
-        ax.set_title(f"annual energy {summary['annual_energy_MWh']:.4g} MWh: each sea state's "
-                     f"share (area)", fontsize=9)
-    if designed:
-        _share_of_bound(fig, axes[2 + weighted], ds)
-    if moored:
-        _mooring_loads(fig, axes[2 + weighted + designed], ds)
-    if budgeted:
-        _budget(axes[-1], summary)
-    fig.tight_layout()
-    if path is not None:
-        save(fig, path)
-    return fig
 
 
 def _sea_dots(fig, ax, ds, values, ringed, *, cmap, label, ring_label, title, **colour):

@@ -122,6 +122,8 @@ def test_sweep_figure_on_real_axes(tmp_path):
     assert {f"{v:.3g}" for v in np.ravel(kw)} <= texts
     assert any(a.get_ylabel() == "mean power, kW" for a in fig.axes)
     assert (tmp_path / "sweep.png").stat().st_size > 10_000
+    # two panels a row: a page wide however many there are (a site's five were 27 in wide)
+    assert fig.get_size_inches()[0] <= 11.5
 
 
 def test_a_case_that_diverges_is_a_result_not_a_crash(tmp_path):
