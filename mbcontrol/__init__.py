@@ -8,30 +8,22 @@ The handful of entry points a script needs are importable from here, e.g.
 ``from mbcontrol import load_scene, build_plant, simulate, linearize, waves``; each is loaded
 on first use, so ``import mbcontrol`` stays cheap.
 """
-from importlib import import_module
+from .lazy import face
 
 __version__ = "0.1.0"
 
-_ENTRY_POINTS = {
-    "load_scene": "mbcontrol.scene", "list_models": "mbcontrol.scene",
-    "build_plant": "mbcontrol.plant", "Fidelity": "mbcontrol.plant",
-    "simulate": "mbcontrol.analysis", "simulate_batch": "mbcontrol.sim",
-    "linearize": "mbcontrol.analysis", "frequency_domain_response": "mbcontrol.analysis",
-    "pto_metrics": "mbcontrol.analysis",
-    "make_controller": "mbcontrol.controllers",
+# name -> (module of the package, its name there); `mbcontrol.simulate` checks its result
+# (mbcontrol.analysis.validity), the raw integrator is mbcontrol.sim.simulate
+_WHERE = {
+    "load_scene": ("scene", "load_scene"), "list_models": ("scene", "list_models"),
+    "build_plant": ("plant", "build_plant"), "Fidelity": ("plant", "Fidelity"),
+    "simulate": ("analysis", "simulate_checked"), "simulate_batch": ("sim", "simulate_batch"),
+    "linearize": ("analysis", "linearize"),
+    "frequency_domain_response": ("analysis", "frequency_domain_response"),
+    "pto_metrics": ("analysis", "pto_metrics"), "make_controller": ("controllers", "make"),
+    "waves": ("waves", None),
 }
-# `mbcontrol.simulate` checks its result (mbcontrol.analysis.validity); the raw integrator is
-# mbcontrol.sim.simulate
-_ALIASES = {"make_controller": "make", "simulate": "simulate_checked"}
 
-__all__ = ["waves", *_ENTRY_POINTS]
+__all__ = list(_WHERE)
 
-
-def __getattr__(name):
-    if name in _ENTRY_POINTS:
-        value = getattr(import_module(_ENTRY_POINTS[name]), _ALIASES.get(name, name))
-        globals()[name] = value
-        return value
-    if name == "waves":
-        return import_module("mbcontrol.waves")
-    raise AttributeError(f"module 'mbcontrol' has no attribute {name!r}")
+__getattr__, __dir__ = face(__name__, globals(), _WHERE)

@@ -1,5 +1,5 @@
-"""Package faces that load what they export on first use (PEP 562): `mbcontrol.sim` and
-`mbcontrol.controllers` name their exports here rather than importing every module, so that
+"""Package faces that load what they export on first use (PEP 562): `mbcontrol`,
+`mbcontrol.sim` and `mbcontrol.controllers` name their exports here rather than importing every module, so that
 a quick answer of the command line (`--help`, `models`) imports no simulator, CasADi, xarray
 or python-control (tests/cli/test_startup.py)."""
 from __future__ import annotations
@@ -9,13 +9,14 @@ from importlib import import_module
 
 def face(package: str, namespace: dict, where: dict):
     """(__getattr__, __dir__) for `package` (its globals `namespace`): `where` maps each name
-    to (its module in the package, its name there); a name is imported when first asked for,
-    then kept in the namespace."""
+    to (its module in the package, its name there, or None for the module itself); a name is
+    imported when first asked for, then kept in the namespace."""
     def __getattr__(name):
         if name not in where:
             raise AttributeError(f"module {package!r} has no attribute {name!r}")
         module, attr = where[name]
-        value = getattr(import_module(f"{package}.{module}"), attr)
+        value = import_module(f"{package}.{module}")
+        value = value if attr is None else getattr(value, attr)
         namespace[name] = value
         return value
 

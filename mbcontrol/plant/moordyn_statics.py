@@ -104,7 +104,8 @@ def mooring_statics(scene, mooring, P0: np.ndarray) -> MooringStatics:
     solved = _shipped(mooring.file, key) or load_or_make(
         cache_dir() / "moordyn" / f"statics-{key}.json", lambda path: json.loads(path.read_bytes()),
         make, what="MoorDyn mooring statics")
-    STATICS_SERVED.append((mooring.file, key, solved))
+    if all(served[1] != key for served in STATICS_SERVED):   # once: a sweep builds many plants
+        STATICS_SERVED.append((mooring.file, key, solved))
     flip = np.tile(TO_MOORDYN, P0.shape[1])
     F = np.asarray(solved["force"]) * flip                 # MoorDyn's frame -> n-frame
     J = flip[:, None] * np.asarray(solved["jacobian"]) * flip[None, :]
