@@ -27,12 +27,16 @@ _WHERE = {
     "mean_power": ("latching", "mean_power"), "optimal_declutch": ("latching", "optimal_declutch"),
     "optimal_latch_time": ("latching", "optimal_latch_time"),
     "command_limit": ("limits", "command_limit"), "linear_range": ("limits", "linear_range"),
-    "loop_margins": ("margins", "loop_margins"), "Mpc": ("mpc", "Mpc"), "Nmpc": ("nmpc", "Nmpc"),
+    "loop_margins": ("margins", "loop_margins"), "loop_bode": ("loop_plots", "loop_bode"),
+    "loop_nyquist": ("loop_plots", "loop_nyquist"), "loop_marks": ("loop_plots", "loop_marks"),
+    "pto_gains": ("margins", "pto_gains"),
+    "Mpc": ("mpc", "Mpc"), "Nmpc": ("nmpc", "Nmpc"),
     "Passive": ("passive", "Passive"), "optimal_damping": ("passive", "optimal_damping"),
     "Reactive": ("reactive", "Reactive"), "reactive_tuning": ("reactive", "reactive_tuning"),
     "loop_robustness": ("robustness", "robustness"),
     "share_explained": ("robustness", "share_explained"),
     "OutsideEnvelope": ("tuning", "OutsideEnvelope"),
+    "LimitsUnreachable": ("tuning", "LimitsUnreachable"),
 }
 
 

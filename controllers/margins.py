@@ -28,7 +28,11 @@ Margins reported (`Margins`):
   -1 where |L| = 1; inf when |L| never reaches 1. Unsigned because reactive control near
   complex-conjugate matching has |L(i omega_wave)| = 1 at an angle -2 arg Z_i, close to
   +-180 deg on either side, and the textbook sign (lag only) then reads "negative" for a
-  stable loop;
+  stable loop. python-control's signed figure at the same crossing, remainder(arg L, 360 deg)
+  - 180 deg (control.stability_margins: negative when the loop lags past -180 deg), is
+  reported beside it as phase_margin_signed_deg; its absolute value is phase_margin_deg. The
+  gain margin and its choice among crossings (nearest 1 in log, L(0) included) are
+  python-control's too, and so is the stability margin;
 - stability margin: min over omega >= 0 of |1 + L(i omega)| (omega = 0 and infinity
   included), the distance of the Nyquist curve from -1, 1 / (peak sensitivity);
 - the closed-loop poles (reactive.closed_loop_stability for static laws): stable, and the
@@ -73,6 +77,7 @@ class Margins:
     message: str
     loop: object = field(default=None, repr=False, compare=False)   # L(s) or L(z)
     period_s: float | None = None   # the controller's sample period (s); None: continuous
+    phase_margin_signed_deg: float = math.inf   # python-control's sign (module docstring)
 
     def to_dict(self) -> dict:
         """JSON-ready: no L(s); inf and nan become None."""
@@ -80,7 +85,7 @@ class Margins:
         for key in ("pto", "law", "gain_margin", "phase_crossover_rad_s", "phase_margin_deg",
                     "gain_crossover_rad_s", "stability_margin", "stability_margin_rad_s",
                     "gain_crossovers_rad_s", "phase_margins_deg", "stable", "pole_margin",
-                    "message", "period_s"):
+                    "message", "period_s", "phase_margin_signed_deg"):
             value = getattr(self, key)
             out[key] = [_finite(v) for v in value] if isinstance(value, tuple) else _finite(value)
         return out
@@ -177,7 +182,8 @@ def loop_margins(plant, law, *, pto: str | None = None, params=None,
     wc = wcs[k] if pms else math.nan
     message = _message(name, label, stable, pole_margin, gm, w180, pm, wc, sm, L)
     return Margins(name, label, gm, w180, pm, wc, sm, wsm, tuple(wcs), tuple(pms),
-                   bool(stable), float(pole_margin), message, L)
+                   bool(stable), float(pole_margin), message, L,
+                   phase_margin_signed_deg=_signed(L, wc, pm))
 
 
 def pto_gains(plant, law, others: dict | None = None) -> dict:
@@ -215,7 +221,18 @@ def _sampled_margins(plant, law, period, name, params, others) -> Margins:
     message = (f"sampled at {period:g} s (zero-order hold), every PTO's loop closed "
                f"(spectral radius {joint.spectral_radius:.6g}): {text}")
     return Margins(name, label, gm, w180, pm, wc, sm, wsm, tuple(wcs), tuple(pms),
-                   bool(joint.stable), float(joint.decay_rate), message, L, period)
+                   bool(joint.stable), float(joint.decay_rate), message, L, period,
+                   _signed(L, wc, pm))
+
+
+def _signed(L, wc: float, pm: float) -> float:
+    """python-control's signed phase margin (deg) at the crossing wc (rad/s): arg(-L), i.e.
+    remainder(arg L, 360) - 180; inf where |L| never reaches 1."""
+    if not math.isfinite(pm):
+        return math.inf
+    point = np.exp(1j * wc * float(L.dt)) if L.isdtime(strict=True) else 1j * wc
+    value = complex(np.asarray(L(point)).ravel()[0])
+    return float(np.remainder(np.degrees(np.angle(value)), 360.0) - 180.0)
 
 
 def _margins(L):
@@ -245,7 +262,9 @@ def _dc(L):
 def _message(pto, label, stable, pole_margin, gm, w_gm, pm, wc, sm, L) -> str:
     gain = ("inf (never crosses the negative real axis)" if math.isinf(gm)
             else f"{gm:.4g} at {w_gm:.4g} rad/s")
-    phase = "inf (|L| < 1 throughout)" if math.isinf(pm) else f"{pm:.3g} deg at {wc:.4g} rad/s"
+    phase = ("inf (|L| < 1 throughout)" if math.isinf(pm) else
+             f"{pm:.3g} deg at {wc:.4g} rad/s (python-control's signed figure "
+             f"{_signed(L, wc, pm):+.3g} deg)")
     text = (f"PTO {pto!r}, {label} law: gain margin {gain}; phase margin {phase}; "
             f"min |1 + L| = {sm:.3g}")
     if stable:

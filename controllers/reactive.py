@@ -133,19 +133,22 @@ def reactive_tuning(plant, wave, pto: str | None = None, *, params=None,
     with a drivetrain is tuned for electrical power by default (objective "auto"; see
     passive.optimal_damping): the winding loss of the spring's reactive current moves the
     optimum away from the complex conjugate. envelope, rated_power: as
-    passive.optimal_damping's. robust: keep the loop min |1 + L| >= robustness.STABILITY_FLOOR
-    (a gain margin of 2.08 and a phase margin of 30.1 deg at the least).
+    passive.optimal_damping's. robust: keep the loop min |1 + L| >= robustness.stability_floor()
+    (with the default floors, a gain margin of 2.08 and a phase margin of 30.1 deg at the
+    least; the floors are the defaults design.gain_margin_min and design.phase_margin_min_deg).
+    This primitive's default is the unconstrained optimum; `design` and `export` (studies.design
+    .tune) ask for robust=True unless told --aggressive.
     """
     winding = electrical_winding(plant, pto, objective)
     if (force_max is not None or stroke_max is not None or efficiency is not None or winding
             or envelope or rated_power is not None or robust):
-        from .robustness import STABILITY_FLOOR
+        from .robustness import stability_floor
         return constrained_tuning(plant, wave, pto=pto, params=params, force_max=force_max,
                                   stroke_max=stroke_max, efficiency=efficiency,
                                   exceedance=exceedance, min_margin=min_margin,
                                   winding=winding, envelope=envelope,
                                   rated_power=rated_power,
-                                  min_stability=STABILITY_FLOOR if robust else None)
+                                  min_stability=stability_floor() if robust else None)
 
     name = pto or plant.scene.ptos[0].name
     w, a = np.asarray(wave.omega, float), np.asarray(wave.amplitude, float)

@@ -21,6 +21,12 @@ class OutsideEnvelope(ControllerError):
         self.fallback, self.ratio = fallback, ratio
 
 
+class LimitsUnreachable(ControllerError):
+    """No damper holds the PTO's force and stroke limits together in this sea: a light one
+    lets the stroke pass its limit, a heavy one the force (studies.design.fallback then
+    tries a force-saturated damper)."""
+
+
 def constrained_tuning(plant, wave, *, pto: str | None = None, params=None,
                        passive: bool = False, bounds=None, force_max: float | None = None,
                        stroke_max: float | None = None, efficiency: float | None = None,
@@ -124,10 +130,23 @@ def _no_feasible_damper(plant, x, st, *, bounds, env, Z, F, wave, f_max, s_max, 
                             f"{r['limit']:.3g}, {r['source']})" for r in worst),
                 fallback=(c, 0.0, float(st["power_W"][j])),
                 ratio=float(st["envelope_ratio"][j]))
-    raise ControllerError(
-        f"{plant.name}: no damping in {bounds[0]:.4g}..{bounds[1]:.4g} keeps the predicted "
-        f"peaks within force_max {f_max:.4g} and stroke_max {s_max:.4g} (least force peak "
-        f"{st['force_peak'].min():.4g}, least stroke peak {st['stroke_peak'].min():.4g})")
+    # a light damper keeps the force low but lets the stroke grow, a heavy one the reverse:
+    # say both ends of the trade, where each limit alone is met, not two unrelated minima
+    within_force = st["force_peak"] <= f_max
+    within_stroke = st["stroke_peak"] <= s_max
+    parts = []
+    if within_force.any():
+        j = int(np.flatnonzero(within_force)[-1])
+        parts.append(f"the heaviest damper within force_max ({np.exp(x[j]):.4g} N s/m) lets "
+                     f"the stroke peak reach {st['stroke_peak'][j]:.4g} (stroke_max {s_max:.4g})")
+    if within_stroke.any():
+        j = int(np.flatnonzero(within_stroke)[0])
+        parts.append(f"the lightest within stroke_max ({np.exp(x[j]):.4g} N s/m) needs a force "
+                     f"peak of {st['force_peak'][j]:.4g} (force_max {f_max:.4g})")
+    raise LimitsUnreachable(
+        f"{plant.name}: no damping in {bounds[0]:.4g}..{bounds[1]:.4g} keeps both predicted "
+        f"peaks within the limits in this sea: " + ("; ".join(parts) or
+                                                     "neither limit can be met alone"))
 
 
 def _best_on_grid(evaluate, x, objective, feasible) -> float:

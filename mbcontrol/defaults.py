@@ -62,6 +62,12 @@ _REGISTRY: dict[str, Default] = {
     "hydro.radiation_tol": Default(0.01, "", "radiation fit error of a scene that sets none "
                                              "([hydro] radiation_tol)"),
     "fidelity.tol": Default(0.01, "", "error a simplified model may add (fidelity auto)"),
+    "design.gain_margin_min": Default(2.0, "", "least gain margin (factor on the gains) of a "
+                                               "linear law design and export tune and ship "
+                                               "(--aggressive: none)"),
+    "design.phase_margin_min_deg": Default(30.0, "deg", "least phase margin of a linear law "
+                                                        "design and export tune and ship "
+                                                        "(--aggressive: none)"),
 }
 
 _set: dict[str, object] = {}

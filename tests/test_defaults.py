@@ -108,3 +108,24 @@ def test_progress_bars_only_where_a_person_watches(monkeypatch):
     bar = progress_bar(total=3, file=sys.stderr)
     assert not bar.disable
     bar.close()
+
+
+def test_the_design_margins_are_defaults_and_set_the_tuners_floor(capsys):
+    """design.gain_margin_min and design.phase_margin_min_deg: listed, and the robust
+    tuner's least |1 + L| follows from them (s = 1 - 1/gm or 2 sin(pm / 2), the larger)."""
+    import math
+
+    from mbcontrol.controllers.robustness import STABILITY_ROOM, floors, stability_floor
+    assert main(["defaults"]) == 0
+    listing = capsys.readouterr().out
+    assert "design.gain_margin_min" in listing and "design.phase_margin_min_deg" in listing
+    assert floors() == {"gain_margin": 2.0, "phase_margin_deg": 30.0}
+    s = 2 * math.sin(math.radians(15))                       # 0.5176 > 1 - 1/2
+    assert stability_floor() == pytest.approx(s * STABILITY_ROOM, rel=1e-12)
+    assert 1 / (1 - stability_floor()) >= 2 and 2 * math.degrees(
+        math.asin(stability_floor() / 2)) >= 30
+    with defaults.override(design_gain_margin_min=4.0):      # 0.75 > 2 sin 15 deg
+        assert stability_floor() == pytest.approx(0.75 * STABILITY_ROOM, rel=1e-12)
+    with defaults.override(design_gain_margin_min=0.5):
+        with pytest.raises(ValueError, match="design.gain_margin_min"):
+            stability_floor()

@@ -37,8 +37,8 @@ from ..errors import MbcontrolError
 from ..sim import METHODS
 from .commands import run_bench, run_fidelity, run_hydro, run_models, run_simulate
 from .describe import default_help, run_defaults, run_keys
-from .design import run_design
-from .linearize import run_linearize
+from .design import add_design_flags, run_design
+from .linearize import add_linearize_flags, run_linearize
 from .codesign import add_parser as add_codesign_parser
 from .export import add_parser as add_export_parser
 from .helptext import BENCH_HELP, DESIGN_HELP, SIMULATE_HELP
@@ -277,9 +277,7 @@ def _add_design(sub, controllers: str) -> None:
                         "loop settles slowly; a sea: its repeat period, max(600 s, 20 Tp))")
     p.add_argument("--dt", type=float, default=None,
                    help="time step, s (default: period / 1000, or Tp / 1000)")
-    p.add_argument("--robust", action="store_true",
-                   help="reactive: tune within the robustness floors (gain margin 2, phase "
-                        "margin 30 deg at the least: min |1 + L| >= 0.52)")
+    add_design_flags(p)          # --aggressive (--robust), --bode, --nyquist
     p.add_argument("--unconstrained", action="store_true",
                    help="tune without the PTO's force and stroke limits (e.g. complex-conjugate\n"
                         "control) and with no controller saturation; the limits are still\n"
@@ -340,6 +338,7 @@ def _add_linearize(sub) -> None:
     p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE",
                    help="plant parameter override, repeatable; e.g. hinge_friction__coulomb=0\n"
                         "(a smoothed Coulomb friction linearises to its slope at rest)")
+    add_linearize_flags(p)       # --no-pto-law
     p.add_argument("--json", action="store_true", help="print signals and poles as JSON")
     p.set_defaults(run=run_linearize)
 

@@ -10,27 +10,92 @@ from .commands import _plant, _wave
 from .messages import invalid_lines
 
 
+def add_design_flags(p) -> None:
+    """design's flags of the margins and the loop's figures."""
+    p.add_argument("--aggressive", action="store_true",
+                   help="reactive: the unconstrained optimum, near the stability edge (by\n"
+                        "default a law is tuned within the margins design.gain_margin_min and\n"
+                        "design.phase_margin_min_deg of `mbcontrol defaults`: 2 and 30 deg)")
+    p.add_argument("--robust", action="store_true",
+                   help="accepted for old scripts: tuning within the margins is the default")
+    p.add_argument("--bode", metavar="FILE.png",
+                   help="write the designed linear law's loop L(i omega), gain and phase\n"
+                        "margins marked (python-control's conventions)")
+    p.add_argument("--nyquist", metavar="FILE.png",
+                   help="write the designed linear law's Nyquist plot, margins marked")
+
+
+def design_wave(args, plant, what: str = "design"):
+    """(wave, repeat s): the wave `design` tunes for, and `export` too, so that both tune the
+    same law: a sea's components spaced 2 pi / repeat with repeat = --duration or 600 s (the
+    spacing moves a sea's tuned law: sphere, Hs 2 m, Tp 8 s, 600 s against 200 s: damping
+    243 against 224 kN s/m), a record over --duration (None: its own length)."""
+    if args.wave == "none":
+        raise InputError(f"{what} needs a wave to tune for: --wave regular|jonswap|pm")
+    repeat = args.duration or 600.0          # a sea's repeat period, s (its components' spacing)
+    return _wave(args, plant, args.duration if args.wave == "elevation" else repeat), repeat
+
+
 def run_design(args) -> int:
     from mbcontrol.studies.design import design
     plant = _plant(args)
-    if args.wave == "none":
-        raise InputError("design needs a wave: --wave regular|jonswap|pm")
-    repeat = args.duration or 600.0          # a sea's repeat period, s (its components' spacing)
-    wave = _wave(args, plant, args.duration if args.wave == "elevation" else repeat)
+    wave, repeat = design_wave(args, plant)
     result = design(plant, wave, args.controller, pto=args.pto, simulate_s=args.duration,
                     dt=args.dt, bounds={"auto": True, "full": "full", "off": False}[args.bounds],
-                    limits=not args.unconstrained, robust=args.robust)
+                    limits=not args.unconstrained, robust=not args.aggressive)
     command = _simulate_command(args, result, repeat)
+    figures = _loop_figures(args, result)
     if args.json:
         print(json.dumps({**result.to_dict(), "model": plant.name, "wave": wave.describe(),
-                          "simulate_command": command}, indent=2, allow_nan=False))
+                          "simulate_command": command, "figures": figures}, indent=2,
+                         allow_nan=False))
     else:
         _print_design(plant, wave, result, command)
+        for kind, path in figures.items():
+            print(f"{kind} plot of the loop written to {path}")
     checked = [] if result.simulation is None else \
         result.simulation["summary"].get("validity_warnings", [])
     for note in dict.fromkeys([*result.warnings, *checked]):   # as `simulate` warns, once
         print(f"mbcontrol: warning: {note}", file=sys.stderr)
     return 0
+
+
+def _loop_figures(args, result) -> dict:
+    """--bode / --nyquist: the designed linear law's loop with its margins marked
+    (controllers.loop_plots); {"bode": path, "nyquist": path} of those written."""
+    wanted = {k: getattr(args, k, None) for k in ("bode", "nyquist")}
+    wanted = {k: v for k, v in wanted.items() if v}
+    if not wanted:
+        return {}
+    if result.margins is None or result.margins.loop is None:
+        raise InputError(f"--{'/--'.join(wanted)}: {result.name} is not a linear law (passive "
+                         f"or reactive), so it has no loop transfer to plot")
+    from mbcontrol.controllers import loop_bode, loop_nyquist
+    draw = {"bode": loop_bode, "nyquist": loop_nyquist}
+    for kind, path in wanted.items():
+        draw[kind](result.margins, path=path)
+    return wanted
+
+
+def _robustness_line(result) -> str:
+    """How the law stands against the floors, and how it was tuned."""
+    r = result.tuner["robustness"]
+    f = r["floors"]
+    how = ""
+    if result.name == "reactive":
+        how = (" tuned within them (--aggressive: the unconstrained optimum);"
+               if result.tuner.get("robust") else " the unconstrained optimum (--aggressive);")
+        cost = result.tuner.get("margins_cost") or {}
+        if cost.get("share") is not None:
+            how += (f" they cost {100 * cost['share']:.3g} % of the unconstrained optimum's "
+                    f"{cost['aggressive_predicted_W'] / 1e3:.4g} kW predicted;")
+    signed = r.get("phase_margin_signed_deg")
+    pc = "" if signed is None else f", python-control's signed phase margin {signed:+.3g} deg"
+    gm = "inf" if r["gain_margin"] is None else f"{r['gain_margin']:.3g}"
+    pm = "inf" if r["phase_margin_deg"] is None else f"{r['phase_margin_deg']:.3g} deg"
+    return (f"  robustness (floors: gain margin {f['gain_margin']:g}, phase margin "
+            f"{f['phase_margin_deg']:g} deg; `mbcontrol defaults` design.*):{how} gain margin "
+            f"{gm}, phase margin {pm}{pc}: {r['why']}")
 
 
 def _unbounded(result) -> bool:
@@ -112,9 +177,7 @@ def _print_design(plant, wave, result, command) -> None:
     if result.margins is not None:
         print(f"  stability: {result.margins.message}")
     if "robustness" in result.tuner:
-        print(f"  robustness (floors: gain margin {result.tuner['robustness']['floors']['gain_margin']:g}, "
-              f"phase margin {result.tuner['robustness']['floors']['phase_margin_deg']:g} deg): "
-              f"{result.tuner['robustness']['why']}")
+        print(_robustness_line(result))
     if "share" in result.tuner:
         print(f"  why this share: {result.tuner['share']['why']}")
     b = result.bound

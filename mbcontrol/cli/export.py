@@ -14,8 +14,13 @@ from .commands import _plant, _wave
 
 EXPORT_HELP = """Export a PTO controller as C and as FMI 2.0 co-simulation FMUs, with its plant.
 
-The controller is designed for the wave as `mbcontrol design` tunes it (no --set), or built
-from --set KEY=VALUE settings as `mbcontrol simulate` takes them. Written to --out DIR:
+The controller is designed for the wave as `mbcontrol design` tunes it (no --set: the same
+tuner and the same sea, so the same numbers; a sea's components spaced by --duration or
+600 s as design spaces them), or built from --set KEY=VALUE settings as `mbcontrol simulate`
+takes them. Safe by default: a reactive law is tuned within the least gain and phase margins
+of `mbcontrol defaults` (design.gain_margin_min, design.phase_margin_min_deg), and a linear
+law below them, designed or --set, is refused; --aggressive exports the unconstrained optimum
+(or the --set law) anyway and flags it (text and --json "robustness"). Written to --out DIR:
   DIR/c/                       self-contained C: mbc_controller.h (the documented API:
                                init(ctx, params), step(ctx, measurements, t, force), reset),
                                the generated and hand-written sources, a Makefile, the
@@ -45,6 +50,10 @@ def add_parser(sub, model_options, wave_options) -> None:
                    help="passive, reactive, latching, declutching or mpc")
     p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                    help="controller setting, repeatable; given: no tuning (e.g. --set damping=2e5)")
+    p.add_argument("--aggressive", action="store_true",
+                   help="reactive: export the unconstrained optimum, and any linear law below\n"
+                        "the margins (design.gain_margin_min, design.phase_margin_min_deg),\n"
+                        "flagged rather than refused")
     p.add_argument("--out", required=True, metavar="DIR", help="folder for the C sources and FMUs")
     p.add_argument("--duration", type=float, default=None,
                    help="closed-loop check, s (default: 20 periods, or 200 s in a sea)")
@@ -58,10 +67,14 @@ def add_parser(sub, model_options, wave_options) -> None:
 
 
 def _controller(args, plant, wave):
+    """(controller, origin): designed as `design` designs it (studies.design.tune on
+    cli.design.design_wave's sea, within the margins unless --aggressive), or from --set.
+    wave: the closed-loop check's (a sea: tuned on the design's own spacing instead)."""
     from mbcontrol.controllers import REGISTRY, make
     from mbcontrol.studies.design import tune
 
     from .commands import _controller as from_settings
+    from .design import design_wave
     if args.controller not in REGISTRY:
         raise InputError(f"export: unknown controller {args.controller!r}; expected one of "
                          f"{', '.join(REGISTRY)}")
@@ -78,8 +91,39 @@ def _controller(args, plant, wave):
         return from_settings(args, wave), "--set"
     pto = plant.scene.ptos[0]
     notes: list[str] = []
-    parameters, _, _, extra = tune(plant, wave, args.controller, pto, True, None, notes)
+    tuned_for = wave if args.wave == "regular" else design_wave(args, plant, "export")[0]
+    parameters, _, _, extra = tune(plant, tuned_for, args.controller, pto, True, None, notes,
+                                   robust=not getattr(args, "aggressive", False))
+    if "wave" in extra:              # a predictive controller previews the check's wave
+        extra["wave"] = wave
     return make(args.controller, **parameters, **extra, **extra_settings), "designed"
+
+
+def _robustness(args, plant, controller, origin: str) -> dict | None:
+    """A linear law's margins on every PTO against the floors (controllers.robustness):
+    {pto: robustness dict}, None for other laws. InputError below the floors unless
+    --aggressive (then flagged on stderr)."""
+    if controller.name not in ("passive", "reactive"):
+        return None
+    from mbcontrol.controllers import loop_margins, loop_robustness, pto_gains
+    gains = pto_gains(plant, controller)
+    out = {}
+    for pto in gains:
+        others = {n: g for n, g in gains.items() if n != pto} or None
+        out[pto] = loop_robustness(loop_margins(plant, controller, pto=pto, others=others))
+    short = {p: r for p, r in out.items() if not r["meets"]}
+    if short:
+        f = next(iter(short.values()))["floors"]
+        why = "; ".join(f"PTO {p!r}: {r['why']}" for p, r in short.items())
+        if not getattr(args, "aggressive", False):
+            raise InputError(f"export: the {origin} {controller.name} law is below the "
+                             f"robustness floors (gain margin {f['gain_margin']:g}, phase "
+                             f"margin {f['phase_margin_deg']:g} deg; `mbcontrol defaults` "
+                             f"design.gain_margin_min, design.phase_margin_min_deg): {why}. "
+                             f"Export it anyway with --aggressive, or give a law within them")
+        print(f"mbcontrol: warning: exported with --aggressive, below the robustness floors: "
+              f"{why}", file=sys.stderr)
+    return out
 
 
 def run_export(args) -> int:
@@ -94,6 +138,7 @@ def run_export(args) -> int:
     duration = args.duration or (20 * period_hint if args.wave == "regular" else 200.0)
     wave = _wave(args, plant, duration)
     controller, origin = _controller(args, plant, wave)
+    robustness = _robustness(args, plant, controller, origin)
     dt = args.dt or _step(float(wave.period) / 200, period_of(controller))
     out = Path(args.out)
     exported = export_controller(controller, plant, out, model=plant.name,
@@ -105,7 +150,10 @@ def run_export(args) -> int:
               "inputs": exported.spec.inputs, "outputs": exported.spec.outputs,
               "fmus": {"controller": str(exported.fmu), "plant": str(plant_fmu)},
               "c_library": str(exported.library), "c_sources": str(exported.c_folder),
-              "footprint": footprint(exported)}
+              "footprint": footprint(exported), "robustness": robustness,
+              "aggressive": bool(args.aggressive),
+              "below_floors": bool(robustness) and not all(r["meets"]
+                                                           for r in robustness.values())}
     if not args.no_check:
         checked = closed_loop_check(plant, wave, controller, exported, duration=duration,
                                     dt=dt, plant_fmu=plant_fmu)
@@ -132,6 +180,13 @@ def _print(r: dict) -> None:
     print(f"  reads {', '.join(r['inputs'])}; writes {', '.join(r['outputs'])}")
     print(f"  C library  {r['c_library']}  (context {r['footprint']['context_bytes']} bytes)")
     print(f"  FMUs       {r['fmus']['controller']}\n             {r['fmus']['plant']}")
+    for pto, rob in (r.get("robustness") or {}).items():
+        gm = "inf" if rob["gain_margin"] is None else f"{rob['gain_margin']:.3g}"
+        pm = "inf" if rob["phase_margin_deg"] is None else f"{rob['phase_margin_deg']:.3g} deg"
+        print(f"  margins of PTO {pto!r}: gain {gm}, phase {pm} (floors "
+              f"{rob['floors']['gain_margin']:g}, {rob['floors']['phase_margin_deg']:g} deg): "
+              + ("meets both" if rob["meets"] else "BELOW THE FLOORS (--aggressive): "
+                 + rob["why"]))
     check = r.get("closed_loop_check")
     if check:
         print(f"  closed loop, {check['duration_s']:g} s at dt {check['dt_s']:g} s: C against "

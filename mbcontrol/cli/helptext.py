@@ -28,6 +28,12 @@ constrained power bounds, and the metrics of a closed-loop simulation on the non
 with the share of each bound it reaches. It ends with the `mbcontrol simulate` command line
 that re-runs that simulation (the parameters as --set KEY=VALUE).
 
+Safe by default: a reactive law is tuned within the least gain and phase margins of
+`mbcontrol defaults` (design.gain_margin_min 2, design.phase_margin_min_deg 30 deg);
+--aggressive asks for the unconstrained optimum (e.g. complex-conjugate control, near the
+stability edge), flagged when below them. --bode FILE and --nyquist FILE draw the designed
+linear law's loop L(s) with its margins marked (python-control's stability_margins).
+
 On a scene with nonlinear hydrostatics and Froude-Krylov forces, a passive or reactive law is
 also tuned with the linear model's envelope lifted (the PTO's limits kept) and simulated on
 that plant: how far past the linear range it goes and the power it gains or loses against
@@ -111,7 +117,9 @@ The --json summary is a contract: {"model", "cases", "computed", "reused", "wall
 range and ran on the nonlinear plant) and "linear_mean_power_W" (those linear runs' mean,
 INVALID, for comparison; null where none), and with
 --design per sea "settings" (the tuned values), "predicted_power_W", "bound_W",
-"percent_of_bound", "inside_envelope" and "meets_robustness_floors", and with a PTO
+"percent_of_bound", "inside_envelope", "meets_robustness_floors", "fell_back" and
+"fallback" (the law that ran), and "fell_back_seas", "fell_back" [{"hs", "tp", "to"}] and
+"zero_seas" [{"hs", "tp", "weight", "kind", "why"}] in the summary, and with a PTO
 rated_power "rated_power_W" (the weighted figures then cap each sea's power at it), and with
 --seeds N >= 2 per sea "valid_seeds", "mean_power_stderr_W" and "mean_power_ci95_W" [lo,
 hi] (Student's t over the valid seeds) with "power_std_W", "power_min_W", "power_max_W"
@@ -123,9 +131,12 @@ standard deviation over records / mean, from the frequency-domain solution), "ba
 spreading-weighted sum over directions), per sea "direction_deg", "spread_deg" and
 "spreading" when given, and for a weighted list "annual_energy_ci95_MWh" [lo, hi] and
 "annual_energy_budget": {"components": [{"component" (statistical, model, radiation_fit,
-parameters, resource), "type" (A or B), "over_seas" (quadrature, linear, one term),
+linear_vs_nonlinear, parameters, scene_parameters, resource), "type" (A or B), "over_seas" (quadrature, linear, one term),
 "std_MWh" (null when absent), "dof", "source", "absent" (why not, or null),
 "share_of_variance"}], "combined_std_MWh", "effective_dof", "coverage_factor", "method"},
+and where a PTO converts (a drivetrain, an efficiency below 1)
+"annual_electrical_energy_MWh", "annual_electrical_energy_ci95_MWh" and
+"annual_electrical_energy_budget" (the same form),
 and with --identified per sea "model_std_W" and "parameter_std_W"}
 (per sea, means over the valid seeds; lists over the varied values when --vary
 is given; weighted figures only for a weighted --seas file; a sea with no valid case counts
@@ -162,9 +173,13 @@ latching, declutching: their simulated tuners; mpc: a horizon of one peak period
 no setting stays inside is flagged (inside_envelope false; the closest setting runs). bound_W
 is the most any PTO force could absorb in that sea inside the same envelope (linear theory,
 mbcontrol.analysis.envelope), so percent_of_bound says how much a law leaves. --set values
-override the tuned ones. --robust keeps a reactive law within the robustness floors (gain
-margin 2, phase margin 30 deg at the least; otherwise laws below them are only flagged,
-meets_robustness_floors). Without --design, a damped law named with no settings absorbs
+override the tuned ones. A reactive law is tuned within the robustness floors as `design`
+tunes it (gain margin 2, phase margin 30 deg at the least: design.gain_margin_min,
+design.phase_margin_min_deg); --aggressive tunes the unconstrained optimum, whose laws below
+the floors are flagged (meets_robustness_floors). A sea where the tuned law cannot hold the
+PTO's limits or the envelope falls back to a detuned or force-saturated damper and says so
+(fell_back, fallback per sea; fell_back_seas in the summary); a sea no law serves is kept
+with its reason (zero_seas) and counts as zero. Without --design, a damped law named with no settings absorbs
 nothing, and says so on stderr.
 
 Examples:

@@ -1,5 +1,5 @@
 """`mbcontrol linearize`: the exact linear model about rest, its poles, the PTO laws it
-includes, and its Bode plot."""
+includes (--no-pto-law: none, the open loop a PTO controller faces), and its Bode plot."""
 from __future__ import annotations
 
 import json
@@ -9,10 +9,20 @@ import numpy as np
 from .commands import _key_value, _plant
 
 
+def add_linearize_flags(p) -> None:
+    p.add_argument("--no-pto-law", action="store_true",
+                   help="zero every PTO's scene damping and stiffness: the open loop a PTO\n"
+                        "controller faces (as design's margins see it); --param still sets them")
+
+
 def run_linearize(args) -> int:
     from ..analysis import linearize
     plant = _plant(args)
     params = dict(_key_value(s, "--param") for s in args.param)
+    if getattr(args, "no_pto_law", False):      # the scene's laws off, --param's kept
+        params = {**{f"{p.name}__{k}": 0.0 for p in plant.scene.ptos
+                     for k in ("damping", "stiffness")
+                     if f"{p.name}__{k}" in plant.parameters}, **params}
     sys_ = linearize(plant, params=params or None)
     poles = np.linalg.eigvals(np.asarray(sys_.A))
     pairs = [tuple(p.split(":", 1)) for p in args.pair] or [
@@ -26,18 +36,22 @@ def run_linearize(args) -> int:
             "inputs": sys_.input_labels, "outputs": sys_.output_labels,
             "poles": [[float(p.real), float(p.imag)] for p in poles],
             "stable": bool(np.all(poles.real < 0)), "bode": args.bode,
-            "pto_laws": _pto_laws(plant, params)}
+            "pto_laws": _pto_laws(plant, params),
+            "pto_laws_dropped": bool(getattr(args, "no_pto_law", False))}
     if args.json:
         print(json.dumps(info, indent=2))
     else:
         print(f"{plant.name}: {sys_.nstates} states, {sys_.ninputs} inputs, {sys_.noutputs} "
               f"outputs; {'stable' if info['stable'] else 'NOT stable'} (max pole real part "
               f"{poles.real.max():.3g})")
+        if info["pto_laws_dropped"]:
+            print("  the scene's PTO laws are left out (--no-pto-law)"
+                  + ("; --param sets some" if args.param else ""))
         for pto, law in info["pto_laws"].items():
             if any(law.values()):
                 print(f"  includes PTO '{pto}' as the scene sets it: " + ", ".join(
-                    f"{k} {v:g}" for k, v in law.items()) + f" (SI); --param {pto}__damping=0 "
-                    f"(and __stiffness=0) leaves it out")
+                    f"{k} {v:g}" for k, v in law.items()) + " (SI); --no-pto-law leaves the "
+                    "scene's laws out")
         if args.bode:
             print(f"Bode plot written to {args.bode}")
     return 0

@@ -42,8 +42,8 @@ def refusal(exc: BaseException) -> tuple[int | None, str]:
     anything else, a bug, which keeps its traceback."""
     if isinstance(exc, (EnvironmentProblem, EntrySetAside)):
         return ENVIRONMENT, str(exc)
-    if isinstance(exc, MbcontrolError):
-        return BAD_INPUT, str(exc)
+    if isinstance(exc, MbcontrolError):   # an error may say it is a result (a sea no law serves)
+        return getattr(exc, "exit_status", BAD_INPUT), str(exc)
     if not isinstance(exc, OSError) or exc.errno not in ENVIRONMENT_ERRNOS:
         return None, ""
     if exc.filename:

@@ -41,9 +41,11 @@ def add_parser(sub) -> None:
     p.add_argument("--design", action="store_true",
                    help="tune the controller for each sea as `design` does (settings and "
                         "bound_W per sea in the JSON)")
-    p.add_argument("--robust", action="store_true",
-                   help="with --design: a reactive law within the robustness floors (gain "
-                        "margin 2, phase margin 30 deg at the least)")
+    p.add_argument("--aggressive", action="store_true",
+                   help="with --design: each sea's unconstrained optimum; by default a reactive\n"
+                        "law is tuned within the robustness floors, as `design` tunes it\n"
+                        "(design.gain_margin_min, design.phase_margin_min_deg)")
+    p.add_argument("--robust", action="store_true", help=argparse.SUPPRESS)   # the default now
     p.add_argument("--spread", type=float, metavar="DEG",
                    help="short-crested seas: every sea's directional spread sigma, degrees\n"
                         "(0 long-crested, below 81; overrides a --seas file's spread column)")
@@ -63,6 +65,11 @@ def add_parser(sub) -> None:
                    help="an identification of this model (`identify --json` or its\n"
                         "summary.json): its parameter values are run, and its model error\n"
                         "and covariance enter the annual energy's budget")
+    p.add_argument("--resource", nargs="+", metavar="NDBC",
+                   help="buoy records (NOAA NDBC spectral density files, text or .gz) for the\n"
+                        "budget's resource term: each hour to the nearest --seas sea; one file\n"
+                        "per year (the years' spread), or one year: monthly blocks (an upper\n"
+                        "estimate: months taken as exchangeable)")
     p.add_argument("--duration", type=float,
                    help=f"simulated time per case, s ({default_help('sweep.duration')})")
     p.add_argument("--dt", type=float, help=f"time step, s ({default_help('sweep.dt')})")
@@ -132,6 +139,9 @@ def run_sweep(args) -> int:
     seas = _seas(args)
     if args.set and not args.controller:
         raise InputError("--set needs --controller")
+    if args.aggressive and not args.design:
+        raise InputError("--aggressive asks the tuner for each sea's unconstrained optimum: it "
+                         "goes with --design")
     cls = REGISTRY.get(args.controller) if args.controller else None
     settings = parse_settings(args.set, inspect.signature(cls).parameters if cls else {})
     vary = _vary(args.vary)
@@ -157,10 +167,9 @@ def run_sweep(args) -> int:
         ds, summary = farm_sweep(args.model, seas, scene_params=scene_params,
                                  isolated=dict(_key_value(s, "--isolated") for s in args.isolated), **common)
     else:
-        from ..waves import read_year_weights
-        years = read_year_weights(args.seas) if args.seas else None
+        years = _years(args, seas)
         ds, summary = sweep(args.model, seas, scene_params=scene_params, design=args.design,
-                            robust=args.robust, identified=args.identified, years=years,
+                            robust=not args.aggressive, identified=args.identified, years=years,
                             nonlinear=args.nonlinear, records=args.records, **common)
     if args.plot:
         from ..studies.sweep import plot_sweep
@@ -201,6 +210,22 @@ def _seas(args) -> list:
             raise InputError("--tp goes with --hs; a --seas file gives its own periods")
         seas = read_seas(args.seas, args.gamma)
     return spread_seas(seas, args.spread, args.spreading)
+
+
+def _years(args, seas):
+    """The budget's resource blocks: a site file's weights_<year> columns, or --resource."""
+    from ..waves import read_year_weights
+    years = read_year_weights(args.seas) if args.seas else None
+    if args.resource:
+        if not args.seas:
+            raise InputError("--resource needs --seas (a weighted site whose seas the buoy's "
+                             "hours are assigned to)")
+        if years:
+            raise InputError(f"--resource with {args.seas}'s weights_<year> columns: give one "
+                             f"source of year-to-year variability")
+        from ..studies.sweep import ndbc_resource
+        return ndbc_resource(args.resource, seas)
+    return years
 
 
 def _vary(items: list[str]) -> dict:
@@ -295,6 +320,14 @@ def _print_summary(summary: dict, store) -> None:
         print(f"  annual energy 95 % interval [{lo:.4g}, {hi:.4g}] MWh; its budget:")
         print("\n".join("    " + line for line in budget_table(summary["annual_energy_budget"])
                         .splitlines()))
+    if summary.get("annual_electrical_energy_ci95_MWh"):
+        from ..studies.sweep import budget_table
+        lo, hi = summary["annual_electrical_energy_ci95_MWh"]
+        print(f"  electrical annual energy {summary['annual_electrical_energy_MWh']:.4g} MWh "
+              f"(absorbed {summary['annual_energy_MWh']:.4g} MWh), 95 % interval "
+              f"[{lo:.4g}, {hi:.4g}] MWh; its budget:")
+        print("\n".join("    " + line for line in
+                        budget_table(summary["annual_electrical_energy_budget"]).splitlines()))
     if farm and farm["q_annual"] is not None:
         print(f"  farm of {farm['devices']} devices: annual energy {summary['annual_energy_MWh']:.4g} MWh "
               f"against {farm['annual_energy_isolated_MWh']:.4g} MWh for as many devices alone: "

@@ -46,7 +46,7 @@ from .mesh.axisymmetric import AxisymmetricFK
 from .mesh.axisymmetric import from_geometry as axisymmetric_fk
 from .model import FITS_SERVED, obstacle_bodies, shipped_fits_dir
 from .fit.plots import hydro_figure
-from .source import converted_source
+from .source import converted_source, with_displaced_masses
 
 __all__ = [
     "read_netcdf", "write_netcdf_atomic",
@@ -61,5 +61,5 @@ __all__ = [
     "buoyancy_potential", "Panels", "body_panels", "hydrostatic_pressure", "pressure_wrench",
     "pressure_wrench_function", "calm_water_function",
     "AxisymmetricFK", "axisymmetric_fk",
-    "FITS_SERVED", "obstacle_bodies", "shipped_fits_dir", "converted_source", "hydro_figure",
+    "FITS_SERVED", "obstacle_bodies", "shipped_fits_dir", "converted_source", "with_displaced_masses", "hydro_figure",
 ]

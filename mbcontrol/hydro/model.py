@@ -26,6 +26,7 @@ from .data.headings import axisymmetric_headings, excitation_over_headings, head
 from .bem.isolated import compute_isolated
 from .bem.neighbours import compute_within
 from .fit.radiation import RadiationModel, coupled_groups
+from .fit.band import default_fit_band
 from .fit.response_error import Device
 from .fit.store import FITS_SERVED, cached_fit, fit_band_limit, model_from_arrays, shipped_fits_dir  # noqa: F401 (the model's face)
 from .fit.ssforms import modal_blocks
@@ -173,9 +174,11 @@ def load_hydro_model(scene: Scene, dofs, tol: float | None = None, device=None) 
     judges the fit (mbcontrol.plant.device_around), or None to judge the kernel itself."""
     tol = scene.hydro.radiation_tol if tol is None else tol
     source, data = load_hydro_data(scene, dofs)
-    return fit_hydro_model(data, dofs, tol, source, scene.hydro.fit_omega_max, scene.hydro.response_band,
-                           fit_method(scene.hydro.radiation_fit, dofs, data),
-                           device(source, data) if device is not None else None)
+    judge, band = device(source, data) if device is not None else None, scene.hydro.fit_omega_max
+    if judge is not None and not np.isfinite(band) and "converted_from" in data.attrs:
+        band = default_fit_band(scene.name, judge, data, dofs)   # a user's own BEM file
+    return fit_hydro_model(data, dofs, tol, source, band, scene.hydro.response_band,
+                           fit_method(scene.hydro.radiation_fit, dofs, data), judge)
 
 
 ARRAY_BODIES = 9   # "auto" fits column by column from this many bodies (module array_fit)
@@ -212,7 +215,7 @@ def load_hydro_data(scene: Scene, dofs) -> tuple[str, xr.Dataset]:
             status(f"{scene.name}: [hydro] source {Path(h.source).name} is used; [hydro] omega "
                    f"(BEM frequencies for Capytaine) is not (remove one of them)", __name__)
         # its cache entry, if unreadable, is set aside by read_netcdf: converted again, once
-        source, data = rebuilt_once(lambda: converted_source(scene))
+        source, data = rebuilt_once(lambda: converted_source(scene, dofs))
     elif h.file and not h.omega:
         raise HydroError(_missing_file(scene))
     else:

@@ -16,7 +16,7 @@ import casadi as ca
 import numpy as np
 
 from ..errors import UnknownName
-from ..hydro import Device, HydroModel, RadiationModel, load_hydro_model
+from ..hydro import Device, HydroModel, RadiationModel, load_hydro_model, with_displaced_masses
 from ..multibody import Topology, build_topology
 from ..scene import DOF_NAMES, Scene, load_scene
 from . import checks, loads, nonlinear
@@ -140,13 +140,11 @@ def assemble_plant(scene: Scene | str, hydro: HydroModel | None = None, *,
     radiation passive, and the excitation force on d; for identification. Users call
     `mbcontrol.plant.build_plant`, which also builds simplified models.
     """
-    scene = load_scene(scene) if not isinstance(scene, Scene) else scene
-    topo = build_topology(scene)
+    scene, topo, hydro_dofs = _resolved(load_scene(scene) if not isinstance(scene, Scene) else scene)
     tree = topo.tree
     q, s = ca.SX.sym("q", tree.n_q), ca.SX.sym("s", tree.n_s)
     u = ca.SX.sym("u", len(scene.ptos))
 
-    hydro_dofs = active_hydro_dofs(scene, topo)
     if hydro is None and hydro_dofs:
         judged = scene.hydro.fit_judged_by == "response"
         hydro = load_hydro_model(scene, hydro_dofs, tol=radiation_tol, device=(
@@ -291,6 +289,16 @@ def _hydro_scales(params, dofs) -> dict:
         roots = values if kind == "excitation" else [ca.sqrt(v) for v in values]
         out[kind] = ca.diag(ca.vertcat(*roots))
     return out
+
+
+def _resolved(scene: Scene):
+    """(scene, its topology, its hydro DOFs), each mass = "displaced" body without geometry given
+    rho x its BEM body's displaced volume (mbcontrol.hydro.with_displaced_masses); the joints'
+    kinematics, hence the DOFs, do not depend on the masses."""
+    topo = build_topology(scene)
+    hydro_dofs = active_hydro_dofs(scene, topo)
+    resolved = with_displaced_masses(scene, hydro_dofs)
+    return (scene, topo, hydro_dofs) if resolved is scene else (resolved, build_topology(resolved), hydro_dofs)
 
 
 def active_hydro_dofs(scene: Scene, topo: Topology) -> list[str]:

@@ -15,7 +15,8 @@ _CACHE: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 def provenance(plant) -> dict:
     """{"version": the package's, "scene_sha256": the scene's content with its resolved
     parameters and the files it names (`Scene.digest`), "hydro_sha256": the BEM data the
-    plant uses, "radiation_sha256": its fitted radiation model}; computed once per plant."""
+    plant uses, "radiation_sha256": its fitted radiation model, and "masses": {body: how} for
+    masses taken from the BEM data (mass = "displaced" without geometry)}; computed once per plant."""
     if plant not in _CACHE:
         hydro = plant.hydro
         _CACHE[plant] = {
@@ -26,6 +27,9 @@ def provenance(plant) -> dict:
                                                hydro.radiation.C, hydro.radiation.D)
             if hydro is not None else None,
         }
+        masses = {b.name: f"{b.mass:.8g} kg, {b.mass_from}" for b in plant.scene.bodies if b.mass_from}
+        if masses:      # mass = "displaced": taken from the BEM data when they were read
+            _CACHE[plant]["masses"] = masses
     return dict(_CACHE[plant])
 
 

@@ -25,6 +25,8 @@ from ..errors import InputError
 
 DOF_NAMES = ("Surge", "Sway", "Heave", "Roll", "Pitch", "Yaw")
 JOINT_TYPES = ("revolute", "prismatic", "fixed", "free")
+# Body.mass_from of a mass = "displaced" body without geometry until its BEM data are read
+DISPLACED_PENDING = "displaced: rho x the displaced volume of its BEM body, when the data are read"
 
 
 @dataclass(frozen=True)
@@ -56,6 +58,9 @@ class Body:
     cog: tuple[float, float, float]                        # m, n-frame at rest
     geometry: Geometry | None = None
     hydro: bool = True                                     # False: no hydrodynamic loads
+    mass_from: str = ""    # "": given; DISPLACED_PENDING: rho x the BEM file's displaced volume,
+                           # set when the data are read (mbcontrol.hydro.with_displaced_masses),
+                           # which says here how (volume, rho, file, BEM body)
 
 
 @dataclass(frozen=True)
@@ -324,6 +329,9 @@ class Scene:
                     mooring.pop(key)
         if not data["obstacles"]:       # digests of scenes without obstacles stay as they were
             data.pop("obstacles")
+        for body in data["bodies"]:       # digests of scenes with given masses stay as they were
+            if not body["mass_from"]:
+                body.pop("mass_from")
         for body in list(data["bodies"]) + list(data.get("obstacles", ())):
             if body["geometry"] and body["geometry"]["file"]:
                 body["geometry"]["file"] = _file_digest(body["geometry"]["file"])

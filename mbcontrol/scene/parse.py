@@ -9,12 +9,14 @@ import numpy as np
 from .. import defaults
 from ..errors import SceneError
 from .checks import Reader, catenary_geometry, check_topology
-from .model import (DOF_NAMES, JOINT_TYPES, Body, Drag, Drivetrain, EndStop, Friction, Geometry,
-                    HydroSettings, Joint, Mooring, Obstacle, Pto, Scene, Water)
+from .frames import FRAMES, to_ned
+from .model import (DISPLACED_PENDING, DOF_NAMES, JOINT_TYPES, Body, Drag, Drivetrain, EndStop,
+                    Friction, Geometry, HydroSettings, Joint, Mooring, Obstacle, Pto, Scene, Water)
 from .moordyn_file import read_moordyn
 from .names import name_from_stem
 from .shapes import displaced_mass, read_profile
 from .template import expand
+from .uncertainty import check_uncertainty
 from .units import JOINT_DIMENSIONS
 
 
@@ -27,11 +29,14 @@ def parse_scene(data: dict, path: Path, parameters: dict | None = None) -> Scene
         raise SceneError(f"{path}: top level: expected a table of scene keys, got "
                          f"{type(data).__name__}")
     data, used = expand(data, str(path), parameters)
+    data = to_ned(data, path)        # frame = "z-up": converted before any field is read
     top = Reader(data, str(path), "")
     top.allow("name", "description", "water", "body", "joint", "pto", "friction", "mooring",
-              "drag", "end_stop", "hydro", "identify", "obstacle")
+              "drag", "end_stop", "hydro", "identify", "obstacle", "uncertainty", "frame")
+    top.choice("frame", FRAMES, default="ned")
     water = _water(top.table("water", required=False))
-    bodies = tuple(_body(r, path, water) for r in top.tables("body", required=True))
+    hydro_data = any(k in (data.get("hydro") or {}) for k in ("source", "file"))  # BEM data given
+    bodies = tuple(_body(r, path, water, hydro_data) for r in top.tables("body", required=True))
     joints = tuple(_joint(r) for r in top.tables("joint", required=True))
     kinds = {j.name: j.type for j in joints}
     hydro = _hydro(top.table("hydro", required=False), path)
@@ -51,7 +56,7 @@ def parse_scene(data: dict, path: Path, parameters: dict | None = None) -> Scene
         identify=_identify(top.table("identify", required=False)),
         obstacles=obstacles,
     )
-    return check_topology(scene, top)
+    return check_uncertainty(top.tables("uncertainty"), check_topology(scene, top))
 
 
 def _scene_name(top, path: Path) -> str:
@@ -68,13 +73,14 @@ def _water(r: Reader) -> Water:
                  depth=r.positive("depth", "length", default=math.inf, finite=False))
 
 
-def _body(r: Reader, path: Path, water: Water) -> Body:
+def _body(r: Reader, path: Path, water: Water, hydro_data: bool = False) -> Body:
     r.allow("name", "mass", "inertia", "cog", "geometry", "hydro")
     name = r.name()
     geometry = _geometry(r.table("geometry", required=False), path, f"body '{name}'")
-    return Body(name=name, mass=displaced_mass(r, geometry, water.rho),
-                inertia=r.inertia("inertia"), cog=r.vector("cog", "length"),
-                geometry=geometry, hydro=r.boolean("hydro", default=True))
+    mass = displaced_mass(r, geometry, water.rho, hydro_data)   # NaN: from the BEM data, later
+    return Body(name=name, mass=mass, inertia=r.inertia("inertia"), cog=r.vector("cog", "length"),
+                geometry=geometry, hydro=r.boolean("hydro", default=True),
+                mass_from=DISPLACED_PENDING if math.isnan(mass) else "")
 
 
 def _geometry(r: Reader, path: Path, owner: str) -> Geometry | None:

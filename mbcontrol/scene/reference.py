@@ -18,6 +18,8 @@ from pathlib import Path
 
 from ..errors import InputError
 from .checks import Reader
+from .frames import MEANING as _FRAME
+from .uncertainty import REFERENCE as _UNCERTAINTY
 from .units import SI_UNIT
 
 # the sections in the order a scene file is usually written, with what each is
@@ -44,7 +46,7 @@ SECTIONS = {
     "hydro.omega": "`[hydro.omega]` (or a list of such tables): a frequency segment",
     "hydro.source_options": "`[hydro.source_options]`: cleaning third-party BEM data",
     "identify": "`[identify]`: the parameters `mbcontrol identify` fits by default",
-}
+    **_UNCERTAINTY["sections"]}
 
 MEANING = {
     ("", "name"): "the model's name (default: the file's name)",
@@ -64,8 +66,7 @@ MEANING = {
     ("water", "g"): "gravity",
     ("water", "depth"): "water depth (`inf`: deep water)",
     ("body", "name"): "the body's name (signals are `<name>__Heave` ...)",
-    ("body", "mass"): "mass; `\"displaced\"`: water rho x the geometry's immersed volume at "
-                      "rest (box or revolution), so that the body floats there",
+    ("body", "mass"): "mass; `\"displaced\"` (alias `\"equilibrium\"`): rho x the immersed volume of the body's geometry at rest (box or revolution), or without one, of its BEM body in `[hydro]` source or file",
     ("body", "inertia"): "inertia about the CoG, in the body frame",
     ("body", "cog"): "centre of gravity at rest, n-frame (z down)",
     ("body", "geometry"): "the hull for the BEM (`[body.geometry]`)",
@@ -220,7 +221,7 @@ MEANING = {
     ("hydro.source_options", "negative_damping"): "repair, project or error",
     ("hydro.source_options", "omega_range"): "[low, high] kept, rad/s",
     ("hydro.source_options", "asym_tol"): "asymmetry tolerated before warning",
-}
+    **_UNCERTAINTY["meaning"], **_FRAME}
 
 # read only when given (the parser checks `key in table` first), though required in form
 OPTIONAL = {("drag.coefficients", None), ("drag.linear", None), ("hydro.source_options", None),
@@ -332,7 +333,7 @@ def schema() -> dict:
     try:
         for model in list_models():
             load_scene(model)
-        parse_scene(tomllib.loads(_EXTRA), Path("reference.toml"))
+        parse_scene(tomllib.loads(_EXTRA + _UNCERTAINTY["example"]), Path("reference.toml"))
     finally:
         Reader.record = None
     return seen

@@ -148,15 +148,25 @@ def read_profile(r, owner: str) -> tuple[tuple[float, float], ...]:
     return tuple(points)
 
 
-def displaced_mass(r, geometry, rho: float) -> float:
-    """``mass`` of a body table (a scene Reader), kg: a number (or "3 t"), or "displaced":
-    rho (kg/m^3) x the immersed volume of ``geometry`` at rest, so that the body floats there."""
-    if r.data.get("mass") != "displaced":
+DISPLACED = ("displaced", "equilibrium")     # "equilibrium": WEC-Sim's word for the same rule
+
+
+def displaced_mass(r, geometry, rho: float, supplied: bool = False) -> float:
+    """``mass`` of a body table (a scene Reader), kg: a number (or "3 t"), or "displaced" (alias
+    "equilibrium"): rho (kg/m^3) x the immersed volume of ``geometry`` at rest, so that the body
+    floats there. Without a geometry, and with BEM data the scene supplies (``supplied``: a
+    [hydro] source or file), NaN: the mass is rho x the displaced volume those data state for
+    the body, taken when they are read (mbcontrol.hydro.with_displaced_masses)."""
+    if r.data.get("mass") not in DISPLACED:
         return r.positive("mass", "mass")
     r._get("mass", _REQUIRED, dimension="mass", shape="number")
+    if geometry is None and supplied:
+        return math.nan
     if geometry is None:
-        r.fail("mass", "\"displaced\" needs the body's [body.geometry] (rho x its immersed "
-                       "volume); expected a geometry table, or the mass in kg")
+        r.fail("mass", f"\"{r.data['mass']}\" needs the body's displaced volume: from its "
+                       "[body.geometry] (rho x its immersed volume) or from the BEM data of "
+                       "[hydro] source (a WAMIT .out, BEMIO .h5 or Capytaine .nc file, which states "
+                       "each body's volume); expected one of them, or the mass in kg")
     try:
         volume = immersed_volume(geometry)
     except ValueError as exc:

@@ -66,8 +66,12 @@ def test_sweep_json_contract_and_annual_energy(capsys, tmp_path):
     lo, hi = s["annual_energy_ci95_MWh"]
     assert lo < s["annual_energy_MWh"] < hi
     parts = {c["component"]: c for c in s["annual_energy_budget"]["components"]}
-    assert set(parts) == {"statistical", "model", "radiation_fit", "parameters", "resource"}
+    assert set(parts) == {"statistical", "model", "radiation_fit", "linear_vs_nonlinear",
+                          "parameters", "scene_parameters", "resource"}
     assert parts["resource"]["std_MWh"] > 0 and parts["model"]["absent"]
+    assert parts["linear_vs_nonlinear"]["absent"] and parts["scene_parameters"]["absent"]
+    assert sum(c["share_of_variance"] or 0 for c in parts.values()) == pytest.approx(1.0)
+    assert "annual_electrical_energy_MWh" not in s          # an ideal PTO: electrical = absorbed
 
 
 def test_sweep_vary_gives_lists(capsys):

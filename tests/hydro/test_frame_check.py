@@ -26,7 +26,7 @@ def _rm3(tmp_path, float_z: str, plate_z: str):
 def test_a_z_up_scene_is_refused_naming_the_frame(tmp_path, monkeypatch):
     monkeypatch.setenv("MBCONTROL_CACHE", str(tmp_path / "cache"))
     with pytest.raises(SceneError, match=r"body 'float': cog z = -0.72 m, but rm3.out states its "
-                                         r"CoG at z = 0.72 m.*written z-up.*NED"):
+                                         r"CoG at z = 0.72 m.*written z-up.*Add frame = \"z-up\".*NED"):
         converted_source(_rm3(tmp_path, "-0.72", "-21.29"))
 
 

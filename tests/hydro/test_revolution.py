@@ -233,7 +233,8 @@ def test_displaced_needs_a_geometry_with_an_exact_volume(tmp_path, geometry, exp
     text = SCENE.replace(SCENE[SCENE.index("type = \"revolution\""):SCENE.index("[[joint]]")], geometry + "\n")
     assert re.search(expected, _scene_error(tmp_path, text))
     bare = SCENE.replace(SCENE[SCENE.index("[body.geometry]"):SCENE.index("[[joint]]")], "")
-    assert "needs the body's [body.geometry]" in _scene_error(tmp_path, bare)
+    assert re.search(r"needs the body's displaced volume: from its \[body.geometry\].*or from the BEM data "
+                     r"of \[hydro\] source", _scene_error(tmp_path, bare))
 
 
 def test_hydro_checks_name_body_and_field():

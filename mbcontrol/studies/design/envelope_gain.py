@@ -36,7 +36,7 @@ def excursion_ratios(excursions: dict) -> dict:
 
 def lifted_envelope(plant, wave, name: str, pto_obj, design: dict, *, duration: float,
                     dt: float, score_from_s: float | None = None,
-                    model_params=None) -> dict | None:
+                    model_params=None, robust: bool = True) -> dict | None:
     """The law `name` tuned without the envelope, on `plant` (one with nonlinear pressure):
     {"parameters", "predicted_power_W" (linear theory), "mean_power_W" (the nonlinear
     plant's, W), "valid", "invalid_reasons", "envelope_used" (`excursion_ratios`), "binds"
@@ -45,7 +45,8 @@ def lifted_envelope(plant, wave, name: str, pto_obj, design: dict, *, duration: 
     checks)}; where the lifted law is the same, its run is the design's and the gain is 0.
     Scored as the design was: from score_from_s (s; None: after the ramp). None where it does
     not apply: a plant without nonlinear pressure, a law other than passive or reactive,
-    several PTOs (tuned jointly, without an envelope already)."""
+    several PTOs (tuned jointly, without an envelope already). robust: as the design was
+    tuned (within the robustness floors, or the unconstrained optimum)."""
     if not plant.pressure or name not in ("passive", "reactive") or len(plant.scene.ptos) > 1:
         return None
     from mbcontrol.analysis import pto_metrics, summary
@@ -56,7 +57,7 @@ def lifted_envelope(plant, wave, name: str, pto_obj, design: dict, *, duration: 
     from .tuning import tune
     try:
         parameters, predicted, _, extra = tune(plant, wave, name, pto_obj, True, model_params,
-                                               [], envelope=False)
+                                               [], robust=robust, envelope=False)
     except ValueError as exc:          # the tuner cannot serve this sea without the envelope
         return {"parameters": {}, "predicted_power_W": None, "binds": None,
                 "mean_power_W": None, "valid": False,

@@ -11,25 +11,29 @@ DESIGNABLE = ("passive", "reactive", "latching", "declutching", "mpc", "nmpc")
 
 
 def design_for_sea(plant, wave, name: str, dt: float | None = None,
-                   robust: bool = False) -> dict:
+                   robust: bool = True) -> dict:
     """{"settings": the tuned settings (make(name, **settings, wave=...) runs them; a
     predictive controller's period rounded to whole steps of the simulation's dt, s),
     "predicted_W": linear theory's mean power (None where there is none), "bound_W": the
     most any PTO force absorbs inside the same envelope (analysis.envelope.envelope_bound;
     several PTOs: the multiport complex-conjugate bound, no envelope), "bound": how it was
     made, "envelope": the tuner's verdict (inside, ratio, reason), "robustness": the linear
-    laws' margins against controllers.robustness' floors (None for the others), "notes"}.
-    JSON-ready. robust: a reactive law tuned within those floors."""
+    laws' margins against controllers.robustness' floors (None for the others), "notes",
+    "controller": the law to make (`name`, or "passive" where the design fell back),
+    "fell_back" and "fallback" (None, or {"fell_back", "from", "to", "why"}:
+    studies.design.fallback)}. JSON-ready. robust: a reactive law tuned within those floors.
+    A sea no law serves raises fallback.NoLawForSea (a ControllerError) with the reason."""
     from ...analysis import envelope_bound
 
-    from .tuning import tune
+    from .fallback import tune_with_fallback
     if name not in DESIGNABLE:
         raise ControllerError(f"--design: {name!r} has no tuner; expected one of "
                               f"{', '.join(DESIGNABLE)}")
     ptos = plant.scene.ptos
     notes: list[str] = []
-    parameters, predicted, tuner, _ = tune(plant, wave, name, ptos[0], True, None, notes,
-                                           robust=robust)
+    law = tune_with_fallback(plant, wave, name, ptos[0], notes, robust=robust)
+    parameters, predicted, tuner = law["parameters"], law["predicted"], law["tuner"]
+    name = law["controller"]
     if dt and parameters.get("dt_s"):      # a controller period of whole simulation steps
         parameters["dt_s"] = dt * max(1, round(parameters["dt_s"] / dt))
     if isinstance(predicted, dict):
@@ -50,4 +54,5 @@ def design_for_sea(plant, wave, name: str, dt: float | None = None,
         robust = loop_robustness(loop_margins(plant, gains, pto=ptos[0].name))
     return jsonable({"settings": parameters, "predicted_W": predicted,
                      "bound_W": bound["bound_W"], "bound": bound, "envelope": envelope,
-                     "robustness": robust, "notes": notes})
+                     "robustness": robust, "notes": notes, "controller": name,
+                     "fell_back": law["fallback"] is not None, "fallback": law["fallback"]})

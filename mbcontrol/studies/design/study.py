@@ -56,7 +56,8 @@ from mbcontrol.results import jsonable
 
 from ...controllers import REGISTRY, make
 from ...sim import period_of
-from .tuning import CONTRACT, tune
+from .fallback import NoLawForSea, tune_with_fallback
+from .tuning import CONTRACT
 from .envelope_gain import lifted_envelope
 
 MAX_HARMONICS = 25            # the constrained bound's QP stays < 0.1 s (0.07 s at 15)
@@ -129,7 +130,7 @@ class DesignResult:
 
 def design(plant, wave, name: str, *, pto: str | None = None, simulate_s: float | None = None,
            dt: float | None = None, bounds: bool | str = True, limits: bool = True,
-           model_params: dict | None = None, robust: bool = False) -> DesignResult:
+           model_params: dict | None = None, robust: bool = True) -> DesignResult:
     """Tune controller `name` for `wave`, check, bound, simulate and score it.
 
     plant: a ProcessPlant; wave: mbcontrol.waves.Wave (regular or a sea); name: a REGISTRY
@@ -144,9 +145,11 @@ def design(plant, wave, name: str, *, pto: str | None = None, simulate_s: float 
     model_params: parameter overrides of the model the tuner sees, for model-error studies:
     the margins and the simulation use the plant as it is. An unstable linear loop is not
     simulated (it would diverge), and a simulation that fails (SimulationError) is reported,
-    not raised: the result says so in margins and warnings, with metrics None. robust: a
-    reactive law within the robustness floors (controllers.robustness; others are checked
-    against them and flagged either way).
+    not raised: the result says so in margins and warnings, with metrics None. robust (the
+    default): a reactive law within the robustness floors (controllers.robustness, the
+    defaults design.gain_margin_min and design.phase_margin_min_deg); False: the
+    unconstrained optimum (`design --aggressive`). Linear laws are checked against the floors
+    and flagged either way (tuner["robustness"]).
 
     Raises ValueError naming the controller when it is unknown or its tuner cannot apply
     (no wave, latching in a sea, latching in waves shorter than the natural period, ...).
@@ -164,11 +167,16 @@ def design(plant, wave, name: str, *, pto: str | None = None, simulate_s: float 
     dt = period / 1000 if default_dt else float(dt)
     notes: list[str] = []
 
-    try:
-        parameters, predicted, tuner, extra = tune(plant, wave, name, pto_obj, limits,
-                                                    model_params, notes, robust=robust)
+    try:      # the tuned law, or in a sea it cannot serve a detuned or saturated damper
+        law = tune_with_fallback(plant, wave, name, pto_obj, notes, robust=robust,
+                                 model_params=model_params, limits=limits)
+    except NoLawForSea:
+        raise
     except ValueError as exc:
         raise ControllerError(f"design {name!r}: {exc}") from None
+    name, parameters, predicted, extra = (law["controller"], law["parameters"],
+                                          law["predicted"], law["extra"])
+    tuner = {**law["tuner"], "fallback": law["fallback"]}
     controller = make(name, **parameters, **extra)
     if isinstance(predicted, dict):                  # jointly tuned: one figure per PTO
         predicted = predicted[pto_obj.name]
@@ -220,7 +228,7 @@ def design(plant, wave, name: str, *, pto: str | None = None, simulate_s: float 
     lifted = None if not limits or metrics is None else lifted_envelope(
         plant, wave, name, pto_obj, _as_designed(parameters, metrics, simulation),
         duration=duration, dt=dt, score_from_s=duration - repeat if whole else None,
-        model_params=model_params)
+        model_params=model_params, robust=robust)
     return DesignResult(name, pto_obj.name, parameters, predicted, bound, metrics, percent,
                         margins, tuner, simulation, notes, ds, lifted)
 
@@ -247,7 +255,8 @@ def _loop_checks(plant, wave, name, parameters, pto, predicted, others, tuner, n
     if margins.stable and not tuner["robustness"]["meets"]:
         notes.append(f"{name}: below the robustness floors: {tuner['robustness']['why']}")
     if len(plant.scene.ptos) == 1 and plant.hydro is not None:
-        tuner["share"] = share_explained(plant, wave, pto, predicted, name)
+        tuner["share"] = share_explained(plant, wave, pto, predicted, name,
+                                         robust=bool(tuner.get("robust")))
     return margins
 
 

@@ -38,10 +38,14 @@ def _limit_kwargs(func, finite: dict, what: str, notes: list) -> dict:
     return taken
 
 
-def tune(plant, wave, name, pto_obj, limits, model_params, notes, robust: bool = False,
+def tune(plant, wave, name, pto_obj, limits, model_params, notes, robust: bool = True,
          envelope: bool = True):
-    """(parameters, predicted W or None, tuner info, extra controller settings). robust: a
-    reactive law within the robustness floors (controllers.robustness); envelope: with
+    """(parameters, predicted W or None, tuner info, extra controller settings): the one tuner
+    `design`, `export` and per-sea design call. robust (the default): a reactive law within the
+    robustness floors (controllers.robustness: the defaults design.gain_margin_min and
+    design.phase_margin_min_deg; a passive damper on a passive device has an infinite gain
+    margin and a phase margin >= 90 deg anyway); False: the unconstrained optimum
+    (--aggressive), checked against the floors and flagged by the callers; envelope: with
     limits, a passive or reactive law also within the linear model's envelope
     (analysis.envelope; False: the PTO's limits only, `envelope_gain.lifted_envelope`)."""
     cls = REGISTRY[name]
@@ -61,9 +65,9 @@ def tune(plant, wave, name, pto_obj, limits, model_params, notes, robust: bool =
     # the wave is a setting beyond the parameters: a predictive controller's preview
     extra = {"wave": wave} if _accepts(cls, "wave") else {}
     if name in ("passive", "reactive") and len(plant.scene.ptos) > 1:
-        if robust:
-            notes.append("robust: not applied to several PTOs tuned jointly (their margins "
-                         "are reported)")
+        if robust and name == "reactive":
+            notes.append("the robustness floors do not constrain several PTOs tuned jointly: "
+                         "each PTO's margins are checked against them and reported")
         return _tune_jointly(plant, wave, name, limits, model_params, own, extra)
     if name in ("passive", "reactive"):
         return _tune_linear(plant, wave, name, pto_obj, limits, model_params, notes, robust,
@@ -91,8 +95,8 @@ def _tune_linear(plant, wave, name, pto_obj, limits, model_params, notes, robust
     if limits:
         if math.isfinite(pto_obj.rated_power):     # detuned to the PTO's rated power
             kw["rated_power"] = info["settings"]["rated_power"] = pto_obj.rated_power
-    if robust and name == "reactive":
-        kw["robust"] = info["robust"] = True
+    if name == "reactive":
+        kw["robust"] = info["robust"] = bool(robust)
     try:
         if name == "passive":
             damping, predicted = tuner(plant, wave, pto=pto, params=model_params, **kw)
@@ -104,10 +108,25 @@ def _tune_linear(plant, wave, name, pto_obj, limits, model_params, notes, robust
         stiffness = None if name == "passive" else stiffness
         info["envelope"].update(inside=False, ratio=exc.ratio, reason=str(exc))
         notes.append(f"OUTSIDE ITS ENVELOPE: {exc}; the damper that comes closest is used")
+    if robust and name == "reactive" and predicted:     # what the floors cost, said
+        info["margins_cost"] = _margins_cost(plant, wave, pto, model_params, kw, predicted)
     tuned = {"damping": damping}
     if stiffness is not None:
         tuned["stiffness"] = stiffness
     return {**tuned, **own}, predicted, info, extra
+
+
+def _margins_cost(plant, wave, pto, model_params, kw, predicted) -> dict:
+    """{"aggressive_predicted_W", "share"}: linear theory's power of the unconstrained optimum
+    (the same limits, no robustness floors) and the share of it the floors give up."""
+    from ...controllers import reactive_tuning
+    try:
+        aggressive = reactive_tuning(plant, wave, pto, params=model_params,
+                                     **{**kw, "robust": False})[2]
+    except OutsideEnvelope as exc:
+        aggressive = exc.fallback[2]
+    share = 1 - predicted / aggressive if aggressive and aggressive > 0 else None
+    return {"aggressive_predicted_W": float(aggressive), "share": share}
 
 
 def _tune_switching(plant, wave, name, pto, model_params, notes, *, finite, own, extra):

@@ -15,8 +15,10 @@ from .budget import table as budget_table
 from .plots import plot_sweep
 from .power import power_matrix
 from .records import MeasuredSea, read_records
+from .resource import Resource, ndbc_resource
 from .study import sweep
 
 __all__ = ["sweep", "SeaState", "grid", "read_seas", "energy_flux", "annual_energy_MWh",
            "power_matrix", "occurrence", "site_energy_flux", "budget_table", "plot_sweep",
-           "MeasuredSea", "read_records"]
+           "MeasuredSea", "read_records",
+           "Resource", "ndbc_resource"]

@@ -70,37 +70,45 @@ def run_case(case) -> dict:
     else:
         wave = sea_wave(plant, case.sea, case.duration, seed=case.seed, direction=direction,
                         amplitudes=case.amplitudes)
-    designed = None
+    designed, law = None, case.controller
     start = time.perf_counter()
     if case.design:      # tuned for this sea; settings given with --set take precedence
-        from mbcontrol.studies.design import design_for_sea
+        from mbcontrol.studies.design import NoLawForSea, design_for_sea
         try:
             designed = design_for_sea(plant, wave, case.controller, dt=case.dt,
                                       robust=case.robust)
+        except NoLawForSea as exc:      # the device cannot serve the sea: zero, with why
+            return no_law_record(case, exc, start)
         except Exception as exc:   # noqa: BLE001 - a sea the tuner cannot serve is a result
             return failed_record(case, exc, start)
+        law = designed["controller"]
+        if law != case.controller:     # fell back to another law: only what it takes
+            settings = {k: v for k, v in settings.items() if k in designed["settings"]}
         settings = {**designed["settings"], **settings}
-    record = _run(case, plant, wave, settings, params, start)
+    record = _run(case, plant, wave, settings, params, start, law)
     if case.nonlinear == "invalid":    # every record says which model made it
-        record = _escalated(case, record, scene_key, wave, settings, params) \
+        record = _escalated(case, record, scene_key, wave, settings, params, law) \
             if _left_linear_range(record) else {**record, "model": "linear"}
     if designed is not None:
         record["design"] = designed
     return record
 
 
-def _run(case, plant, wave, settings: dict, params: dict, start: float) -> dict:
+def _run(case, plant, wave, settings: dict, params: dict, start: float,
+         law: str | None = None) -> dict:
+    """Run `case` with the controller `law` (default case.controller: --design may have
+    fallen back to another) made from `settings`; its record (failed_record if it raises)."""
     import inspect
 
     from mbcontrol.controllers import REGISTRY, make
 
     from ...sim import can_run_light, simulate, simulate_arrays
-    controller = None
-    if case.controller:
-        cls = REGISTRY[case.controller]
+    controller, law = None, law or case.controller
+    if law:
+        cls = REGISTRY[law]
         if "wave" in inspect.signature(cls).parameters:
             settings = {"wave": wave, **settings}
-        controller = make(case.controller, **settings)
+        controller = make(law, **settings)
     try:
         if can_run_light(plant, controller, case.method):
             run = simulate_arrays(plant, wave, duration=case.duration, dt=case.dt,
@@ -120,7 +128,8 @@ def _left_linear_range(record: dict) -> bool:
     return left_linear_range(record["invalid_reasons"])
 
 
-def _escalated(case, linear: dict, scene_key: tuple, wave, settings, params) -> dict:
+def _escalated(case, linear: dict, scene_key: tuple, wave, settings, params,
+               law: str | None = None) -> dict:
     """The case run again on the nonlinear plant; the linear record under "linear". A
     nonlinear run that cannot be made keeps the linear record, with the reason added."""
     summary = {k: linear[k] for k in ("metrics", "valid", "invalid_reasons", "wall_time_s")}
@@ -130,7 +139,7 @@ def _escalated(case, linear: dict, scene_key: tuple, wave, settings, params) -> 
     except Exception as exc:       # noqa: BLE001 - reported in the record, as a failed run
         record = failed_record(case, exc, start)
     else:
-        record = _run(case, plant, wave, settings, params, start)
+        record = _run(case, plant, wave, settings, params, start, law)
     if record.get("failed"):
         return {**linear, "model": "linear", "invalid_reasons": linear["invalid_reasons"] + [
             f"the nonlinear plant could not run this sea ({record['failure']})"]}
@@ -165,6 +174,18 @@ def failed_record(case, exc: BaseException, start: float) -> dict:
     reason = f"{type(exc).__name__}: {exc}"
     return {"case": case.key, "metrics": {}, "valid": False, "failed": True,
             "failure": reason, "invalid_reasons": [f"run failed ({reason})"],
+            "wall_time_s": time.perf_counter() - start}
+
+
+def no_law_record(case, exc: BaseException, start: float) -> dict:
+    """The record of a --design case whose sea no law serves within the PTO's limits
+    (studies.design.NoLawForSea: the device's survival mode): not run, no metrics, not valid
+    and not failed, no_law true, the reason in invalid_reasons and under design (fell_back
+    true, to null), so the sweep counts its energy as zero and says why."""
+    from mbcontrol.studies.design import no_law_design
+    reason = f"no law within the PTO's limits serves this sea (survival, counted as zero): {exc}"
+    return {"case": case.key, "metrics": {}, "valid": False, "failed": False, "no_law": True,
+            "invalid_reasons": [reason], "design": no_law_design(exc, case.controller),
             "wall_time_s": time.perf_counter() - start}
 
 

@@ -164,8 +164,12 @@ def _model_variables(records: dict, shape: tuple, dims: tuple) -> dict:
 
 def _design_variables(records: dict, shape: tuple, dims: tuple) -> dict:
     """--design: per case its tuned settings (JSON), linear theory's power, the bound inside
-    the same envelope (W) and whether the tuner kept the device inside its envelope."""
+    the same envelope (W), whether the tuner kept the device inside its envelope, whether the
+    design fell back to a gentler law (studies.design.fallback), which ("" where none; the
+    reason where no law serves the sea) and whether no law serves the sea at all."""
     settings = np.full(shape, "", dtype=object)
+    fell_back, no_law = np.zeros(shape, bool), np.zeros(shape, bool)
+    fallback = np.full(shape, "", dtype=object)
     bound, predicted = np.full(shape, np.nan), np.full(shape, np.nan)
     inside = np.ones(shape, bool)
     robust = np.ones(shape, bool)
@@ -178,7 +182,19 @@ def _design_variables(records: dict, shape: tuple, dims: tuple) -> dict:
         bound[index] = np.nan if d["bound_W"] is None else d["bound_W"]
         predicted[index] = np.nan if d["predicted_W"] is None else d["predicted_W"]
         inside[index] = d["envelope"].get("inside") is not False
-    return {"design_settings": (dims, settings.astype(str),
+        no_law[index] = bool(r.get("no_law"))       # fell back to nothing: zero_seas says why
+        fell_back[index] = bool(d.get("fell_back")) and not no_law[index]
+        if d.get("fallback"):
+            fallback[index] = d["fallback"]["to"] or "none: no law serves the sea"
+    return {"fell_back": (dims, fell_back, {
+                "long_name": "the law tuned for the sea could not hold the PTO's limits or the "
+                             "envelope: the design fell back to a gentler law, which ran "
+                             "(studies.design.fallback)"}),
+            "fallback": (dims, fallback.astype(str), {
+                "long_name": "the law it fell back to (\"none: ...\" where no law serves the sea)"}),
+            "no_law": (dims, no_law, {
+                "long_name": "no law within the PTO's limits serves the sea: not run, its "
+                             "energy counted as zero"}),"design_settings": (dims, settings.astype(str),
                                 {"long_name": "the settings tuned for the case's sea (JSON)"}),
             "bound_W": (dims, bound, {"long_name": "the most any PTO force absorbs inside the "
                                                    "same envelope (linear theory)",

@@ -21,6 +21,7 @@ from .records import label_summary, measured_seas, with_records
 from ...waves import annual_energy_MWh, site_energy_flux
 from .runner import execute, keep_plant
 from .store import CaseStore, assemble
+from .zero import fell_back_summary, zero_note, zero_seas
 
 
 NONLINEAR_MODES = ("scene", "invalid", "always")
@@ -31,7 +32,7 @@ def sweep(model: str, seas, *, seeds: int = 1, vary: dict | None = None, params=
           duration: float | None = None, dt: float | None = None, method: str | None = None,
           store=None, workers: int | None = 0, scheduler: str | None = None,
           width: float | None = None, progress: bool = True, design: bool = False,
-          robust: bool = False, amplitudes: str = "deterministic", identified=None,
+          robust: bool = True, amplitudes: str = "deterministic", identified=None,
           years: dict | None = None, nonlinear: str = "scene", records=None):
     """Run a sweep and return (Dataset, summary).
 
@@ -41,7 +42,8 @@ def sweep(model: str, seas, *, seeds: int = 1, vary: dict | None = None, params=
     finished cases are not run again; `<store>/sweep.nc` holds the Dataset); width: the
     characteristic width (m) for the capture width ratio. design: the controller is tuned for
     each sea (studies.design.sea; per sea "settings", "bound_W", "percent_of_bound" in the
-    summary); robust: a reactive law tuned within the robustness floors; amplitudes:
+    summary); robust (the default; False: --aggressive): a reactive law tuned within the
+    robustness floors, as `design` tunes it; amplitudes:
     "deterministic" (the expected power) or "random" (Rayleigh: a record's statistics;
     waves.irregular). With several seeds each sea gets its standard error and 95 % interval
     (seed_statistics). identified: an identification's summary (path): its parameter values
@@ -65,7 +67,7 @@ def sweep(model: str, seas, *, seeds: int = 1, vary: dict | None = None, params=
     dt, method = defaults.resolve("sweep.dt", dt), defaults.resolve("sweep.method", method)
     vary = {k: list(v) for k, v in (vary or {}).items()}
     scene = load_scene(model, scene_params or None)
-    _check_controller(controller, design, robust)
+    robust = _check_controller(controller, design, robust)
     plant = build_plant(scene)
     scene_key = tuple(sorted((scene_params or {}).items()))
     keep_plant(model, scene_key, plant)   # serial path: reuse
@@ -138,17 +140,18 @@ def sweep(model: str, seas, *, seeds: int = 1, vary: dict | None = None, params=
     return ds, summary
 
 
-def _check_controller(controller, design: bool, robust: bool) -> None:
+def _check_controller(controller, design: bool, robust: bool) -> bool:
+    """InputError for a controller no sweep can run; robust as a case's key records it (only
+    where the law is tuned: --design)."""
     from mbcontrol.controllers import REGISTRY
     if controller is not None and controller not in REGISTRY:
         raise InputError(f"--controller {controller}: expected one of {', '.join(REGISTRY)}")
-    if robust and not design:
-        raise InputError("--robust tunes within the robustness floors: it goes with --design")
     if design:
         from mbcontrol.studies.design import DESIGNABLE
         if controller not in DESIGNABLE:
             raise InputError(f"--design tunes a controller for each sea: give --controller, one "
                              f"of {', '.join(DESIGNABLE)} (got {controller})")
+    return bool(robust and design)
 
 
 def _keep_nonlinear_plant(model: str, scene, scene_key: tuple, nonlinear: str) -> None:
@@ -219,13 +222,12 @@ def _summary(ds, seas, run, wall, n_cases) -> dict:
         raw = ds.get("mean_power_W__unchecked", ds["mean_power_W"]).mean("seed")
         # a case that failed to run has no number at all: it counts as nothing here too
         unchecked = annual_energy_MWh(np.nan_to_num(raw.values, nan=0.0), weights)
-        if missing.any():
-            notes.append(f"annual energy {aep:.4g} MWh counts {int(missing.sum())} weighted "
-                         f"seas ({100 * (1 - coverage):.3g} % of the year) with no valid case "
-                         f"as producing nothing: a lower bound; their failed cases would "
-                         f"have given {unchecked:.4g} MWh in all")
+        zero = zero_seas(ds, seas, missing)
+        if zero:
+            notes.append(zero_note(zero, aep, coverage, unchecked))
     if "bound_W" in ds:
         notes += _design_notes(ds, rows)
+    extra = {"zero_seas": zero if aep is not None else [], **fell_back_summary(ds, rows)}
     listed, crashed = _cases_where(ds, invalid), _cases_where(ds, failed)
     if listed:
         notes.append(f"{len(listed)} of {n_cases} cases failed their physics checks and are "
@@ -242,7 +244,7 @@ def _summary(ds, seas, run, wall, n_cases) -> dict:
             "failed_cases": len(crashed), "failed": crashed, "notes": notes, "seas": rows,
             "weighted_mean_power_W": weighted, "annual_energy_MWh": aep,
             "annual_energy_coverage": coverage if aep is not None else None,
-            "annual_energy_unchecked_MWh": unchecked}
+            "annual_energy_unchecked_MWh": unchecked, **extra}
 
 
 def seed_statistics(powers) -> dict:
@@ -285,6 +287,9 @@ def _designed_row(ds, k: int) -> dict:
             "percent_of_bound": None if bound is None or power is None else float(
                 100 * power / bound),
             "inside_envelope": bool(sea["inside_envelope"].values.all()),
+            "fell_back": bool(sea["fell_back"].values.any()) if "fell_back" in sea else False,
+            "fallback": next((str(f) for f in np.ravel(sea["fallback"].values) if str(f)), None)
+            if "fallback" in sea else None,
             "meets_robustness_floors": bool(sea["meets_robustness_floors"].values.all())}
 
 
@@ -293,6 +298,12 @@ def _design_notes(ds, rows) -> list[str]:
     envelope, laws below the robustness floors, simulations far off linear theory, and any
     sea whose power beats its bound by more than 1 %."""
     notes = []
+    fell = [r for r in rows if r["fell_back"]]
+    if fell:
+        notes.append(f"{len(fell)} seas' tuned laws could not hold the PTO's limits or the "
+                     f"envelope and fell back (fell_back true; their energy is counted): "
+                     + ", ".join(f"Hs {r['hs']:.3g} m Tp {r['tp']:.3g} s to {r['fallback']}"
+                                 for r in fell))
     outside = [r for r in rows if not r["inside_envelope"]]
     if outside:
         notes.append(f"{len(outside)} seas have no setting inside the linear model's envelope "
@@ -302,7 +313,8 @@ def _design_notes(ds, rows) -> list[str]:
     if fragile:
         notes.append(f"{len(fragile)} seas' tuned laws are below the robustness floors (gain "
                      f"margin 2, phase margin 30 deg; meets_robustness_floors false): deploy "
-                     f"them knowing a few % of model error can destabilise them")
+                     f"them knowing a few % of model error can destabilise them (without "
+                     f"--aggressive, design tunes within the floors)")
     # a loop that rings (a phase margin near 0: linear theory's steady state is never
     # reached in the record): Humboldt Bay's Hs 1.25 m, Tp 20.4 s, reactive, 22 kW predicted,
     # 1 kW simulated, phase margin 0.8 deg

@@ -15,8 +15,11 @@ import numpy as np
 
 from ...errors import InputError
 from . import budget as bud
+from .scene_parameters import efficiency_gradients, relative_gradients
 from .spectral import radiation_fit_effect, parameter_gradient, sea_components, sea_gains, \
     spectral_row
+from .terms import electrical_power, nonlinear_component, nonlinear_difference, pto_means, \
+    scene_component
 
 
 def read_identified(path, model: str, plant_parameters) -> dict:
@@ -71,10 +74,14 @@ def _model_error(summary: dict) -> dict:
 
 def add_uncertainty(summary: dict, ds, seas, plant, *, controller, settings, params,
                     duration: float, amplitudes: str, identified: dict | None = None,
-                    years: dict | None = None) -> None:
+                    years=None) -> None:
     """Adds to `summary` (in place): per sea the spectral entries of a linear law, and for a
     weighted list "annual_energy_ci95_MWh" and "annual_energy_budget" (with an
-    identification also per sea "model_std_W" and "parameter_std_W", W)."""
+    identification also per sea "model_std_W" and "parameter_std_W", W); where the scene
+    converts (a drivetrain, an efficiency below 1) "annual_electrical_energy_MWh" with its
+    own "annual_electrical_energy_ci95_MWh" and "annual_electrical_energy_budget". years:
+    label -> per-year weights (`waves.read_year_weights`) or a buoy record's blocks
+    (`resource.ndbc_resource`)."""
     rows = summary["seas"]
     if ds["mean_power_W"].ndim != 2:           # other quantities varied: no single law per sea
         return
@@ -96,36 +103,96 @@ def add_uncertainty(summary: dict, ds, seas, plant, *, controller, settings, par
     weights = np.array([s.weight for s in seas])
     power = np.array([np.nan if r["mean_power_W"] is None else r["mean_power_W"]
                       for r in rows], float)
-    rated = summary.get("rated_power_W")
+    rated = summary.get("rated_power_W") or ds.attrs.get("rated_power_W")
     capped = power >= rated if rated else np.zeros(power.size, bool)
+    held = np.where(np.isfinite(power), power, 0.0)
+    if rated:
+        held = np.minimum(held, rated)
+    inputs = _inputs(ds, plant, rows, waves, laws, weights, power, capped, identified=identified,
+                     params=params, controller=controller, why_not=why_not)
+    ones = np.ones(power.size)
+    ci, table = bud.combine(summary["annual_energy_MWh"],
+                            _components(inputs, ones, held, years, summary["annual_energy_MWh"],
+                                        electrical=False))
+    summary["annual_energy_ci95_MWh"], summary["annual_energy_budget"] = ci, \
+        _noted(table, capped, summary)
+    electric = electrical_power(ds, plant.scene, held)
+    if electric is not None:
+        aep_e = float(bud.MWH_PER_W * np.sum(weights * electric))
+        scale = np.where(held > 0, electric / np.where(held > 0, held, 1.0), 1.0)
+        ci, table = bud.combine(aep_e, _components(inputs, scale, electric, years, aep_e,
+                                                   electrical=True))
+        table["energy"] = ("electrical: the PTOs' mean electrical power (the drivetrain's "
+                           "winding loss, else the efficiency both ways) of the causal law "
+                           "simulated; each absorbed-power term scaled per sea by its "
+                           "electrical-to-absorbed ratio")
+        summary["annual_electrical_energy_MWh"] = aep_e
+        summary["annual_electrical_energy_ci95_MWh"] = ci
+        summary["annual_electrical_energy_budget"] = _noted(table, capped, summary)
+    summary["annual_energy_budget"]["energy"] = "absorbed (mechanical)"
+
+
+def _inputs(ds, plant, rows, waves, laws, weights, power, capped, *, identified, params,
+            controller, why_not) -> dict:
+    """Per-sea quantities (W, absorbed) every budget is made from."""
+    out = {"weights": weights, "power": power, "why_not": why_not,
+           "statistical": _statistical(rows, capped, power), "identified": identified}
     linear = all(g is not None for g in laws)
-    components = [_statistical(rows, weights, power, capped)]
-    components.append(_model(identified, weights, power, capped))
     if identified is not None:           # each sea's own share of the model's error
         for k, row in enumerate(rows):
             row["model_std_W"] = None if capped[k] or not np.isfinite(power[k]) else \
                 2 * identified["model_error"] * power[k]
-    if linear:
-        effect = np.array([0.0 if capped[k] else radiation_fit_effect(plant, waves[k], laws[k],
-                                                                      params)
-                           for k in range(len(seas))])
-        components.append(bud.linear_over_seas(
-            "radiation_fit", weights, effect * np.nan_to_num(power),
-            "linear theory's power with the state-space radiation fit over that with the BEM "
-            "data, per sea, times the simulated power"))
+        out["model_W"] = np.where(capped, 0.0, 2 * identified["model_error"]
+                                  * np.nan_to_num(power))
+    out["radiation_W"] = np.array([0.0 if capped[k] else radiation_fit_effect(
+        plant, waves[k], laws[k], params) for k in range(len(waves))]) * np.nan_to_num(power) \
+        if linear else None
+    out["parameters"] = _parameters(identified, plant, waves, laws, params=params,
+                                    controller=controller, capped=capped, power=power,
+                                    rows=rows, weights=weights, why_not=why_not)
+    out["nonlinear"] = nonlinear_difference(ds, capped)
+    from ...scene import scene_uncertainty
+    items = scene_uncertainty(plant.scene)
+    out["items"] = items
+    skip = capped | ~(np.nan_to_num(power) > 0)
+    out["scene_rel"] = relative_gradients(plant, waves, laws, items, params=params, skip=skip) \
+        if items and linear else None
+    eta = {p.name: p.efficiency for p in plant.scene.ptos}
+    out["scene_eff"] = efficiency_gradients(items, *pto_means(ds, plant.scene), eta) \
+        if items else None
+    if out["scene_eff"] is not None:
+        out["scene_eff"][skip] = 0.0
+    return out
+
+
+def _components(inputs: dict, scale, power_W, years, aep: float, *, electrical: bool) -> list:
+    """The budget's rows for one energy (absorbed: scale 1; electrical: per sea P_e / P)."""
+    w, why_not = inputs["weights"], inputs["why_not"]
+    stderr, dof = inputs["statistical"]
+    out = [bud.statistical(w, stderr * scale, dof)]
+    out.append(_model(inputs["identified"], w, inputs.get("model_W"), scale))
+    out.append(bud.linear_over_seas(
+        "radiation_fit", w, inputs["radiation_W"] * scale,
+        "linear theory's power with the state-space radiation fit over that with the BEM "
+        "data, per sea, times the simulated power") if inputs["radiation_W"] is not None
+        else bud.absent("radiation_fit", "B", "linear", f"needs a linear law ({why_not})"))
+    out.append(nonlinear_component(w, *inputs["nonlinear"], scale))
+    out.append(inputs["parameters"](scale) if callable(inputs["parameters"])
+               else inputs["parameters"])
+    out.append(scene_component(inputs["items"], inputs["scene_rel"], inputs["scene_eff"], w,
+                               inputs["power"], scale, electrical=electrical, why_not=why_not))
+    if years is None or (isinstance(years, dict) and not years):
+        out.append(bud.absent("resource", "A", "one term", (
+            "no year-to-year record: give the site file weights_<year> columns, or "
+            "--resource with NDBC spectral files (one per year, or one year: monthly blocks)")))
+    elif isinstance(years, dict):
+        out.append(bud.resource(years, power_W))
     else:
-        components.append(bud.absent("radiation_fit", "B", "linear",
-                                     f"needs a linear law ({why_not})"))
-    components.append(_parameters(identified, weights, plant, waves, laws, params=params,
-                                  controller=controller, capped=capped, why_not=why_not,
-                                  power=power, rows=rows))
-    power_valid = np.where(np.isfinite(power), power, 0.0)
-    if rated:
-        power_valid = np.minimum(power_valid, rated)
-    components.append(bud.resource(years, power_valid) if years else bud.absent(
-        "resource", "A", "one term", "the site file has one set of weights (give "
-        "weights_<year> columns, one per year, for the interannual variability)"))
-    ci, table = bud.combine(summary["annual_energy_MWh"], components)
+        out.append(bud.resource_blocks(years, power_W, aep))
+    return out
+
+
+def _noted(table: dict, capped, summary) -> dict:
     notes = []
     if capped.any():
         notes.append(f"{int(capped.sum())} seas at the rated power carry no uncertainty (the "
@@ -135,13 +202,13 @@ def add_uncertainty(summary: dict, ds, seas, plant, *, controller, settings, par
                      "a lower bound of the annual energy (annual_energy_coverage)")
     if notes:
         table["notes"] = notes
-    summary["annual_energy_ci95_MWh"] = ci
-    summary["annual_energy_budget"] = table
+    return table
 
 
-def _statistical(rows, weights, power, capped) -> dict:
-    """Each sea's standard error: from its seeds, else spectral; none where its power is held
-    (capped at the rated power) or counted as nothing (no valid case)."""
+def _statistical(rows, capped, power) -> tuple[np.ndarray, np.ndarray]:
+    """Each sea's standard error (W) and its degrees of freedom: from its seeds, else
+    spectral; 0 where its power is held (capped at the rated power) or counted as nothing (no
+    valid case); NaN where there is no estimate."""
     stderr, dof = [], []
     for r, p, held in zip(rows, power, capped):
         if held or not np.isfinite(p):
@@ -156,23 +223,24 @@ def _statistical(rows, weights, power, capped) -> dict:
         else:
             stderr.append(math.nan)
             dof.append(math.inf)
-    return bud.statistical(weights, stderr, dof)
+    return np.array(stderr, float), np.array(dof, float)
 
 
-def _model(identified, weights, power, capped) -> dict:
+def _model(identified, weights, model_W, scale) -> dict:
     if identified is None:
         return bud.absent("model", "B", "linear", "no identification given (--identified): "
                           "the model's error against measurements is not known here")
     r = identified["model_error"]
-    per_sea = np.where(capped, 0.0, 2 * r * np.nan_to_num(power))
     return bud.linear_over_seas(
-        "model", weights, per_sea,
+        "model", weights, model_W * scale,
         f"identification's relative amplitude error {100 * r:.3g} % (1 sigma) from its "
         f"{identified['model_error_source']}, x2 for power ({identified['source']})")
 
 
-def _parameters(identified, weights, plant, waves, laws, *, params, controller, capped,
-                why_not, power, rows) -> dict:
+def _parameters(identified, plant, waves, laws, *, params, controller, capped, power, rows,
+                weights, why_not):
+    """The identified parameters' term as a function of the per-sea scale (or an absent
+    row): gradients computed once."""
     if identified is None or not identified["names"]:
         return bud.absent("parameters", "B", "linear",
                           "no identified parameters with standard errors (--identified)")
@@ -187,7 +255,8 @@ def _parameters(identified, weights, plant, waves, laws, *, params, controller, 
     for k, row in enumerate(rows):        # each sea's spread from the parameters alone
         row["parameter_std_W"] = float(np.sqrt(max(grads[k] @ identified["covariance"]
                                                    @ grads[k], 0.0)))
-    return bud.parameters(weights, grads, identified["covariance"], identified["names"],
-                          f"{len(identified['names'])} identified parameters' covariance "
-                          f"through linear theory's relative sensitivities (central "
-                          f"differences) times the simulated power")
+    return lambda scale: bud.parameters(
+        weights, grads * scale[:, None],
+        identified["covariance"], identified["names"],
+        f"{len(identified['names'])} identified parameters' covariance through linear "
+        f"theory's relative sensitivities (central differences) times the simulated power")
