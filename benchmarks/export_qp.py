@@ -35,8 +35,8 @@ def record_qps():
     seen = []
     original = mq._QpForm.solve
 
-    def solve(self, q, free, u_prev, warm):
-        out = original(self, q, free, u_prev, warm)
+    def solve(self, q, free, u_prev, warm, memory=None):
+        out = original(self, q, free, u_prev, warm, memory)
         if not self.soft and out[0] is not None:
             seen.append((self, *self.bounds(q, free, u_prev), out[0]))
         return out

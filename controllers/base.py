@@ -1,6 +1,8 @@
 """The controllers' common helpers. The Controller protocol they implement, with the optional
 members the simulator and the exporters may use, is declared where the simulator lives
-(`mbcontrol.sim.protocol`) and re-exported here.
+(`mbcontrol.sim.protocol`) and re-exported here. What a registered controller class states
+about itself beyond it (its kind, tuned settings, tune(), ...) is the law protocol of
+`controllers.law`.
 """
 from __future__ import annotations
 

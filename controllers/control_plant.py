@@ -129,7 +129,7 @@ def pto_admittance(cp, omega) -> np.ndarray:
     """|force -> velocity| of each PTO at omega (rad/s): (n_omega, n_pto), m/s per N (or
     rad/s per N m), from the control plant's continuous model."""
     G = frequency_response(cp.A, cp.Bu_c, cp.Cv, None, omega)
-    return np.abs(np.diagonal(G, axis1=1, axis2=2))
+    return np.abs(np.diagonal(G, axis1=0, axis2=1))
 
 
 def pto_impedance(cp, omega: float) -> np.ndarray:

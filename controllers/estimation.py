@@ -5,7 +5,9 @@ wave model: each generalised excitation d_i is a sum of lightly damped oscillato
 (d'' + 2 zeta w d' + w^2 d = white noise) at frequencies around the sea state's energy, so the
 filter estimates the plant state and the excitation it cannot measure from joint encoders
 alone. Model error (nonlinearity, reduction) lands in the excitation estimate: the filter is
-also a disturbance observer, which is what the MPC needs.
+also a disturbance observer, which is what the MPC needs. The filter (its matrices) is built
+once and never changes; a run's state lives apart in a `KalmanEstimate` (Pinocchio's Model
+and Data), so one filter serves any number of runs.
 
 `ArPredictor`: forecasts each d_i by an auto-regressive model fitted by least squares to the
 filter's recent estimates (refitted every few seconds), the usual causal predictor for wave
@@ -13,11 +15,14 @@ excitation; a regular wave is predicted exactly by AR(2). A least-squares fit ma
 unstable (a root of the characteristic polynomial outside the unit circle: a fit to a growing
 record, e.g. the wave's ramp), and its forecast then grows geometrically over the horizon; such
 roots are reflected into the unit circle (r -> 1 / conj(r): the same spectral magnitude up to a
-constant, a decaying forecast) and the event counted.
+constant, a decaying forecast) and the event counted. `ArConfig` is a predictor's settings
+(frozen); each run makes its own predictor from it.
 
 Units: d in the control plant's generalised units (N-like), t and dt in s, omega in rad/s.
 """
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import numpy as np
 from scipy import linalg
@@ -80,7 +85,6 @@ class ExcitationKalman:
         P = linalg.solve_discrete_are(self.Phi.T, C.T, Q, R)
         self.K = P @ C.T @ np.linalg.inv(C @ P @ C.T + R)
         self.C = C
-        self.state = np.zeros(nz + nxi)
 
     def _response_scale(self, omegas) -> np.ndarray:
         """Peak |measured output| per unit d over the wave-model band (sets R's units)."""
@@ -88,8 +92,21 @@ class ExcitationKalman:
         w = np.geomspace(omegas.min() / 3, omegas.max() * 3, 60)
         nd = max(cp.nd, 1)
         G = frequency_response(cp.A, cp.Bd_c if cp.nd else np.zeros((cp.nz, nd)), cp.Cm, None, w)
-        peak = np.abs(G).max(axis=(0, 2))
+        peak = np.abs(G).max(axis=(1, 2))
         return np.where(peak > 0, peak, 1.0)
+
+    def estimate(self) -> "KalmanEstimate":
+        """A fresh estimate (state at rest) that this filter's model updates: one per run."""
+        return KalmanEstimate(self)
+
+
+class KalmanEstimate:
+    """One run's state of an ExcitationKalman (`model`, fixed): z and the wave model's
+    states, from rest. The model is shared; each run keeps its own estimate."""
+
+    def __init__(self, model: ExcitationKalman):
+        self.model = model
+        self.state = np.zeros(model.nz + model.nxi)
 
     def reset(self) -> None:
         self.state[:] = 0.0
@@ -97,26 +114,60 @@ class ExcitationKalman:
     def update(self, y: np.ndarray, u_prev: np.ndarray) -> None:
         """One step: predict with the command held over the last period, then correct with
         the measurements y (deviations from rest, Cm's rows)."""
-        predicted = self.Phi @ self.state + self.Gamma @ u_prev
-        self.state = predicted + self.K @ (y - self.C @ predicted)
+        m = self.model
+        predicted = m.Phi @ self.state + m.Gamma @ u_prev
+        self.state = predicted + m.K @ (y - m.C @ predicted)
 
     @property
     def z(self) -> np.ndarray:
-        return self.state[:self.nz]
+        return self.state[:self.model.nz]
 
     @property
     def d(self) -> np.ndarray:
         """Current generalised excitation estimate."""
-        return self.C_xi @ self.state[self.nz:]
+        return self.model.C_xi @ self.state[self.model.nz:]
 
     def model_forecast(self, n: int) -> np.ndarray:
         """(n, nd): d over the next n periods, midpoints, from the wave model's free motion."""
-        xi = self.state[self.nz:]
-        out = np.empty((n + 1, self.C_xi.shape[0]))
+        m = self.model
+        xi = self.state[m.nz:]
+        out = np.empty((n + 1, m.C_xi.shape[0]))
         for k in range(n + 1):
-            out[k] = self.C_xi @ xi
-            xi = self.Phi_xi @ xi
+            out[k] = m.C_xi @ xi
+            xi = m.Phi_xi @ xi
         return 0.5 * (out[:-1] + out[1:])
+
+
+@dataclass(frozen=True)
+class ArConfig:
+    """What an ArPredictor is, apart from what it has seen: nd components, dt (s), AR order,
+    window_s (s, the fit's span), refit_s (s), ridge (relative), min_samples before the first
+    fit. `window`, `refit` and `first_fit` are the same in samples, as the predictor uses them."""
+    nd: int
+    dt: float
+    order: int = 8
+    window_s: float = 120.0
+    refit_s: float = 10.0
+    ridge: float = 1e-8
+    min_samples: int = 0
+
+    @property
+    def first_fit(self) -> int:
+        """Samples before the first fit (at least 4 x order)."""
+        return max(int(self.min_samples), 4 * self.order)
+
+    @property
+    def window(self) -> int:
+        return max(int(round(self.window_s / self.dt)), self.first_fit)
+
+    @property
+    def refit(self) -> int:
+        return max(int(round(self.refit_s / self.dt)), 1)
+
+    def predictor(self) -> "ArPredictor":
+        """A fresh predictor (no history, no fit)."""
+        return ArPredictor(self.nd, self.dt, order=self.order, window_s=self.window_s,
+                           refit_s=self.refit_s, ridge=self.ridge, min_samples=self.min_samples)
 
 
 class ArPredictor:
@@ -130,10 +181,9 @@ class ArPredictor:
 
     def __init__(self, nd: int, dt: float, *, order: int = 8, window_s: float = 120.0,
                  refit_s: float = 10.0, ridge: float = 1e-8, min_samples: int = 0):
+        self.config = config = ArConfig(nd, dt, order, window_s, refit_s, ridge, min_samples)
         self.nd, self.dt, self.order = nd, dt, order
-        self.min_samples = max(int(min_samples), 4 * order)
-        self.window = max(int(round(window_s / dt)), self.min_samples)
-        self.refit = max(int(round(refit_s / dt)), 1)
+        self.min_samples, self.window, self.refit = config.first_fit, config.window, config.refit
         self.ridge = ridge
         self.history: list[np.ndarray] = []
         self.coefficients = None          # (nd, order), newest sample first

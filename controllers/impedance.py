@@ -3,14 +3,15 @@ frequency-domain statistics of a damper-spring law, and the stability of its clo
 
 Phasors exp(+i omega t), as python-control and `analysis.frequency_domain_response` (see
 `controllers.reactive` for the conventions of Z_i and the PTO impedance); the Thevenin
-equivalent itself is computed once, by `analysis.pto_thevenin` in exp(-i omega t), and
-conjugated here.
+equivalent itself is computed once, by `analysis.pto_thevenin` in exp(-i omega t) (the bound
+stack's, notebooks/guide.md "Conventions"), and converted here by `mbcontrol.lti.phasor`.
 """
 from __future__ import annotations
 
 import numpy as np
 
 from mbcontrol.errors import ControllerError
+from mbcontrol.lti import phasor
 from mbcontrol.plant import controlled_params
 
 
@@ -31,7 +32,7 @@ def intrinsic_impedance(plant, omega, *, pto: str | None = None, params=None,
     on this PTO itself as set by params, base_params); F_eq (N per m of wave amplitude): the
     force that drives it, so that with a PTO impedance Z_pto the PTO velocity is
     F_eq / (Z_i + Z_pto). The one computation is `mbcontrol.analysis.pto_thevenin` (exp(-i
-    omega t), the PTO's whole force): here its conjugate, converted at this edge, plus the
+    omega t), the PTO's whole force): here converted at this edge (`lti.phasor`), plus the
     law params sets on the PTO itself (c - i k / omega beside the controller).
     """
     from mbcontrol.analysis import pto_thevenin
@@ -40,7 +41,7 @@ def intrinsic_impedance(plant, omega, *, pto: str | None = None, params=None,
     base = base_params(plant, name, params)
     th = pto_thevenin(plant, omega, name, direction, base, check_passive=False)
     beside = base[f"{name}__damping"] - 1j * base[f"{name}__stiffness"] / omega
-    return np.conj(th.impedance) + beside, np.conj(th.excitation)
+    return phasor(th.impedance) + beside, phasor(th.excitation)
 
 
 def complex_conjugate_power(plant, wave, *, pto: str | None = None, params=None) -> float:

@@ -38,13 +38,33 @@ from mbcontrol.errors import ControllerError
 
 from .base import per_pto, signal_indices
 from .impedance import intrinsic_impedance
+from .law import Law
 from .limits import force_limits, limits_report, saturate
 from .tuning import electrical_winding
 
 
-class _Switching:
+class _Switching(Law):
     """Common machinery: per-PTO crossing detection, a timer, and a damper when engaged."""
     name = "switching"
+    kind, exportable = "switching", True        # the law protocol (controllers.law)
+    run_state = ("per PTO: held or not, the release time (s), the last velocity sign, the last "
+                 "sample (t, v, u) and the log of holds (`holds`: (on, off) times, s)")
+    units = {"damping": "N s/m (or N m s/rad)", "latch_time": "s", "declutch_time": "s",
+             "period": "s", "force_max": "N (or N m)"}
+
+    @classmethod
+    def tune(cls, plant, wave, pto=None, **options):
+        """The hold time and damping for a regular `wave`, found by simulating the plant
+        (its tuner below; options: Law.tune's, the PTO's limits taken where it takes them)."""
+        from .law import pto_of
+        from .law_tuning import tune_switching
+        return tune_switching(cls, cls._tuner(), plant, wave, pto_of(plant, pto), **options)
+
+    @staticmethod
+    def _tuner():
+        """The law's tuner (below): wave -> (hold time s, damping N s/m, simulated W)."""
+        raise NotImplementedError
+
     _moves_while_held = False     # the hold stops the PTO (latching) or frees it (declutching)
 
     def __init__(self, damping: float = 0.0, hold_time: float = 0.0,
@@ -133,6 +153,8 @@ class Latching(_Switching):
     (N or N m; None: the scene PTO's force_max).
     """
     name = "latching"
+    tuned = ("damping", "latch_time")
+    _tuner = staticmethod(lambda: optimal_latch_time)     # defined below
 
     def __init__(self, damping: float = 0.0, latch_time: float = 0.0,
                  period: float | None = None, force_max=None):
@@ -166,6 +188,8 @@ class Declutching(_Switching):
     force_max: N (or N m), the damper's saturation (None: the scene PTO's force_max).
     """
     name = "declutching"
+    tuned = ("damping", "declutch_time")
+    _tuner = staticmethod(lambda: optimal_declutch)       # defined below
     _moves_while_held = True
 
     def __init__(self, damping: float = 0.0, declutch_time: float = 0.0,

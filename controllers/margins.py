@@ -123,10 +123,11 @@ def _gains(law, pto: str):
                                   f"outputs")
         return "lti", law
     if isinstance(law, dict):
-        label, settings = "reactive" if "stiffness" in law else "passive", law
+        from . import linear_law_named
+        label, settings = linear_law_named(law), law
     else:
         label = getattr(law, "name", type(law).__name__)
-        if label not in ("passive", "reactive"):
+        if getattr(law, "kind", None) != "linear":
             raise ControllerError(f"margins: {label!r} is not a linear law (passive, reactive, a "
                                   f"dict of damping and stiffness, or an LTI K(s)); switching and "
                                   f"predictive controllers have no loop transfer")

@@ -53,42 +53,50 @@ wave) and its roll and pitch, are soft constraints at every step of the horizon,
 PEAK_SHARE of the check's limit (controllers.mpc_envelope; describe()["envelope"]). Without
 it the MPC rode PacWave's seas outside the linear model's range: sphere 28, rm3 17, OSWEC 10
 of 32 seas INVALID (200 s each); with it none.
+
+Three parts, as do-mpc separates settings, setup and data and Pinocchio its Model and Data:
+`mpc.settings` (MpcSettings, frozen: what `Mpc(**settings)` was given), `mpc.setup`
+(MpcSetup, built by reset(plant) from the plant and the settings, fixed once built) and
+`mpc.run` (MpcRun, this run's estimates, warm start and log, fresh at every reset).
+`mpc.build_setup(plant)` builds a setup without touching the controller: the exporter reads
+the settings and such a setup, never the caller's run. The names the Mpc had before the
+split read through: mpc.horizon_s is mpc.settings.horizon_s, mpc.qp is mpc.setup.qp,
+mpc.stats is mpc.run.stats (read-only).
 """
 from __future__ import annotations
 
-import math
+import inspect
 import time
 import warnings
+from typing import NamedTuple
 
 import numpy as np
 
-from mbcontrol.analysis import winding_coefficient
 from mbcontrol.errors import ControllerError
 from mbcontrol.results import jsonable
 
-from .base import signal_indices
-from .control_plant import build_control_plant, device_frequency, hydro_band, pto_impedance
-from .estimation import ArPredictor, ExcitationKalman, excitation_error, wave_frequencies
-from .limits import (LINEAR_RANGE_SHARE, command_limit, hull_limits, linear_range,
-                     per_pto_values)
-from .sampled import held_dampers
-from .mpc_envelope import MpcEnvelope
-from .mpc_qp import CondensedQp
+from .estimation import excitation_error
+from .law import PredictiveLaw
+from .limits import LINEAR_RANGE_SHARE
+from .mpc_settings import ORACLE_LABEL, SETTING_NAMES, MpcSettings
+from .mpc_setup import WARM_UP_PERIODS, MpcRun, MpcSetup, build_setup
 
-# warm-up before the first AR fit, in peak periods of the sea (or of the wave model without
-# a wave): 5 periods give the least-squares fit 5 T / dt_s samples (225 for rm3 at Tp 9 s,
-# dt_s 0.2 s: 28 per AR(8) coefficient), 3 periods past the simulation's ramp (2 Tp). The
-# root reflection alone already prevents the blow-up; the warm-up is for the fit's quality.
-# Measured on rm3 (Hs 2 m, Tp 9 s, seeds 0-2, 400 s, power over t >= 80 s): 278.5-279.3,
-# 254.1-255.9 and 247.9-248.8 kW for warm-ups of 0-5 periods (within 0.7 %), stabilised
-# fits 10 -> 3, 12 -> 6, 7 -> 1 from 0 to 5 periods; 8 periods gave +0.6 % to +4.4 % power
-# but costs another 27 s of every record's statistics
-WARM_UP_PERIODS = 5.0
-ORACLE_LABEL = "non-causal upper bound (true future wave)"
+__all__ = ["Mpc", "MpcSettings", "MpcSetup", "MpcRun", "MpcView", "ORACLE_LABEL",
+           "WARM_UP_PERIODS"]
 
 
-class Mpc:
-    """Linear MPC of the PTO force(s). Settings (the contract names first):
+class MpcView(NamedTuple):
+    """What leaves the controller for the exporter (Mpc.export_view): settings (frozen), a
+    setup built afresh for the plant (fixed), and description, the describe() of an MPC
+    bound to that setup before its first step."""
+    settings: MpcSettings
+    setup: MpcSetup
+    description: dict
+
+
+class Mpc(PredictiveLaw):
+    """Linear MPC of the PTO force(s). Settings (the contract names first; MpcSettings
+    gives each with its unit and default):
 
     horizon_s, dt_s: prediction horizon and control period, s (dt_s a multiple of the
     simulation step); force_max (N or N m), stroke_max (m or rad), rate_max (N/s): limits,
@@ -105,225 +113,161 @@ class Mpc:
     (electrical power for PTOs with a drivetrain: each step's winding loss R F^2 dt /
     (gear kt')^2 enters the QP), "electrical" or "mechanical"; envelope: keep the linear
     model's range (see the module docstring).
+
+    settings: MpcSettings; setup: MpcSetup of the last reset(plant) (None before); run:
+    MpcRun of this run (None before).
     """
     name = "mpc"
+    # the law protocol (controllers.law): its settings are MpcSettings, and with limits on, a
+    # limit the scene leaves free keeps the MPC's own default (a soft stroke in its range)
+    Settings, exportable, own_free_limits = MpcSettings, True, True
+    # what the C engine needs that Python does not: the exporter and its Python twin run
+    # with these settings (mbcontrol.cli.export adds them unless given, and says why)
+    export_settings = {"envelope": False}
+    export_note = ("the MPC is exported without the linear model's envelope (its "
+                   "relative-heave and angle constraints need a surface probe the C engine "
+                   "does not read yet): the export and its Python check both run with "
+                   "envelope=false")
 
-    def __init__(self, horizon_s: float = 10.0, dt_s: float = 0.2, force_max=None,
-                 stroke_max=None, rate_max=None, *, wave=None, forecast: str | None = None,
-                 estimator: str = "kalman", solver: str = "qpoases", order: int | None = None,
-                 force_penalty: float = 1e-3, stroke_penalty: float = 100.0,
-                 soft_stroke: bool = True, measured=None, ar_order: int = 8,
-                 measurement_noise: float = 1e-3, efficiency=None,
-                 warm_up_s: float | None = None, objective: str = "auto",
-                 envelope: bool = True):
-        forecast = forecast or "ar"        # causal by default; the oracle only when asked
-        _choice("forecast", forecast, ("known", "ar", "model", "none"))
-        _choice("estimator", estimator, ("kalman", "state"))
-        _choice("solver", solver, ("qpoases", "cvxpy"))
-        _choice("objective", objective, ("auto", "electrical", "mechanical"))
-        if forecast == "known" and wave is None:
-            raise ControllerError("mpc: forecast 'known' needs the wave (wave=...)")
-        if warm_up_s is not None and not warm_up_s >= 0:
-            raise ControllerError(f"mpc: warm_up_s must be >= 0 s, got {warm_up_s}")
-        if horizon_s < dt_s or dt_s <= 0:
-            raise ControllerError(f"mpc: expected 0 < dt_s <= horizon_s, got dt_s={dt_s}, "
-                                  f"horizon_s={horizon_s}")
-        self.horizon_s, self.dt_s = float(horizon_s), float(dt_s)
-        self.force_max, self.stroke_max, self.rate_max = force_max, stroke_max, rate_max
-        self.wave, self.forecast, self.estimator, self.solver = wave, forecast, estimator, solver
-        self.order, self.force_penalty, self.stroke_penalty = order, force_penalty, stroke_penalty
-        self.soft_stroke, self.measured, self.ar_order = soft_stroke, measured, ar_order
-        self.measurement_noise = measurement_noise
-        self.efficiency, self.objective = efficiency, objective
-        self.envelope = bool(envelope)
-        self.warm_up_setting = warm_up_s
-        self.period = self.dt_s
-        self.uses_state = estimator == "state"
+    def __init__(self, *args, **settings):
+        self.settings = MpcSettings(*args, **settings)
+        self.setup: MpcSetup | None = None
+        self.run: MpcRun | None = None
+
+    @classmethod
+    def from_settings(cls, settings: MpcSettings) -> Mpc:
+        """An Mpc with these settings (frozen: shared safely)."""
+        mpc = cls.__new__(cls)
+        mpc.settings, mpc.setup, mpc.run = settings, None, None
+        return mpc
+
+    @property
+    def period(self) -> float:
+        """s: the control period (zero-order hold), dt_s."""
+        return self.settings.dt_s
+
+    @property
+    def uses_state(self) -> bool:
+        return self.settings.uses_state
 
     # -- set-up --------------------------------------------------------------------------
+    def build_setup(self, plant) -> MpcSetup:
+        """A setup for `plant` from the settings; the controller is left as it is."""
+        return build_setup(self.settings, plant)
+
+    def export_view(self, plant) -> MpcView:
+        """The settings and a fresh setup for `plant` (with the description of an MPC bound
+        to it): all that mbcontrol.export reads. The controller is left as it is."""
+        twin = Mpc.from_settings(self.settings)
+        twin.reset(plant)
+        return MpcView(self.settings, twin.setup, twin.describe())
+
     def reset(self, plant) -> None:
-        self.plant = plant
-        self.env = MpcEnvelope(plant, self.wave, on=self.envelope, forecast=self.forecast,
-                               dt=self.dt_s)
-        self.cp = cp = build_control_plant(plant, self.dt_s, measured=self.measured,
-                                           order=self.order, extra_outputs=self.env.outputs)
-        ptos = [p for p in plant.scene.ptos if p.name in cp.ptos]
-        strokes = [p.stroke_max if math.isfinite(p.stroke_max) else linear_range(plant, p.name)
-                   for p in ptos]
-        self.stroke_default = None if self.stroke_max is not None else {
-            p.name: s for p, s in zip(ptos, strokes) if not math.isfinite(p.stroke_max)}
-        hull = hull_limits(ptos, list(cp.ptos), self.force_max)   # force_max_on = "hull"
-        self.limits = {
-            "force": per_pto_values(plant, self.force_max, [command_limit(p) for p in ptos],
-                                    "force_max"),
-            "stroke": per_pto_values(plant, self.stroke_max, strokes, "stroke_max"),
-            "rate": per_pto_values(plant, self.rate_max, [math.inf] * len(ptos), "rate_max"),
-        }
-        self.N = int(round(self.horizon_s / self.dt_s))
-        efficiency = per_pto_values(plant, self.efficiency, [p.efficiency for p in ptos], "efficiency")
-        self.device_omega = device_frequency(cp, hydro_band(plant))
-        if self.wave is None:
-            warnings.warn(f"mpc: no sea state given (wave=...): the Kalman wave model is centred "
-                          f"on the device's resonance seen from its PTO ({self.device_omega:.3g} "
-                          f"rad/s, period {2 * np.pi / self.device_omega:.3g} s), a guess; the "
-                          f"sea's own spectrum estimates the excitation better", RuntimeWarning,
-                          stacklevel=3)
-        omega = wave_frequencies(self.wave, self.device_omega)
-        winding = [0.0 if self.objective == "mechanical" else winding_coefficient(plant, p.name)
-                   or 0.0 for p in ptos]            # a drivetrain's R / (gear kt')^2, W/N^2
-        self.qp = CondensedQp(cp, self.N, self.limits, efficiency=efficiency, winding=winding,
-                              loss_damping=pto_impedance(cp, float(np.median(omega))),
-                              force_penalty=self.force_penalty,
-                              stroke_penalty=self.stroke_penalty, soft_stroke=self.soft_stroke,
-                              solver=self.solver, envelope=self.env.rows(cp), hull=hull)
-        if self.estimator == "kalman":
-            self.kalman = ExcitationKalman(cp, omega, measurement_noise=self.measurement_noise)
-        else:
-            self.kalman = None
-            if self.forecast != "known":
-                raise ControllerError("mpc: estimator 'state' knows no excitation; use forecast 'known'")
-        self.warm_up_planned = self._warm_up_time(cp)
-        self.ar = (ArPredictor(cp.nd, self.dt_s, order=self.ar_order,
-                               min_samples=int(math.ceil(self.warm_up_planned / self.dt_s - 1e-9))
-                               + 1)
-                   if self.forecast == "ar" else None)
-        self.env.forecast_like(self.ar)
-        self._velocity = signal_indices(plant, [f"{n}__velocity" for n in cp.ptos])
-        self.warm_up_damping = self._warm_up_damping(plant, cp, omega)
-        self.warm_up_end = None           # s: when the MPC took over
-        self._last_t = None
-        self._excitation_cache = (None, None)
-        self.u_prev = np.zeros(len(cp.ptos))
-        self._plan = None
-        self.stats = {"solves": 0, "failures": 0, "infeasible": 0, "solve_s": []}
-        self.history = []                 # (t, d estimate) per call, for checks and plots
-        self._warned = False
+        """Bind to `plant`: build the setup, start a fresh run."""
+        self.setup = build_setup(self.settings, plant)
+        self.run = self.setup.new_run()
 
     # -- the control law -----------------------------------------------------------------
     def __call__(self, t: float, y: np.ndarray, x: np.ndarray | None = None) -> np.ndarray:
-        cp = self.cp
-        if self._last_t is not None and t < self._last_t + self.dt_s * (1 - 1e-6):
+        s, r, st = self.setup, self.run, self.settings
+        if s is None:
+            raise ControllerError("mpc: call reset(plant) before using the controller")
+        cp = s.cp
+        if r.last_t is not None and t < r.last_t + st.dt_s * (1 - 1e-6):
             # called again within a period (simulate's closing sample, off the controller's
             # grid): hold the command. Updating the filter here would step its discrete model
             # by a whole period for a fraction of one (measured on rm3: a 228 MN command).
-            return self.u_prev.copy()
-        self._last_t = float(t)
-        if self.estimator == "state":
+            return r.u_prev.copy()
+        r.last_t = float(t)
+        if st.estimator == "state":
             z = cp.T @ np.asarray(x, float)
         else:
             ym = np.asarray(y, float)[cp.y_index] - cp.y_rest
-            self.kalman.update(ym, self.u_prev)
-            z = self.kalman.z
-        if self.kalman is not None:
-            self.history.append((t, self.kalman.d.copy()))
-            if self.ar is not None:
-                self.ar.append(self.kalman.d)
-        self.env.measure(t)              # the surface probes: a measurement, now
-        if self._warming_up(t):          # the tuned damper until the predictor has a fit
-            u = -self.warm_up_damping * np.asarray(y, float)[self._velocity]
-            self.u_prev = np.clip(u, -self.limits["force"], self.limits["force"])
-            return self.u_prev.copy()
-        known = self._known_forecast(t) if self.forecast == "known" else None
+            r.kalman.update(ym, r.u_prev)
+            z = r.kalman.z
+        if r.kalman is not None:
+            r.history.append((t, r.kalman.d.copy()))
+            if r.ar is not None:
+                r.ar.append(r.kalman.d)
+        s.env.measure(t, r.surface_ar)       # the surface probes: a measurement, now
+        velocity = list(s.velocity)
+        if self._warming_up(t):              # the tuned damper until the predictor has a fit
+            u = -s.warm_up_damping * np.asarray(y, float)[velocity]
+            r.u_prev = np.clip(u, -s.limits["force"], s.limits["force"])
+            return r.u_prev.copy()
+        known = self._known_forecast(t) if st.forecast == "known" else None
         D = self._forecast(known)
         start = time.perf_counter()
-        U, status = self.qp.solve(z, D, self.u_prev, self._plan, self.env.offset(t, self.N))
-        self.stats["solve_s"].append(time.perf_counter() - start)
-        self.stats["solves"] += 1
+        U, status = s.qp.solve(z, D, r.u_prev, r.plan, s.env.offset(t, s.N, r.surface_ar),
+                               work=r.qp)
+        r.stats["solve_s"].append(time.perf_counter() - start)
+        r.stats["solves"] += 1
         if U is None:
             self._failed(t, status)
             U = self._shifted_plan()
-        self._plan = U
+        r.plan = U
         u = U[0]
-        if self.warm_up_end is not None and t < self.warm_up_end + self.blend_s:
+        if r.warm_up_end is not None and t < r.warm_up_end + s.blend_s:
             # bumpless take-over: from the damper to the MPC over one peak period (its first
             # plan alone kicked rm3's PTO with 12 MN, 4x its later peaks)
-            share = (t - self.warm_up_end) / self.blend_s
-            u = share * u - (1 - share) * self.warm_up_damping * np.asarray(y, float)[
-                self._velocity]
-        self.u_prev = np.clip(u, -self.limits["force"], self.limits["force"])
-        return self.u_prev.copy()
+            share = (t - r.warm_up_end) / s.blend_s
+            u = share * u - (1 - share) * s.warm_up_damping * np.asarray(y, float)[velocity]
+        r.u_prev = np.clip(u, -s.limits["force"], s.limits["force"])
+        return r.u_prev.copy()
 
     def _forecast(self, known) -> np.ndarray:
-        n, nd = self.N, self.cp.nd
+        s, r = self.setup, self.run
+        n, nd = s.N, s.cp.nd
         if known is not None:
             return known
-        if self.forecast == "none" or nd == 0:
+        if self.settings.forecast == "none" or nd == 0:
             return np.zeros((n, nd))
-        if self.ar is not None:
-            predicted = self.ar.forecast(n)
+        if r.ar is not None:
+            predicted = r.ar.forecast(n)
             if predicted is not None:
                 return predicted
-        return self.kalman.model_forecast(n)
+        return r.kalman.model_forecast(n)
 
     def _warming_up(self, t: float) -> bool:
-        if self.warm_up_end is not None:
+        r = self.run
+        if r.warm_up_end is not None:
             return False
-        ready = (self.ar.coefficients is not None if self.ar is not None
-                 else t >= self.warm_up_planned - 1e-9)
+        ready = (r.ar.coefficients is not None if r.ar is not None
+                 else t >= self.setup.warm_up_planned - 1e-9)
         if ready:
-            self.warm_up_end = float(t)
+            r.warm_up_end = float(t)
         return not ready
-
-    def _warm_up_time(self, cp) -> float:
-        """Planned warm-up, s: the setting, or WARM_UP_PERIODS peak periods (AR forecast)."""
-        if self.wave is not None:
-            period = float(self.wave.period)
-        else:
-            period = 2 * np.pi / self.device_omega
-        if self.warm_up_setting is not None:
-            planned = float(self.warm_up_setting)
-        elif self.forecast != "ar":
-            planned = 0.0
-        else:
-            planned = max(WARM_UP_PERIODS * period, (4 * self.ar_order - 1) * self.dt_s)
-        self.blend_s = period if planned > 0 else 0.0      # the take-over's length, s
-        return planned
-
-    def _warm_up_damping(self, plant, cp, omega) -> np.ndarray:
-        """The warm-up damper per PTO, N s/m: optimal_damping for the sea (linear theory, the
-        other PTOs free), or |Z_i| at the wave model's median frequency (the regular-wave
-        optimum) without a wave or when the sea lies outside the hydro data. A limit on the
-        hull is not held during the warm-up (the command clip holds a machine limit)."""
-        out = pto_impedance(cp, float(np.median(omega)))
-        if self.wave is not None:
-            from .passive import optimal_damping
-            for i, name in enumerate(cp.ptos):
-                try:
-                    out[i] = optimal_damping(plant, self.wave, pto=name)[0]
-                except ValueError:
-                    pass
-        # held over dt_s, as it is applied: a damper tuned in continuous time can destabilise
-        # the sampled loop (rm3, Tp >= 11.3 s, dt_s 0.2 s: the cause of its divergences)
-        held, self.warm_up_factor = held_dampers(plant, dict(zip(cp.ptos, out)), self.dt_s)
-        return np.array([held[name] for name in cp.ptos])
 
     def _known_forecast(self, t: float) -> np.ndarray:
         """d at the midpoints of the next N periods from the wave (cached in blocks)."""
-        k0 = int(round(t / self.dt_s))
-        start, block = self._excitation_cache
-        if start is None or k0 < start or k0 + self.N > start + len(block):
-            times = (k0 + np.arange(self.N + 2000) + 0.5) * self.dt_s
-            block = self.plant.excitation(self.wave, times) @ self.cp.S.T
-            self._excitation_cache = (k0, block)
+        s, r, dt = self.setup, self.run, self.settings.dt_s
+        k0 = int(round(t / dt))
+        start, block = r.excitation_cache
+        if start is None or k0 < start or k0 + s.N > start + len(block):
+            times = (k0 + np.arange(s.N + 2000) + 0.5) * dt
+            block = s.plant.excitation(self.settings.wave, times) @ s.cp.S.T
+            r.excitation_cache = (k0, block)
             start = k0
-        return block[k0 - start:k0 - start + self.N]
+        return block[k0 - start:k0 - start + s.N]
 
     def _failed(self, t: float, status: str) -> None:
-        self.stats["failures"] += 1
+        r = self.run
+        r.stats["failures"] += 1
         if "infeasible" in status.lower():
-            self.stats["infeasible"] += 1
-        if not self._warned:
-            self._warned = True
+            r.stats["infeasible"] += 1
+        if not r.warned:
+            r.warned = True
             hint = (" The hard stroke limit cannot be met from this state; use soft_stroke=True "
-                    "(the default)." if not self.soft_stroke else "")
+                    "(the default)." if not self.settings.soft_stroke else "")
             warnings.warn(f"mpc: QP not solved at t = {t:.4g} s ({status}); applying the previous "
                           f"plan's next move.{hint} Counts are in describe()['stats'].",
                           RuntimeWarning, stacklevel=3)
 
     def _shifted_plan(self) -> np.ndarray:
-        if self._plan is None:
-            return np.zeros((self.N, len(self.cp.ptos)))
-        return np.vstack([self._plan[1:], self._plan[-1:]])
+        plan = self.run.plan
+        if plan is None:
+            return np.zeros((self.setup.N, len(self.setup.cp.ptos)))
+        return np.vstack([plan[1:], plan[-1:]])
 
     def casadi_law(self, plant):
         return None                      # dynamic (estimator, horizon): runs in Python
@@ -331,39 +275,39 @@ class Mpc:
     def estimation_report(self, t, W) -> dict | None:
         """The Kalman excitation estimate's accuracy against the simulation's true excitation
         W (on times t, s), after the warm-up (estimation.excitation_error); simulate calls it."""
-        if not self.history:
+        r = self.run
+        if r is None or not r.history:
             return None
-        start = self.warm_up_end if self.warm_up_end is not None else self.warm_up_planned
-        times, estimates = zip(*self.history)
-        return excitation_error(times, np.array(estimates), t, W, self.cp.S, start)
+        start = r.warm_up_end if r.warm_up_end is not None else self.setup.warm_up_planned
+        times, estimates = zip(*r.history)
+        return excitation_error(times, np.array(estimates), t, W, self.setup.cp.S, start)
 
     def describe(self) -> dict:
-        times = np.asarray(self.__dict__.get("stats", {}).get("solve_s", [])) * 1e3
-        stats = dict(self.__dict__.get("stats", {}))
-        stats.pop("solve_s", None)
-        if "qp" in self.__dict__:
-            stats["soft_solves"] = self.qp.soft_solves
-        if self.__dict__.get("ar") is not None:
-            stats["ar_fits"] = self.ar.fits
-            stats["ar_unstable_fits"] = self.ar.unstable_fits
+        st, s, r = self.settings, self.setup, self.run
+        stats = dict(r.stats) if r is not None else {}
+        times = np.asarray(stats.pop("solve_s", [])) * 1e3
+        if r is not None:
+            stats["soft_solves"] = r.qp.soft_solves
+            if r.ar is not None:
+                stats["ar_fits"] = r.ar.fits
+                stats["ar_unstable_fits"] = r.ar.unstable_fits
         if times.size:
             stats.update(solve_ms_median=float(np.median(times)),
                          solve_ms_p95=float(np.percentile(times, 95)))
-        out = {"name": self.name, "horizon_s": self.horizon_s, "dt_s": self.dt_s,
-               "force_max": jsonable(self.force_max), "stroke_max": jsonable(self.stroke_max),
-               "rate_max": jsonable(self.rate_max), "forecast": self.forecast,
-               "oracle": self.forecast == "known" or self.uses_state,
-               "label": self.label(),
-               "estimator": self.estimator + (" (full-state oracle)" if self.uses_state else ""),
-               "solver": self.solver, "order": self.order, "soft_stroke": self.soft_stroke,
-               "envelope_on": self.envelope,
+        out = {"name": self.name, "horizon_s": st.horizon_s, "dt_s": st.dt_s,
+               "force_max": jsonable(st.force_max), "stroke_max": jsonable(st.stroke_max),
+               "rate_max": jsonable(st.rate_max), "forecast": st.forecast,
+               "oracle": st.oracle, "label": st.label(),
+               "estimator": st.estimator + (" (full-state oracle)" if st.uses_state else ""),
+               "solver": st.solver, "order": st.order, "soft_stroke": st.soft_stroke,
+               "envelope_on": st.envelope,
                "period_s": self.period, "stats": stats}
         out.update(self._warm_up_report())
-        if "env" in self.__dict__ and self.envelope:
-            out["envelope"] = self.env.report()
-        if self.__dict__.get("stroke_default"):
+        if s is not None and st.envelope:
+            out["envelope"] = s.env.report()
+        if s is not None and s.stroke_default:
             out["stroke_max_default"] = {
-                "values": {k: float(v) for k, v in self.stroke_default.items()},
+                "values": {k: float(v) for k, v in s.stroke_default.items()},
                 "why": f"the scene sets no stroke limit: a soft one at {LINEAR_RANGE_SHARE:g} of "
                        f"the linear-hydrodynamics range (30 deg; the shallowest mean draft), "
                        f"where the MPC's linear model holds"}
@@ -371,30 +315,44 @@ class Mpc:
 
     def label(self) -> str:
         """How causal the run is, for JSON, Datasets and figure legends."""
-        if self.forecast == "known":
-            return ORACLE_LABEL
-        causal = {"ar": "causal (AR forecast of the Kalman excitation estimate)",
-                  "model": "causal (Kalman wave-model forecast)",
-                  "none": "causal (no forecast)"}[self.forecast]
-        return causal + ("; full-state oracle" if self.uses_state else "")
+        return self.settings.label()
 
     def _warm_up_report(self) -> dict:
         """warm_up_s: when the MPC took over (the plan before a run, or when it never did)."""
-        if "warm_up_planned" not in self.__dict__:
-            return {"warm_up_s": self.warm_up_setting}
-        end = self.warm_up_end if self.warm_up_end is not None else self.warm_up_planned
+        s, r = self.setup, self.run
+        if s is None:
+            return {"warm_up_s": self.settings.warm_up_s}
+        end = r.warm_up_end if r.warm_up_end is not None else s.warm_up_planned
         return {"warm_up_s": float(end),
                 "warm_up": {"law": "passive damper u = -c v until the first AR fit"
-                            if self.ar is not None else "passive damper u = -c v",
-                            "damping": [float(c) for c in self.warm_up_damping],
+                            if s.ar is not None else "passive damper u = -c v",
+                            "damping": [float(c) for c in s.warm_up_damping],
                             # < 1: the sea's damper scaled down to keep its loop held over
                             # dt_s stable (controllers.sampled.held_dampers)
-                            "held_factor": float(self.warm_up_factor),
-                            "planned_s": float(self.warm_up_planned),
-                            "take_over_s": float(self.blend_s),
-                            "completed": self.warm_up_end is not None}}
+                            "held_factor": float(s.warm_up_factor),
+                            "planned_s": float(s.warm_up_planned),
+                            "take_over_s": float(s.blend_s),
+                            "completed": r.warm_up_end is not None}}
 
 
-def _choice(what, value, allowed):
-    if value not in allowed:
-        raise ControllerError(f"mpc: {what} must be one of {', '.join(allowed)}, got {value!r}")
+def _view(part: str, name: str) -> property:
+    def read(self):
+        holder = getattr(self, part)
+        if holder is None:
+            raise AttributeError(f"mpc.{name}: call reset(plant) first (it is mpc.{part}.{name})")
+        return getattr(holder, name)
+    return property(read, doc=f"mpc.{part}.{name} (read-only)")
+
+
+# the Mpc's names from before the split, read-only, each from the part that now holds it
+for _name in SETTING_NAMES:
+    setattr(Mpc, _name, _view("settings", _name))
+for _name in ("plant", "cp", "qp", "N", "limits", "env", "device_omega", "stroke_default",
+              "warm_up_planned", "blend_s", "warm_up_damping", "warm_up_factor"):
+    setattr(Mpc, _name, _view("setup", _name))
+for _name in ("stats", "history", "warm_up_end", "u_prev", "ar"):
+    setattr(Mpc, _name, _view("run", _name))
+Mpc.warm_up_setting = _view("settings", "warm_up_s")
+# Mpc(**settings) takes exactly MpcSettings' arguments (one list of names and defaults)
+Mpc.__signature__ = inspect.signature(MpcSettings).replace(
+    return_annotation=inspect.Signature.empty)

@@ -19,6 +19,9 @@ to qpOASES's own tolerances, so the result is the QP's unique optimum, not an ap
 Measured on the demo's rate-limited MPC: ~70 % of calls settle in step 1 (1-2 iterations).
 Parallel rows (the stroke and the first step's force, an envelope's heave and pitch rows)
 are merged into one row with the tightest bounds: a working set must be independent.
+`ActiveSetQp` holds only what H and A fix (built once, never changed by a solve); what one
+run's calls carry from one to the next (the last active set, the counters) is its
+`ActiveSetMemory`, passed to every call.
 """
 from __future__ import annotations
 
@@ -35,9 +38,20 @@ SKIP_AFTER, PROBE_EVERY = 3, 8   # after 3 calls in a row left to qpOASES, try 1
 PARALLEL = 1 - 1e-12   # |cos| between rows treated as the same constraint
 
 
+class ActiveSetMemory:
+    """One run's warm start for an ActiveSetQp: the last active set (W: merged rows, up: at
+    their upper bounds), counts (calls settled by each step, and those left to the caller)
+    and misses (calls in a row left to the caller)."""
+
+    def __init__(self):
+        self.W, self.up = np.zeros(0, int), np.zeros(0, bool)
+        self.counts = {"warm": 0, "dual": 0, "fallback": 0, "skipped": 0}
+        self.misses = 0
+
+
 class ActiveSetQp:
     """Verified solves of min 1/2 x'Hx + g'x, lbx <= x <= ubx, lba <= A x <= uba (H, A
-    fixed). counts: calls settled by each step, and those left to the caller."""
+    fixed); each call reads and updates the caller's ActiveSetMemory (`memory()`)."""
 
     def __init__(self, H, A):
         H, A = np.asarray(H, float), np.asarray(A, float)
@@ -57,15 +71,17 @@ class ActiveSetQp:
         self.M = Cg @ self.HiCt
         self.m = reps.size
         self.group_of_row = group
-        self.W, self.up = np.zeros(0, int), np.zeros(0, bool)     # the last active set
-        self.counts = {"warm": 0, "dual": 0, "fallback": 0, "skipped": 0}
-        self.misses = 0                   # calls in a row left to the caller
 
-    def solve(self, g, lbx, ubx, lba, uba):
+    @staticmethod
+    def memory() -> ActiveSetMemory:
+        """A fresh warm start (no active set yet): one per run."""
+        return ActiveSetMemory()
+
+    def solve(self, g, lbx, ubx, lba, uba, memory: ActiveSetMemory):
         """x, or None when neither step found a verified optimum (then call remember)."""
-        if self.misses >= SKIP_AFTER and (self.misses - SKIP_AFTER) % PROBE_EVERY:
-            self.misses += 1
-            self.counts["skipped"] += 1
+        if memory.misses >= SKIP_AFTER and (memory.misses - SKIP_AFTER) % PROBE_EVERY:
+            memory.misses += 1
+            memory.counts["skipped"] += 1
             return None
         lo0 = np.concatenate([lbx, lba])
         hi0 = np.concatenate([ubx, uba])
@@ -74,28 +90,28 @@ class ActiveSetQp:
         cxu = self.Cg @ xu
         for step, found in (("warm", self._pdas), ("dual", self._dual)):
             try:
-                got = found(cxu, lo, hi)
+                got = found(cxu, lo, hi, memory)
                 x = None if got is None else self._verified(g, *got, xu, hi, lo, lo0, hi0)
             except (ArithmeticError, ValueError):
                 x = None
             if x is not None:
-                self.W, self.up = got[0], got[1]
-                self.counts[step] += 1
-                self.misses = 0
+                memory.W, memory.up = got[0], got[1]
+                memory.counts[step] += 1
+                memory.misses = 0
                 return x
-        self.counts["fallback"] += 1
-        self.misses += 1
+        memory.counts["fallback"] += 1
+        memory.misses += 1
         return None
 
-    def remember(self, lam_x, lam_a):
+    def remember(self, lam_x, lam_a, memory: ActiveSetMemory):
         """The active set of a solve done elsewhere (nonzero multipliers: > 0 at the upper
         bound), the next call's start."""
         lam = np.concatenate([np.ravel(lam_x), np.ravel(lam_a)])
         rows = np.flatnonzero(lam != 0)
         groups, first = np.unique(self.group_of_row[rows], return_index=True)
         rows = rows[first]
-        self.W = groups
-        self.up = (lam[rows] > 0) == self.pos[rows]
+        memory.W = groups
+        memory.up = (lam[rows] > 0) == self.pos[rows]
 
     # -- the steps ---------------------------------------------------------------------
     def _merged(self, lo, hi):
@@ -117,9 +133,9 @@ class ActiveSetQp:
         _, _, nu, info = lapack.dgesv(self.M.take(W, 0).take(W, 1), cxu[W] - b)
         return None if info else nu
 
-    def _pdas(self, cxu, lo, hi):
+    def _pdas(self, cxu, lo, hi, memory):
         """(W, up, nu) from the last active set, adding and dropping rows wholesale."""
-        W, up = self.W, self.up
+        W, up = memory.W, memory.up
         for _ in range(PDAS_ITERATIONS):
             nu = self._eqp(W, up, cxu, lo, hi)
             if nu is None:
@@ -137,10 +153,10 @@ class ActiveSetQp:
             up = side[W]
         return None
 
-    def _dual_start(self, cxu, lo, hi):
+    def _dual_start(self, cxu, lo, hi, memory):
         """A dual-feasible start for the dual method: the last active set less the rows
         whose multipliers have the wrong sign (the empty set if it is singular)."""
-        W, up = self.W, self.up
+        W, up = memory.W, memory.up
         for _ in range(PDAS_ITERATIONS):
             nu = self._eqp(W, up, cxu, lo, hi)
             if nu is None:
@@ -151,12 +167,12 @@ class ActiveSetQp:
             W, up = W[right], up[right]
         return np.zeros(0, int), np.zeros(0, bool), np.zeros(0)
 
-    def _dual(self, cxu, lo, hi):
+    def _dual(self, cxu, lo, hi, memory):
         """(W, up, nu) by Goldfarb and Idnani's dual method from a dual-feasible start. In
         the outward form s c x <= s b (s = +1 at an upper bound) every multiplier mu >= 0
         throughout; each step adds the most violated row or drops one."""
         M = self.M
-        Wa, upa, nu = self._dual_start(cxu, lo, hi)
+        Wa, upa, nu = self._dual_start(cxu, lo, hi, memory)
         cx = cxu - M[:, Wa] @ nu
         W, s = list(Wa), list(np.where(upa, 1.0, -1.0))
         mu = np.abs(nu)

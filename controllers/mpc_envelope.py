@@ -8,16 +8,18 @@ relative heave needs the surface at the body: a probe measures it each period (t
 at the body's centre of buoyancy, now: causal) and it is forecast as the excitation is (an
 AR model of the probe's samples), or taken from the wave with the oracle forecast "known".
 Without a wave nothing measures the surface, and relative heaves are left out.
+The envelope is part of the MPC's setup (fixed once built); a run's surface predictor is its
+own (made from `surface_config`, passed to `measure` and `offset`).
 """
 from __future__ import annotations
 
 import numpy as np
 
-from .estimation import ArPredictor
+from .estimation import ArConfig, ArPredictor
 
 
 class MpcEnvelope:
-    """The envelope rows of one MPC, built in its reset().
+    """The envelope rows of one MPC, part of its setup.
 
     items: analysis.envelope.EnvelopeItems kept; limits: their peak limits (m or rad);
     probes: (wave seen at the body, item index) per relative heave."""
@@ -32,14 +34,12 @@ class MpcEnvelope:
                            for k, i in enumerate(self.items) if i.relative]
         self.limits = PEAK_SHARE * np.array([i.limit for i in self.items])
         self.forecast, self.dt = forecast, dt
-        self.surface_ar = None
 
-    def forecast_like(self, ar: ArPredictor | None) -> None:
-        """Forecast the probes' surface as `ar` forecasts the excitation (its order and
-        warm-up), or not at all (None)."""
-        self.surface_ar = (ArPredictor(len(self.probes), self.dt, order=ar.order,
-                                       min_samples=ar.min_samples)
-                           if ar is not None and self.probes else None)
+    def surface_config(self, ar: ArConfig | None) -> ArConfig | None:
+        """The probes' surface predictor: as `ar` forecasts the excitation (its order and
+        warm-up), or none (None) without the AR forecast or probes."""
+        return (ArConfig(len(self.probes), self.dt, order=ar.order, min_samples=ar.first_fit)
+                if ar is not None and self.probes else None)
 
     @property
     def outputs(self) -> list[str]:
@@ -54,23 +54,23 @@ class MpcEnvelope:
         sign = np.array([-1.0 if i.relative else 1.0 for i in self.items])
         return (sign / self.limits)[:, None] * cp.Ce
 
-    def measure(self, t: float) -> None:
-        """A probe sample of the surface at each body, now (for the AR forecast)."""
-        if self.surface_ar is not None:
-            self.surface_ar.append([probe.elevation(np.array([t]))[0]
-                                    for probe, _ in self.probes])
+    def measure(self, t: float, surface_ar: ArPredictor | None) -> None:
+        """A probe sample of the surface at each body, now, into the run's predictor."""
+        if surface_ar is not None:
+            surface_ar.append([probe.elevation(np.array([t]))[0] for probe, _ in self.probes])
 
-    def offset(self, t: float, n: int):
+    def offset(self, t: float, n: int, surface_ar: ArPredictor | None):
         """(n, ne): minus the surface forecast at the ends of the next n periods over each
-        relative heave's peak limit (0 for angles); None without probes."""
+        relative heave's peak limit (0 for angles; surface_ar: the run's predictor); None
+        without probes."""
         if not self.probes:
             return None
         eta = np.zeros((n, len(self.probes)))
         if self.forecast == "known":           # the oracle sees the future surface too
             times = t + self.dt * np.arange(1, n + 1)
             eta = np.column_stack([probe.elevation(times) for probe, _ in self.probes])
-        elif self.surface_ar is not None:
-            predicted = self.surface_ar.forecast(n, midpoints=False)
+        elif surface_ar is not None:
+            predicted = surface_ar.forecast(n, midpoints=False)
             eta = predicted if predicted is not None else eta
         out = np.zeros((n, len(self.items)))
         for j, (_, k) in enumerate(self.probes):

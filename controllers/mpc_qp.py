@@ -1,8 +1,13 @@
 """The MPC's quadratic programme: condensed (states eliminated), scaled, built once, solved
-by qpOASES (real-time path) or cvxpy/Clarabel (prototyping path); see `controllers.mpc`."""
+by qpOASES (real-time path) or cvxpy/Clarabel (prototyping path); see `controllers.mpc`.
+A CondensedQp is fixed once built; what a run carries from one solve to the next (the form
+that solved last, the warm-starting active set, counters) is its own `QpWork`."""
 from __future__ import annotations
 
 import contextlib
+import io
+import os
+import sys
 
 import numpy as np
 
@@ -25,7 +30,7 @@ class CondensedQp:
     gear^2 b, gear^2 K, limit): that force, u - gear^2 (J a + b v + K x), at the start and
     the end of each held step kept within the limit (hard; soft in the soft form): within a
     step it moves with the motion, smooth over a step much shorter than the wave's period.
-    solve(z0, D, u_prev, warm, offset) -> (U (N, nu) or None, status).
+    solve(z0, D, u_prev, warm, offset, work) -> (U (N, nu) or None, status).
     """
 
     def __init__(self, cp, N: int, limits: dict, *, efficiency, loss_damping,
@@ -95,12 +100,17 @@ class CondensedQp:
         self.forms = [_QpForm(self, soft=False, backend=backend)]
         if (soft_stroke and self.has_stroke) or self.n_env or self.n_hull:
             self.forms.append(_QpForm(self, soft=True, backend=backend))
-        self._last, self.soft_solves = 0, 0
 
-    def solve(self, z0, D, u_prev, warm=None, offset=None):
+    def workspace(self) -> "QpWork":
+        """A fresh run's solver state (no warm start): one per run."""
+        return QpWork(self)
+
+    def solve(self, z0, D, u_prev, warm=None, offset=None, work: "QpWork | None" = None):
         """(U (N, nu) N or N m, status), or (None, status) when no form could be solved.
         offset (N, ne): what the envelope rows add that no state holds (minus the forecast
-        surface elevation over the limit, for a relative heave), None: nothing."""
+        surface elevation over the limit, for a relative heave), None: nothing. work: the
+        run's QpWork, read and updated (None: a fresh one, a cold start)."""
+        work = self.workspace() if work is None else work
         z0, D, u_prev = np.asarray(z0, float), np.asarray(D, float), np.asarray(u_prev, float)
         free = []                                     # what each row block is with U = 0
         if self.has_stroke:
@@ -114,15 +124,24 @@ class CondensedQp:
         status = "not solved"
         # start with the form that solved last time: the hard QP is infeasible for stretches
         # (a wave group), and an active-set solver takes long to prove infeasibility
-        order = self.forms if self._last == 0 else self.forms[::-1]
-        for form in order:
-            sol, status, slack = form.solve(q, free, u_prev, warm)
+        order = list(enumerate(self.forms))
+        for i, form in (order if work.last == 0 else order[::-1]):
+            sol, status, slack = form.solve(q, free, u_prev, warm, memory=work.forms[i])
             if sol is not None:
                 # back to the hard form once the slack is no longer used
-                self._last = int(form.soft and slack > 1e-6)
-                self.soft_solves += int(form.soft)
+                work.last = int(form.soft and slack > 1e-6)
+                work.soft_solves += int(form.soft)
                 return (sol * self.Fs).reshape(self.N, self.nu), status
         return None, status
+
+
+class QpWork:
+    """One run's state of a CondensedQp: last (0: the hard form solved last, 1: the soft
+    one), soft_solves (count), forms (per form its backend's memory: the warm start)."""
+
+    def __init__(self, qp: CondensedQp):
+        self.last, self.soft_solves = 0, 0
+        self.forms = [form.backend.memory() for form in qp.forms]
 
 
 class _QpForm:
@@ -192,12 +211,15 @@ class _QpForm:
         join = (lambda parts: np.concatenate(parts) if parts else np.zeros(0))
         return g, join(lba), join(uba)
 
-    def solve(self, q, free, u_prev, warm):
+    def solve(self, q, free, u_prev, warm, memory=None):
+        """(scaled forces or None, status, largest slack); memory: the backend's run state
+        (QpWork.forms; None: a fresh one)."""
         g, lba, uba = self.bounds(q, free, u_prev)
         x0 = np.zeros(self.n_var)
         if warm is not None:
             x0[:self.n_u] = np.vstack([warm[1:], warm[-1:]]).ravel() / self.qp.Fs
-        sol, status = self.backend.solve(g, self.lbx, self.ubx, lba, uba, x0)
+        memory = self.backend.memory() if memory is None else memory
+        sol, status = self.backend.solve(g, self.lbx, self.ubx, lba, uba, x0, memory)
         if sol is None:
             return None, status, 0.0
         return sol[:self.n_u], status, float(np.max(sol[self.n_u:], initial=0.0))
@@ -207,28 +229,31 @@ class _QpoasesBackend:
     """Dense qpOASES through CasADi's conic interface; H and A fixed, built once. On the hard
     form each call first tries the verified active-set shortcut (mpc_active_set: the same
     optimum, and CasADi's qpOASES starts cold at every call); not on the soft form (met only
-    when the hard QP is infeasible, 6x the variables: there the shortcut measured slower)."""
+    when the hard QP is infeasible, 6x the variables: there the shortcut measured slower).
+    A run's memory: the shortcut's active set and whether qpOASES has been called yet."""
 
     def __init__(self, form):
         import casadi as ca
         self.H, self.A = ca.DM(form.H), ca.DM(form.A)      # converted once, not per call
         self.fast = None if form.soft else ActiveSetQp(form.H, form.A)
-        self.called = False
         opts = {"printLevel": "none", "sparse": False, "error_on_fail": False,
                 "hessian_type": "posdef"}
         self.solver = _quiet(lambda: ca.conic(
             "mpc_qp", "qpoases", {"h": ca.DM(form.H).sparsity(), "a": ca.DM(form.A).sparsity()},
             opts))
 
-    def solve(self, g, lbx, ubx, lba, uba, x0):
+    def memory(self) -> dict:
+        return {"fast": None if self.fast is None else self.fast.memory(), "called": False}
+
+    def solve(self, g, lbx, ubx, lba, uba, x0, memory):
         if self.fast is not None:
-            x = self.fast.solve(g, lbx, ubx, lba, uba)
+            x = self.fast.solve(g, lbx, ubx, lba, uba, memory["fast"])
             if x is not None:
                 return x, "solved"
         call = (lambda: self.solver(h=self.H, a=self.A, g=g, lbx=lbx, ubx=ubx, lba=lba,
                                     uba=uba, x0=x0))
-        if not self.called:                 # qpOASES prints its banner on the first solve
-            self.called = True
+        if not memory["called"]:            # qpOASES prints its banner on the first solve
+            memory["called"] = True
             out = _quiet(call)
         else:
             # and reports an infeasible QP (counted in the MPC's stats) through CasADi's
@@ -239,7 +264,8 @@ class _QpoasesBackend:
         if not stats.get("success", False):
             return None, str(stats.get("return_status", "failed"))
         if self.fast is not None:               # the next call starts from this active set
-            self.fast.remember(np.asarray(out["lam_x"]), np.asarray(out["lam_a"]))
+            self.fast.remember(np.asarray(out["lam_x"]), np.asarray(out["lam_a"]),
+                               memory["fast"])
         return np.asarray(out["x"]).ravel(), "solved"
 
 
@@ -272,7 +298,9 @@ class _CvxpyBackend:
         objective = 0.5 * cp.sum_squares(factor.T @ self.x) + self.g @ self.x
         self.problem = cp.Problem(cp.Minimize(objective), cons)
 
-    def solve(self, g, lbx, ubx, lba, uba, x0):
+    memory = staticmethod(lambda: None)   # Clarabel starts afresh; Parameters set per call
+
+    def solve(self, g, lbx, ubx, lba, uba, x0, memory=None):
         import cvxpy as cp
         self.g.value = g
         self.lba.value, self.uba.value = lba[self.lo_rows], uba[self.hi_rows]
@@ -354,10 +382,6 @@ _DISCARD = _Discard()
 def _quiet(call):
     """Run with output silenced: qpOASES prints a banner, through CasADi's stream (which
     CasADi hands to Python's sys.stdout) or straight to the process's stdout."""
-    import contextlib
-    import io
-    import os
-    import sys
     sys.stdout.flush()
     sys.stderr.flush()
     saved = [os.dup(1), os.dup(2)]

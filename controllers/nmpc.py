@@ -41,6 +41,7 @@ from mbcontrol.errors import ControllerError, UnknownName
 from mbcontrol.sim import rk4_step
 
 from .base import signal_indices
+from .law import PredictiveLaw
 
 STATE_NOTE = ("full-state feedback: an oracle that reads the plant's whole state x, "
               "radiation states included (no real device measures them)")
@@ -49,7 +50,7 @@ STATE_NOTE = ("full-state feedback: an oracle that reads the plant's whole state
 ORACLE_LABEL = "non-causal upper bound (true future wave, full state)"
 
 
-class Nmpc:
+class Nmpc(PredictiveLaw):
     """Nonlinear MPC of one PTO's force, maximising absorbed energy over a receding horizon.
 
     wave: the sea the controller forecasts (excitation known exactly; required): a
@@ -73,8 +74,9 @@ class Nmpc:
     stiffness are zero, as simulate sets them in closed loop).
     max_iter, tol, max_cpu_time (s, per solve), ipopt (dict): IPOPT settings.
     """
-    name = "nmpc"
+    name = "nmpc"     # the law protocol (controllers.law): a predictive law, not exported
     uses_state = True
+    export_refusal = "NMPC's solver, IPOPT, generates no C"    # why not (mbcontrol.export)
 
     def __init__(self, wave, *, horizon_s: float = 10.0, dt_s: float = 0.25, substeps: int = 2,
                  force_max: float | None = None, stroke_max: float | None = None,

@@ -16,11 +16,12 @@ from mbcontrol.errors import ControllerError
 
 from .base import per_pto, signal_indices
 from .impedance import base_params, default_bounds
+from .law import Law
 from .limits import casadi_saturate, force_limits, limits_report, linear_law_parametric, saturate
 from .tuning import constrained_tuning, electrical_winding
 
 
-class Passive:
+class Passive(Law):
     """A linear damper on every PTO: u = sat(-damping * v), the PTO's whole force.
 
     damping: N s/m (or N m s/rad) per PTO, one number for all, or a dict by PTO name. In
@@ -29,6 +30,19 @@ class Passive:
     the scene PTO's force_max; inf: none).
     """
     name = "passive"
+    kind, tuned, exportable = "linear", ("damping",), True     # the law protocol (controllers.law)
+    run_state = "none: the gains and limits bound by reset(plant); no memory between calls"
+    units = {"damping": "N s/m (or N m s/rad)", "period": "s", "force_max": "N (or N m)"}
+
+    @classmethod
+    def tune(cls, plant, wave, pto=None, **options):
+        """The damping of `optimal_damping` (below) for `wave`, within the PTO's limits, the
+        linear model's envelope and its rated power (options: Law.tune's); several PTOs
+        tuned jointly (controllers.joint)."""
+        from .law import pto_of
+        from .law_tuning import tune_linear
+        return tune_linear(cls, optimal_damping, plant, wave, pto_of(plant, pto),
+                           **options)
 
     def __init__(self, damping=0.0, period: float | None = None, force_max=None):
         self.damping = damping

@@ -34,11 +34,12 @@ from mbcontrol.errors import ControllerError
 
 from .base import per_pto, signal_indices
 from .impedance import closed_loop_stability, intrinsic_impedance
+from .law import Law
 from .limits import casadi_saturate, force_limits, limits_report, linear_law_parametric, saturate
 from .tuning import constrained_tuning, electrical_winding, multistart
 
 
-class Reactive:
+class Reactive(Law):
     """Damper and spring on every PTO: u = sat(-(damping * v + stiffness * x)), the PTO's force.
 
     damping: N s/m (or N m s/rad), >= 0; stiffness: N/m (or N m/rad), any sign. Each one
@@ -49,6 +50,21 @@ class Reactive:
     does not bound the stroke: tune with reactive_tuning(..., force_max=, stroke_max=).
     """
     name = "reactive"
+    # the law protocol (controllers.law); tuned within the robustness floors when robust
+    kind, tuned, exportable, floors = "linear", ("damping", "stiffness"), True, True
+    run_state = "none: the gains and limits bound by reset(plant); no memory between calls"
+    units = {"damping": "N s/m (or N m s/rad)", "stiffness": "N/m (or N m/rad)",
+             "period": "s", "force_max": "N (or N m)"}
+
+    @classmethod
+    def tune(cls, plant, wave, pto=None, **options):
+        """The (damping, stiffness) of `reactive_tuning` (below) for `wave`, within the PTO's
+        limits, the linear model's envelope, its rated power and, robust, the robustness
+        floors (options: Law.tune's); several PTOs tuned jointly (controllers.joint)."""
+        from .law import pto_of
+        from .law_tuning import tune_linear
+        return tune_linear(cls, reactive_tuning, plant, wave, pto_of(plant, pto),
+                           **options)
 
     def __init__(self, damping=0.0, stiffness=0.0, period: float | None = None,
                  force_max=None):

@@ -91,7 +91,8 @@ def share_explained(plant, wave, pto: str, predicted_W: float, name: str,
     theory: the bound with every force allowed, the bound inside the envelope, and the law's
     prediction; the gap between the last two is what a fixed damper (and spring) cannot do
     across the sea's frequencies (robust: and within the robustness floors), the gap between
-    the first two what the envelope forbids."""
+    the first two what the envelope forbids. name: the registered linear law (its `tuned`
+    says whether it has a spring, its `floors` whether robust tuning bound it)."""
     from mbcontrol.analysis import envelope_bound
     b = envelope_bound(plant, wave, pto)
     cc, inside = b["unconstrained_W"], b["bound_W"]
@@ -108,7 +109,10 @@ def share_explained(plant, wave, pto: str, predicted_W: float, name: str,
                            + (f", {', '.join(b['binding'])} binding" if b["binding"] else "")
                            + ")")
         return out
-    law = "a damper" if name == "passive" else "a damper and spring"
+    from . import REGISTRY
+    cls = REGISTRY[name]
+    spring = "stiffness" in cls.tuned
+    law = "a damper and spring" if spring else "a damper"
     parts = [f"the law predicts {100 * predicted_W / cc:.3g} % of the complex-conjugate bound"]
     if b["binding"]:
         parts.append(f"the envelope ({', '.join(b['binding'])}) caps any force at "
@@ -117,8 +121,8 @@ def share_explained(plant, wave, pto: str, predicted_W: float, name: str,
     if gap > 0.5:
         parts.append(f"the other {gap:.3g} points are what {law} fixed for the sea"
                      + (" within the robustness floors (--aggressive lifts them)"
-                        if robust and name == "reactive" else "")
+                        if robust and cls.floors else "")
                      + " cannot do: it matches the device's impedance at one frequency at most"
-                     + (" and absorbs no reactive power" if name == "passive" else ""))
+                     + ("" if spring else " and absorbs no reactive power"))
     out["why"] = "; ".join(parts)
     return out

@@ -14,6 +14,7 @@ lists every key with its value and where the value came from.
 """
 from __future__ import annotations
 
+import math
 import os
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -52,6 +53,13 @@ _REGISTRY: dict[str, Default] = {
     "sweep.method": Default("rk4", "", "fixed-step method of sweep cases", str),
     "sweep.workers": Default(-1, "", "local Dask workers of a sweep: -1 one per core, "
                                      "0 serial in this process", int),
+    "sweep.cluster": Default("auto", "", "a sweep's local Dask cluster: auto (only when it "
+                                         "pays, timed) or always", str),
+    "sweep.start": Default("spawn", "", "how a sweep's local Dask workers start: spawn (fresh "
+                                        "interpreters) or fork (faster; may hang a threaded "
+                                        "process)", str),
+    "compile.cc": Default("", "", "C compiler of the compiled simulation code (empty: gcc, "
+                                  "else cc)", str, env="CC"),
     "dask.host": Default("127.0.0.1", "", "address local Dask clusters (sweeps, co-design) "
                                           "and their web server listen on", str),
     "identify.dt": Default(0.01, "s", "simulation step of identification runs"),
@@ -68,6 +76,59 @@ _REGISTRY: dict[str, Default] = {
     "design.phase_margin_min_deg": Default(30.0, "deg", "least phase margin of a linear law "
                                                         "design and export tune and ship "
                                                         "(--aggressive: none)"),
+    # Result-shaping thresholds (issue 59): each was a module constant; same built-in values
+    "validity.power_allowance": Default(0.10, "", "share above the power bound a result's mean "
+                                                  "power may reach before it is INVALID"),
+    "validity.energy_tolerance": Default(0.05, "", "energy balance error a valid result may "
+                                                   "have, as a share of the excitation's "
+                                                   "absolute work over the record"),
+    "linearize.equilibrium_share": Default(1e-6, "", "residual acceleration linearize() accepts "
+                                                     "at its point, as a share of g"),
+    "mooring.mpm_hours": Default(3.0, "h", "sea-state length of a line tension's most probable "
+                                           "maximum (mpm_3h_N)"),
+    "mooring.slack_fraction": Default(0.02, "", "a line is slack below this share of its mean "
+                                                "tension"),
+    "sim.energy_margin": Default(2.0, "", "factor on the energy put in that a run's energy may "
+                                          "not exceed (energy audit)"),
+    "plant.imbalance_tol": Default(0.10, "", "weight against buoyancy at rest a scene may be "
+                                             "off by (share of the weight) before it is "
+                                             "refused"),
+    "plant.equilibrium_warn": Default(1e-6, "", "load left at rest, as a share of the largest "
+                                                "body weight, above which a warning is given"),
+    "hydro.bem_asymmetry_tol": Default(1e-2, "", "reciprocity error of BEM data (scaled) "
+                                                 "symmetrised with a warning; larger is refused"),
+    "identify.alpha": Default(0.05, "", "miscoverage of calibrated identification intervals "
+                                        "(0.05: 95 %)"),
+    "identify.kappa": Default(0.3, "", "weight of the frequency slope in the calibration "
+                                       "score's scale"),
+    "identify.correlation_limit": Default(0.95, "", "parameter correlation above which an "
+                                                    "identification warns"),
+    "identify.condition_limit": Default(1e6, "", "condition number of the fit's information "
+                                                 "matrix above which it warns"),
+    "identify.structure_tie": Default(0.01, "", "cross-validation scores within this share of "
+                                                "the best tie: the smaller structure wins"),
+    "design.bound_tolerance": Default(0.01, "", "share by which a simulated power may exceed "
+                                                "its bound before it is noted"),
+    "design.max_harmonics": Default(25, "", "harmonics of the constrained power bound's QP",
+                                    int),
+    "design.settle_time_constants": Default(12, "", "slowest time constants a design's check "
+                                                    "run settles before its window", int),
+    "design.coulomb_share": Default(0.98, "", "share of the Coulomb limit a clipped damper "
+                                              "fallback is taken to at most"),
+    "fidelity.steps_per_period": Default(200, "", "fidelity auto's default step: the peak "
+                                                  "period over this", int),
+    "fidelity.signal_floor": Default(1e-3, "", "signals below this share of their unit "
+                                               "class's largest RMS are not compared "
+                                               "(fidelity auto)"),
+    "fidelity.freeze_threshold": Default(1e-3, "", "excitation and response share below which "
+                                                   "freeze = \"auto\" freezes a DOF"),
+    "waves.breaking_steepness": Default(1 / 7, "", "wave steepness H/L refused as breaking"),
+    "sweep.direction_step": Default(math.radians(1.0), "rad", "direction bins of a spread "
+                                                              "sea's expected power"),
+    "resource.min_hours_year": Default(24 * 120, "h", "valid hours a year needs to enter a "
+                                                      "resource's per-year weights", int),
+    "resource.min_hours_month": Default(24 * 7, "h", "valid hours a month needs to enter a "
+                                                     "resource's per-month weights", int),
 }
 
 _set: dict[str, object] = {}

@@ -7,10 +7,11 @@ from __future__ import annotations
 from importlib import import_module
 
 
-def face(package: str, namespace: dict, where: dict):
+def face(package: str, namespace: dict, where: dict, listed=None):
     """(__getattr__, __dir__) for `package` (its globals `namespace`): `where` maps each name
     to (its module in the package, its name there, or None for the module itself); a name is
-    imported when first asked for, then kept in the namespace."""
+    imported when first asked for, then kept in the namespace. listed: the names `dir()` shows
+    (a curated face: `mbcontrol`'s); None: the namespace's and `where`'s."""
     def __getattr__(name):
         if name not in where:
             raise AttributeError(f"module {package!r} has no attribute {name!r}")
@@ -21,5 +22,5 @@ def face(package: str, namespace: dict, where: dict):
         return value
 
     def __dir__():
-        return sorted(set(namespace) | set(where))
+        return sorted(listed) if listed is not None else sorted(set(namespace) | set(where))
     return __getattr__, __dir__

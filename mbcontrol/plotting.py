@@ -50,7 +50,7 @@ def bode(sys, pairs, omega, *, title=None, path=None, fd=None, units=None):
     for k, (inp, out) in enumerate(pairs):
         ax_mag, ax_ph = axes[:, k]
         i, o = sys.input_labels.index(inp), sys.output_labels.index(out)
-        G = frequency_response(A, B[:, i], C[o], D[o, i], omega)[:, 0, 0]
+        G = frequency_response(A, B[:, i], C[o], D[o, i], omega)[0, 0]
         ax_mag.loglog(omega, np.abs(G), label="linearised state space")
         ax_ph.semilogx(omega, np.degrees(np.unwrap(np.angle(G))))
         if fd and (inp, out) in fd:

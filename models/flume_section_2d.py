@@ -49,6 +49,9 @@ from pathlib import Path
 
 import numpy as np
 
+if __name__ == "__main__":      # run as a script from a checkout: the package beside models/
+    sys.path.append(str(Path(__file__).resolve().parent.parent))   # (an installed one wins)
+
 HERE = Path(__file__).resolve().parent
 BEAM, DRAFT, BILGE = 0.40, 0.20, 0.0512       # m
 SPAN = 0.586                                  # m, the section's length across the flume

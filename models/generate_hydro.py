@@ -29,6 +29,9 @@ import sys
 import time
 from pathlib import Path
 
+if __name__ == "__main__":      # run as a script from a checkout: the package beside models/
+    sys.path.append(str(Path(__file__).resolve().parent.parent))   # (an installed one wins)
+
 HERE = Path(__file__).resolve().parent
 
 

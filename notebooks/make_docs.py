@@ -7,8 +7,9 @@ Writes a Sphinx source tree into OUT/src and the HTML into OUT/html, warnings as
 - the tutorials: the notebooks with their outputs and figures. The test suite executes each
   notebook and keeps the executed copy in out/notebooks (tests/test_notebooks.py); one newer
   than its source is used as it is, any other is executed here first;
-- the API reference: autodoc of every module of mbcontrol and mbcontrol.controllers
-  (numpy-style docstrings through napoleon).
+- the API reference: first the public API, `mbcontrol.__all__` (what ``import mbcontrol as
+  mbc`` gives) with each name's docstring; then autodoc of every module of mbcontrol and
+  mbcontrol.controllers (numpy-style docstrings through napoleon).
 
 Run: python notebooks/make_docs.py [--out out/docs]   (needs the [docs] extra)
 """
@@ -157,11 +158,13 @@ def cli_page(src: Path) -> None:
 
 
 def api(src: Path) -> list[str]:
-    """One page per package of mbcontrol (and the controllers), automodule per module."""
+    """The API reference: the public API first (`public_api`), then one page per package of
+    mbcontrol (and the controllers), automodule per module."""
     import mbcontrol
     import mbcontrol.controllers
     folder = src / "api"
     folder.mkdir(exist_ok=True)
+    (folder / "public.rst").write_text("\n".join(public_api()))
     groups: dict[str, list[str]] = {}
     packages = set()
     for package in (mbcontrol, mbcontrol.controllers):
@@ -173,13 +176,12 @@ def api(src: Path) -> list[str]:
             parts = info.name.split(".")
             group = ".".join(parts[:2]) if len(parts) > 2 or info.ispkg else "mbcontrol"
             groups.setdefault(group, []).append(info.name)
-    pages = []
+    pages = ["api/public"]
     for group, modules in sorted(groups.items()):
-        lines = [group, "=" * len(group), ""]
+        title = group if group != "mbcontrol" else "mbcontrol (top-level modules)"
+        lines = [title, "=" * len(title), ""]
         if group != "mbcontrol":            # a package: its docstring; members on their pages
             lines += [f".. automodule:: {group}", "   :no-members:", ""]
-        else:
-            lines += _entry_points()
         for module in sorted(set(modules) - {group}):
             lines += [module, "-" * len(module), "", f".. automodule:: {module}"]
             lines += ["   :no-members:", ""] if module in packages else [""]
@@ -245,22 +247,26 @@ def _tidy_stderr(text: str, seen: set) -> str:
     return "\n".join(lines) + ("\n" if lines else "")
 
 
-def _entry_points() -> list[str]:
-    """The names `from mbcontrol import ...` gives (loaded on first use, so autodoc's walk of
-    the modules does not see them under these names)."""
+def public_api() -> list[str]:
+    """The first page of the API reference: the curated public API, `mbcontrol.__all__` in its
+    order (what ``import mbcontrol as mbc`` gives), each name with its docstring; the
+    submodules' pages follow it."""
     import inspect
 
     import mbcontrol
-    lines = ["Entry points", "-" * 12, "",
-             "What a script imports from the package itself, e.g. ``from mbcontrol import "
-             "load_scene, build_plant, simulate``; each is documented again on its module's "
-             "page.", ""]
+    title = "The public API: import mbcontrol as mbc"
+    lines = [title, "=" * len(title), "", ".. automodule:: mbcontrol", "   :no-members:",
+             "   :no-index:", ""]
     for name in mbcontrol.__all__:
         value = getattr(mbcontrol, name)
-        kind = ("autoclass" if inspect.isclass(value) else "autofunction" if callable(value)
-                else None)
-        if kind:
-            lines += [f".. {kind}:: mbcontrol.{name}", "   :no-index:", ""]
+        if inspect.ismodule(value):
+            heading = f"mbcontrol.{name} (module)"
+            lines += [heading, "-" * len(heading), "", f".. automodule:: {value.__name__}",
+                      "   :no-members:", "   :no-index:", ""]
+            continue
+        kind = "autoclass" if inspect.isclass(value) else "autofunction"
+        lines += [f"mbcontrol.{name}", "-" * len(f"mbcontrol.{name}"), "",
+                  f".. {kind}:: mbcontrol.{name}", "   :no-index:", ""]
     return lines
 
 

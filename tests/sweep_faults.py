@@ -6,6 +6,7 @@ branch of its own): python tests/sweep_faults.py FAULT ARGS..., FAULT one of
 import os
 import sys
 
+from mbcontrol import defaults
 from mbcontrol.cli import main
 from mbcontrol.studies.sweep import runner
 from mbcontrol.studies.sweep.store import CaseStore
@@ -26,14 +27,14 @@ def _exit_after(n: int) -> None:
 def _kill_worker_once(flag: str) -> None:
     run_group = runner.run_group
 
-    def dying_group(cases):              # pickled by value: the worker runs this very code
+    def dying_group(cases, plants=None):   # pickled by value: the worker runs this very code
         if not os.path.exists(flag):
             open(flag, "w").close()
             os._exit(1)                  # a worker dies in the middle of its task
-        return run_group(cases)
+        return run_group(cases, plants)
 
     runner.run_group = dying_group
-    os.environ[runner.CLUSTER_ENV] = "always"   # a cluster even for a sweep this small
+    defaults.set("sweep.cluster", "always")   # a cluster even for a sweep this small
 
 
 if __name__ == "__main__":

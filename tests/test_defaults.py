@@ -51,7 +51,8 @@ def test_cache_folder_and_quiet_keep_their_historical_variables(monkeypatch, tmp
 
 
 def test_simulate_takes_its_step_and_method_from_the_registry():
-    from mbcontrol import build_plant, simulate, waves
+    from mbcontrol import build_plant, waves
+    from mbcontrol.analysis import simulate_checked as simulate   # the checked Dataset
     plant = build_plant("sphere")
     wave = waves.regular(1.0, 9.0)
     with defaults.override(sim_dt=0.1, sim_method="rk3"):   # stable below 0.15 s
@@ -129,3 +130,48 @@ def test_the_design_margins_are_defaults_and_set_the_tuners_floor(capsys):
     with defaults.override(design_gain_margin_min=0.5):
         with pytest.raises(ValueError, match="design.gain_margin_min"):
             stability_floor()
+
+
+# The result-shaping constants moved into the registry (issue 59), with the values they had
+# as module constants: `mbcontrol defaults` lists each, unchanged.
+MOVED = {"validity.power_allowance": 0.10, "validity.energy_tolerance": 0.05,
+         "linearize.equilibrium_share": 1e-6, "mooring.mpm_hours": 3.0,
+         "mooring.slack_fraction": 0.02, "sim.energy_margin": 2.0,
+         "plant.imbalance_tol": 0.10, "plant.equilibrium_warn": 1e-6,
+         "hydro.bem_asymmetry_tol": 1e-2, "identify.alpha": 0.05, "identify.kappa": 0.3,
+         "identify.correlation_limit": 0.95, "identify.condition_limit": 1e6,
+         "identify.structure_tie": 0.01, "design.bound_tolerance": 0.01,
+         "design.max_harmonics": 25, "design.settle_time_constants": 12,
+         "design.coulomb_share": 0.98, "fidelity.steps_per_period": 200,
+         "fidelity.signal_floor": 1e-3, "fidelity.freeze_threshold": 1e-3,
+         "waves.breaking_steepness": 1 / 7, "sweep.direction_step": 0.017453292519943295,
+         "resource.min_hours_year": 2880, "resource.min_hours_month": 168,
+         "sweep.cluster": "auto", "sweep.start": "spawn", "compile.cc": ""}
+
+
+def test_moved_constants_are_listed_with_their_values(capsys, monkeypatch):
+    monkeypatch.delenv("CC", raising=False)
+    monkeypatch.delenv("MBCONTROL_SWEEP_CLUSTER", raising=False)
+    monkeypatch.delenv("MBCONTROL_SWEEP_START", raising=False)
+    assert main(["defaults", "--json"]) == 0
+    rows = {r["key"]: r for r in json.loads(capsys.readouterr().out)}
+    for key, value in MOVED.items():
+        assert rows[key]["value"] == value and type(rows[key]["value"]) is type(value), key
+        assert rows[key]["source"] == "built-in" and rows[key]["doc"], key
+
+
+def test_moved_constants_are_read_at_call_time():
+    """defaults.override changes what the functions compute, with no module reloaded."""
+    from mbcontrol.studies.identify.calibration import scale, score_text
+    assert scale(2.0, -10.0) == pytest.approx(2.0 * np.hypot(1, 3.0))
+    with defaults.override(identify_kappa=0.6):
+        assert scale(2.0, -10.0) == pytest.approx(2.0 * np.hypot(1, 6.0))
+        assert "(0.6 * d ln a" in score_text()
+    assert "(0.3 * d ln a" in score_text()
+
+
+def test_the_cli_quiet_flag_sets_the_default_not_the_environment(monkeypatch):
+    import os
+    monkeypatch.delenv("TQDM_DISABLE", raising=False)
+    assert main(["-q", "defaults"]) == 0
+    assert "TQDM_DISABLE" not in os.environ and defaults.source("log.quiet") == "built-in"

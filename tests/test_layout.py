@@ -14,9 +14,10 @@ STAGES = ("scene", "multibody", "hydro", "plant", "sim", "analysis", "controller
           "export", "cli")
 # modules every stage may use; they import no stage themselves
 COMMON = ("errors", "results", "waves", "plotting", "cache", "console", "atomic", "defaults", "lti", "textsafe",
-          "lazy")
+          "lazy", "checkout")
 # top-level programs that drive the whole flow: may import any stage, none may import them
-DRIVERS = ("cli", "demo", "models", "__main__")   # __main__: python -m mbcontrol
+DRIVERS = ("cli", "demo", "models", "__main__", "api")   # __main__: python -m mbcontrol;
+# api: the front door behind `import mbcontrol as mbc` (load, simulate, ...)
 MAX_LINES = 400          # the house rule: a module past ~400 lines is two modules
 SOURCE_DIRS = {"mbcontrol": ROOT / "mbcontrol", "mbcontrol.controllers": ROOT / "controllers",
                "mbcontrol.models": ROOT / "models"}
@@ -354,3 +355,92 @@ def test_no_function_past_the_size_rule():
     many = [f"{where}: {p} positional parameters" for where, _, p in _function_sizes()
             if p > MAX_POSITIONAL]
     assert not long + many, "\n".join(long + many)
+
+
+# Module state (issue 59): what a module-level container mutated by its functions may hold.
+# A cache of pure lookups or a said-once set of messages is not state; anything else (a
+# result, an object carried from one call to the next) is passed or owned by the caller.
+DOCUMENTED_STATE = {
+    "mbcontrol/defaults.py:_set": "the registry's set() layer, by design",
+    "mbcontrol/cache.py:_usable": "cache: configured folder -> the folder this process uses",
+    "mbcontrol/cache.py:_private": "cache: this process's private cache folder, made once",
+    "mbcontrol/hydro/source.py:_SAID": "said-once messages",
+    "mbcontrol/plant/rest.py:_SAID": "said-once messages",
+    "mbcontrol/sim/compiled.py:_FAILED": "said-once messages",
+    "mbcontrol/sim/compiled.py:_warned": "said-once messages",
+    "mbcontrol/sim/compiled.py:_warned_cc": "said-once messages",
+    "mbcontrol/sim/compiled.py:_TAGS": "cache: a compiler's version line",
+    "mbcontrol/plant/provenance.py:_CACHE": "cache: an immutable plant's content hashes (weak)",
+    "mbcontrol/sim/record.py:_VERSIONS": "cache: package versions",
+    "mbcontrol/sim/run.py:_VERSIONS": "cache: package versions",
+    # known, still to go (issue 59): logs of what generate_hydro --ship-fits ships
+    "mbcontrol/hydro/fit/store.py:FITS_SERVED": "TODO: a recorder the caller owns",
+    "mbcontrol/plant/moordyn_statics.py:STATICS_SERVED": "TODO: a recorder the caller owns",
+}
+MUTATORS = {"append", "add", "update", "pop", "clear", "setdefault", "extend", "insert",
+            "remove", "discard", "popitem"}
+
+
+def _mutated_module_state(path: Path) -> set[str]:
+    """Module-level names bound to a container (or declared global) that a function changes."""
+    tree = ast.parse(path.read_text())
+    names = {t.id for n in tree.body if isinstance(n, (ast.Assign, ast.AnnAssign))
+             and isinstance(n.value, (ast.Dict, ast.List, ast.Set, ast.Call))
+             for t in (n.targets if isinstance(n, ast.Assign) else [n.target])
+             if isinstance(t, ast.Name)}
+    found = set()
+    for f in ast.walk(tree):
+        if not isinstance(f, (ast.FunctionDef, ast.AsyncFunctionDef)):
+            continue
+        for n in ast.walk(f):
+            if isinstance(n, ast.Global):
+                found.update(n.names)
+            elif (isinstance(n, ast.Call) and isinstance(n.func, ast.Attribute)
+                  and n.func.attr in MUTATORS and isinstance(n.func.value, ast.Name)):
+                found.add(n.func.value.id)
+            elif isinstance(n, (ast.Assign, ast.AugAssign, ast.Delete)):
+                for t in getattr(n, "targets", None) or [n.target]:
+                    if isinstance(t, ast.Subscript) and isinstance(t.value, ast.Name):
+                        found.add(t.value.id)
+    return {name for name in found if name in names or name.startswith("_warned")}
+
+
+def test_no_module_state_carries_results_between_calls():
+    """Every module-level container a function mutates is a documented cache or message set
+    (DOCUMENTED_STATE); the sweep's plants live in a PlantCache the run owns."""
+    found = {f"{path.relative_to(ROOT)}:{name}" for folder in ("mbcontrol", "controllers")
+             for path in (ROOT / folder).rglob("*.py") for name in _mutated_module_state(path)}
+    assert found - set(DOCUMENTED_STATE) == set()
+    assert "mbcontrol/studies/sweep/case_run.py:_PLANTS" not in found
+
+
+def test_the_state_scan_sees_a_module_cache(tmp_path):
+    path = tmp_path / "m.py"
+    path.write_text("_PLANTS = {}\nSAID = set()\n\ndef f(k):\n    _PLANTS[k] = 1\n"
+                    "    SAID.add(k)\n")
+    assert _mutated_module_state(path) == {"_PLANTS", "SAID"}
+
+
+def _environment_reads(path: Path) -> list[int]:
+    """Lines of `path` that read or write the process environment (os.environ, os.getenv,
+    os.putenv, os.unsetenv)."""
+    lines = []
+    for n in ast.walk(ast.parse(path.read_text())):
+        if isinstance(n, ast.Attribute) and n.attr in ("environ", "getenv", "putenv", "unsetenv") \
+                and isinstance(n.value, ast.Name) and n.value.id == "os":
+            lines.append(n.lineno)
+        elif isinstance(n, ast.ImportFrom) and n.module == "os" and any(
+                a.name in ("environ", "getenv", "putenv", "unsetenv") for a in n.names):
+            lines.append(n.lineno)
+    return lines
+
+
+def test_no_environment_variable_is_a_switch_inside_the_library():
+    """Only the defaults registry reads the environment (its documented layer, the cache
+    folder's MBCONTROL_CACHE and the compiler's CC included); every switch is a default
+    (`mbcontrol defaults`) or an argument."""
+    found = {f"{path.relative_to(ROOT)}:{line}" for folder in ("mbcontrol", "controllers")
+             for path in (ROOT / folder).rglob("*.py") if path.name != "defaults.py"
+             or path.parent.name != "mbcontrol" for line in _environment_reads(path)}
+    assert found == set()
+    assert _environment_reads(ROOT / "mbcontrol" / "defaults.py")     # the scan sees it there

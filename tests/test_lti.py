@@ -21,10 +21,12 @@ def test_frequency_response_is_python_controls(system):
     omega = np.geomspace(0.01, 100, 257)
     G = frequency_response(A, B, C, D, omega)
     ref = control.ss(A, B, C, D)(1j * omega)            # (outputs, inputs, omega)
-    np.testing.assert_allclose(G, np.moveaxis(ref, -1, 0), rtol=1e-10, atol=1e-12)
-    np.testing.assert_allclose(frequency_response(A, B, C, None, omega) + D, G, rtol=1e-12)
+    assert G.shape == ref.shape == (3, 2, omega.size)   # python-control's axis order
+    np.testing.assert_allclose(G, ref, rtol=1e-10, atol=1e-12)
+    np.testing.assert_allclose(frequency_response(A, B, C, None, omega) + D[..., None], G,
+                               rtol=1e-12)
     X = state_response(A, B, omega)
-    np.testing.assert_allclose(np.einsum("ij,wjk->wik", C, X) + D, G, rtol=1e-12)
+    np.testing.assert_allclose(np.einsum("ij,jkw->ikw", C, X) + D[..., None], G, rtol=1e-12)
 
 
 def test_many_states_are_solved_in_slices_with_the_same_result():
@@ -33,7 +35,7 @@ def test_many_states_are_solved_in_slices_with_the_same_result():
     A = rng.standard_normal((n, n)) / np.sqrt(n) - 2 * np.eye(n)
     B, C = rng.standard_normal((n, 1)), rng.standard_normal((1, n))
     omega = np.linspace(0.1, 3, 23)
-    G = frequency_response(A, B, C, None, omega)[:, 0, 0]
+    G = frequency_response(A, B, C, None, omega)[0, 0]
     one_by_one = [C[0] @ np.linalg.solve(1j * w * np.eye(n) - A, B[:, 0]) for w in omega]
     np.testing.assert_allclose(G, one_by_one, rtol=1e-10)
 

@@ -4,8 +4,8 @@ Everything here is linear theory on the frequency-domain (FD) model built straig
 BEM data (the physics of `analysis.frequency_domain_response`, no radiation fit, Coulomb
 friction removed), seen from one PTO as a Thevenin equivalent.
 
-Convention: complex amplitudes are phasors of exp(-i omega t), as the hydro data and
-`mbcontrol.waves` (a signal y(t) = Re[Y exp(-i omega t)]; d/dt is -i omega). A wave component
+Convention: phasors of exp(-i omega t) as stored (hydro data, `mbcontrol.waves`), the bound
+stack's documented exception to the public exp(+i omega t) (`lti.phasor`). A wave component
 (omega, a, phi) has the complex elevation a exp(-i phi). Seen from the PTO (its own damping and
 stiffness set to zero, so the PTO force F is the whole force it applies to its follower),
 

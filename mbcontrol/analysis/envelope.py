@@ -7,7 +7,8 @@ module predicts those same quantities before a run, from the BEM data alone, for
 force, so that tuners choose settings that stay inside (controllers.tuning) and a sea where
 none can is known before it is simulated.
 
-Linear theory, phasors exp(-i omega t) (analysis.ports): each envelope quantity q is
+Linear theory, phasors exp(-i omega t) as analysis.ports (the bound stack's documented
+exception to the public exp(+i omega t), `lti.phasor`): each envelope quantity q is
 q = G U + H a per wave component, with U the PTO force, a the component's complex amplitude,
 G and H from `ports.output_responses`. A relative heave is -(body heave, z down) minus the
 surface elevation at the body's centre of buoyancy, e^{i k (x cos beta + y sin beta)} per unit

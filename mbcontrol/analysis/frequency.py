@@ -1,7 +1,8 @@
 """Frequency-domain analysis: the BEM-direct solution, RAOs and state-space responses.
 
-Convention here: phasors of exp(+i omega t) (python-control's). BEM excitation is stored per
-exp(-i omega t), so its phasor in this convention is the complex conjugate.
+Convention: phasors of exp(+i omega t), the toolbox's public one (python-control's; see
+mbcontrol.lti): x(t) = Re[X e^{+i omega t}]. The BEM excitation, stored per exp(-i omega t), is
+converted at the hydro boundary (`HydroModel.excitation_phasor`).
 
 The frequency-domain (FD) solution uses the BEM data at each frequency directly, with no
 radiation fit: [-omega^2 (M + A(omega)) + i omega (B(omega) + B_mech) + K] X = F. It is the
@@ -11,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..lti import frequency_chunks, frequency_response, state_response
+from ..lti import frequency_chunks, frequency_response, phasor, state_response
 from ..plant import MechanicalMatrices, mechanical_matrices  # noqa: F401 (their public home here too)
 from ..errors import InputError
 
@@ -28,7 +29,7 @@ def frequency_domain_response(plant, omega, *, direction: float = 0.0, params=No
     mech = mechanical_matrices(plant, params)
     hyd = plant.hydro
     A_w, B_w = hyd.frequency_domain_matrices(omega)
-    F = np.conj(hyd.excitation_at(omega, direction))
+    F = hyd.excitation_phasor(omega, direction)
     idx = [plant.outputs.index(o) for o in (outputs or plant.outputs)]
     rhs = (F @ mech.P_hydro.T)[..., None]
     X = np.concatenate([np.linalg.solve(_impedance(mech, omega[k], A_w[k], B_w[k]), rhs[k])
@@ -54,10 +55,11 @@ def _outputs(mech, omega, X, idx) -> np.ndarray:
 
 
 def excitation_transfer(plant, omega, *, params=None, outputs=None, sys=None) -> np.ndarray:
-    """(n_omega, n_outputs, n_hydro_dof): the outputs' response to a unit excitation force on
-    each hydro DOF (exp(+i omega t)); times conj(F) (`HydroModel.excitation_at`) it is
-    `frequency_domain_response` (BEM data straight) or, given the linearised `sys`,
-    `statespace_response`. For many wave directions at once: one solve per frequency."""
+    """(n_outputs, n_hydro_dof, n_omega), python-control's axis order (mbcontrol.lti): the
+    outputs' response to a unit excitation force on each hydro DOF (exp(+i omega t)); times
+    the excitation phasor F (`HydroModel.excitation_phasor`) it is `frequency_domain_response`
+    (BEM data straight) or, given the linearised `sys`, `statespace_response`. For many wave
+    directions at once: one solve per frequency."""
     omega = np.atleast_1d(np.asarray(omega, float))
     if sys is not None:
         w_idx = [sys.input_labels.index(f"w__{d}") for d in plant.hydro.dofs]
@@ -69,23 +71,23 @@ def excitation_transfer(plant, omega, *, params=None, outputs=None, sys=None) ->
     idx = [plant.outputs.index(o) for o in (outputs or plant.outputs)]
     X = np.concatenate([np.linalg.solve(_impedance(mech, omega[k], A_w[k], B_w[k]), mech.P_hydro)
                         for k in frequency_chunks(omega.size, mech.mass.shape[0])])
-    return _outputs(mech, omega, X, idx)
+    return np.moveaxis(_outputs(mech, omega, X, idx), 0, -1)
 
 
 def statespace_response(sys, plant, omega, *, direction: float = 0.0, outputs=None):
     """Response per unit wave amplitude of a linearised model (n_omega, n_outputs).
 
-    Drives the w inputs of `sys` with the conjugated BEM excitation (exp(+i omega t)).
+    Drives the w inputs of `sys` with the BEM excitation's phasor (exp(+i omega t)).
     """
     omega = np.atleast_1d(np.asarray(omega, float))
     hyd = plant.hydro
-    F = np.conj(hyd.excitation_at(omega, direction))
+    F = hyd.excitation_phasor(omega, direction)
     w_idx = [sys.input_labels.index(f"w__{d}") for d in hyd.dofs]
     names = outputs or sys.output_labels
     y_idx = [sys.output_labels.index(o) for o in names]
     A, B, C, D = (np.asarray(M) for M in (sys.A, sys.B, sys.C, sys.D))
     G = frequency_response(A, B[:, w_idx], C[y_idx], D[np.ix_(y_idx, w_idx)], omega)
-    return np.einsum("wom,wm->wo", G, F)
+    return np.einsum("omw,wm->wo", G, F)
 
 
 def steady_amplitude(ds, name: str, period: float, n_periods: int = 10) -> float:
@@ -99,19 +101,18 @@ def steady_amplitude(ds, name: str, period: float, n_periods: int = 10) -> float
 def steady_state_initial(sys, plant, wave) -> np.ndarray:
     """State at t = 0 on the linear periodic response to a regular wave (no ramp needed).
 
-    x(t) = Re(X exp(i omega t)) with X = (i omega I - A)^-1 B_w conj(F) a; starting there
+    x(t) = Re(X exp(i omega t)) with X = (i omega I - A)^-1 B_w F a (F, a: the excitation's
+    and the wave's exp(+i omega t) phasors); starting there
     removes the start-up transient of lightly damped modes, leaving only what the nonlinear
     terms add. Returns the full plant state (sys must be linearize(plant) with all states).
     """
-    from ..waves import interpolate_complex
     if wave.omega.size != 1:
         raise InputError("steady_state_initial needs a regular wave")
     w, a = float(wave.omega[0]), float(wave.amplitude[0]) * np.exp(-1j * wave.phase[0])
     hyd = plant.hydro
-    F = np.conj(interpolate_complex(hyd.omega, hyd.excitation_coefficients(wave.direction),
-                                    np.array([w]))[0] * a)
+    F = hyd.excitation_phasor(np.array([w]), wave.direction)[0] * phasor(a)
     w_idx = [sys.input_labels.index(f"w__{d}") for d in hyd.dofs]
-    X = state_response(sys.A, np.asarray(sys.B)[:, w_idx] @ F, [w])[0, :, 0]
+    X = state_response(sys.A, np.asarray(sys.B)[:, w_idx] @ F, [w])[:, 0, 0]
     return plant.x0() + X.real
 
 

@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .. import defaults
 from ..errors import LinearizationError
 from ..plant import jacobians
 
@@ -20,7 +21,7 @@ if TYPE_CHECKING:       # python-control costs 2.5 s to import: only where it is
     import control
 
 
-EQUILIBRIUM_SHARE = 1e-6
+# EQUILIBRIUM_SHARE: the default "linearize.equilibrium_share" (mbcontrol.defaults)
 
 
 def linearize(plant, *, x0=None, u0=None, w0=None, params=None, inputs=None, outputs=None,
@@ -38,7 +39,7 @@ def linearize(plant, *, x0=None, u0=None, w0=None, params=None, inputs=None, out
     p = plant.params(**params) if isinstance(params, dict) else (
         plant.p0 if params is None else np.asarray(params, float))
     g = plant.scene.water.g
-    tol = EQUILIBRIUM_SHARE * g if tol is None else tol
+    tol = defaults.get("linearize.equilibrium_share") * g if tol is None else tol
     residual = np.asarray(plant.f(x0, u0, w0, p)).ravel()
     if np.max(np.abs(residual), initial=0.0) > tol:
         worst = np.argsort(-np.abs(residual))[:3]

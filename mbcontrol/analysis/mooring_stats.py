@@ -19,9 +19,10 @@ import math
 import re
 
 import numpy as np
+from .. import defaults
 
-MPM_HOURS = 3.0
-SLACK_FRACTION = 0.02
+# MPM_HOURS: the default "mooring.mpm_hours" (mbcontrol.defaults)
+# SLACK_FRACTION: the default "mooring.slack_fraction" (mbcontrol.defaults)
 _NAME = re.compile(r"^(?P<mooring>.+)__line(?P<line>\d+)__(?P<end>anchor|fairlead)_tension$")
 
 
@@ -37,12 +38,12 @@ def tension_statistics(t: np.ndarray, tension: np.ndarray) -> dict:
            "slack_at_s": None}
     if ups >= 2 and std > 0:
         tz = span / ups
-        crossings = MPM_HOURS * 3600.0 / tz
+        crossings = defaults.get("mooring.mpm_hours") * 3600.0 / tz
         out.update(tz_s=tz, mpm_3h_N=mean + std * math.sqrt(2.0 * math.log(crossings)))
     # a shorter record's max above the Gaussian 3-hour estimate: the load is not Gaussian
     # (snap loads, a line going slack and taut), and the estimate is not to be trusted
     out["gaussian"] = out["mpm_3h_N"] is not None and out["max_N"] <= out["mpm_3h_N"]
-    slack = np.flatnonzero(x < SLACK_FRACTION * abs(mean))
+    slack = np.flatnonzero(x < defaults.get("mooring.slack_fraction") * abs(mean))
     if slack.size:
         out["slack_at_s"] = float(t[slack[0]])
     return out
@@ -80,7 +81,7 @@ def slack_lines(summary: dict) -> list[str]:
                 if stats["slack_at_s"] is not None:
                     notes.append(f"mooring '{mooring}' {line} went slack at its {end} at "
                                  f"t = {stats['slack_at_s']:.4g} s (tension below "
-                                 f"{SLACK_FRACTION:.0%} of its mean {stats['mean_N']:.4g} N): "
+                                 f"{defaults.get('mooring.slack_fraction'):.0%} of its mean {stats['mean_N']:.4g} N): "
                                  f"snap loads follow; check the line's length and pretension")
     return notes
 

@@ -1,7 +1,8 @@
 """The device seen from its PTOs: multiport frequency responses and the multiport
 complex-conjugate bound.
 
-Phasors of exp(-i omega t), as `analysis.bounds`. With every PTO's own damping and stiffness
+Phasors of exp(-i omega t), as `analysis.bounds` (the bound stack's documented exception to
+the public exp(+i omega t); `lti.phasor` converts). With every PTO's own damping and stiffness
 set to zero (so the PTO forces F are the whole forces the PTOs apply) and Coulomb friction
 removed, the PTO velocities are
 

@@ -35,7 +35,8 @@ its reasons. The checks, each independent of the time-domain model that made the
 
 `assess` works on a Dataset from `mbcontrol.sim.simulate` and writes the verdict into its
 attrs; `assess_values` works on plain numbers, for callers that keep no Dataset;
-`simulate_checked` (the package's `mbcontrol.simulate`) simulates and assesses in one call.
+`simulate_checked` simulates and assesses in one call, to a Dataset (`mbcontrol.simulate` makes
+the same checks and returns a `mbcontrol.Result`).
 """
 from __future__ import annotations
 
@@ -44,11 +45,13 @@ import math
 
 import numpy as np
 
+from .. import defaults
 from ..plant import derived
 from ..results import jsonable, record
 
-POWER_ALLOWANCE = 0.10            # share above the bound a reported mean power may reach
-ENERGY_TOLERANCE = 0.05           # of the excitation's absolute work over the record
+# POWER_ALLOWANCE and ENERGY_TOLERANCE: the defaults "validity.power_allowance" (share above
+# the bound a reported mean power may reach) and "validity.energy_tolerance" (of the
+# excitation's absolute work over the record)
 ANGLE_MAX_RAD = math.radians(30.0)
 DRAFT_FACTOR = 1.0                # relative heave limit in mean drafts
 
@@ -144,23 +147,24 @@ def assess_values(plant, wave, params, *, window, mean_power_W: float, energy=No
     excursions: per body, what `excursions` returns. Returns {"valid", "invalid_reasons",
     "warnings", "checks"}.
     """
-    reasons, checks = [], {"power_allowance": POWER_ALLOWANCE}
+    share = defaults.get("validity.power_allowance")
+    reasons, checks = [], {"power_allowance": share}
     if wave is not None and plant.hydro is not None and plant.scene.ptos:
         bound = power_bound(plant, wave, params)
-        allowed = (1 + POWER_ALLOWANCE) * bound["bound_W"]
+        allowed = (1 + share) * bound["bound_W"]
         if mean_power_W > allowed:          # a finite record may beat the spectral mean
             bound = power_bound(plant, wave, params, window)
-            allowed = (1 + POWER_ALLOWANCE) * max(bound["bound_W"], bound["window_bound_W"])
+            allowed = (1 + share) * max(bound["bound_W"], bound["window_bound_W"])
         checks.update(bound, allowed_power_W=allowed, mean_power_W=mean_power_W)
         if mean_power_W > allowed:
             reasons.append(
                 f"mean absorbed power {_watts(mean_power_W)} exceeds the complex-conjugate "
                 f"bound of its wave ({_watts(bound['bound_W'])}; allowed "
-                f"{_watts(allowed)} with {POWER_ALLOWANCE:.0%} for finite records and "
+                f"{_watts(allowed)} with {share:.0%} for finite records and "
                 f"nonlinear terms): no controller can absorb that{REMEDY}{REMEDIES['bound']}")
     if energy is not None:
         exc, absorbed, gained, magnitude = energy
-        slack = ENERGY_TOLERANCE * magnitude
+        slack = defaults.get("validity.energy_tolerance") * magnitude
         checks["energy_J"] = {"excitation_work": exc, "pto_work": absorbed, "gained": gained,
                               "tolerance": slack}
         if absorbed > exc - gained + slack:
@@ -363,7 +367,7 @@ def _window_reason(window: dict) -> str:
 def simulate_checked(plant, wave=None, **options):
     """`mbcontrol.sim.simulate`, then `assess`: the Dataset carries its verdict in its attrs
     ("valid", "invalid_reasons", "validity"), and an invalid result warns (RuntimeWarning)
-    with its reasons. The entry point `mbcontrol.simulate` is this function."""
+    with its reasons. `mbcontrol.simulate` makes the same checks and returns a Result."""
     import warnings
 
     from ..sim import simulate

@@ -60,7 +60,7 @@ def main(argv=None) -> int:
     logger = logging.getLogger("mbcontrol")
     previous, warnings.formatwarning = warnings.formatwarning, format_warning
     shown, warnings.showwarning = warnings.showwarning, said_once(warnings.showwarning)
-    level, bars = logger.level, os.environ.get("TQDM_DISABLE")
+    level = logger.level
     quiet = defaults.get("log.quiet") if defaults.source("log.quiet") == "set" else None
     try:
         return _main(argv)
@@ -71,22 +71,18 @@ def main(argv=None) -> int:
             defaults.reset("log.quiet")
         else:
             defaults.set("log.quiet", quiet)
-        if bars is None:
-            os.environ.pop("TQDM_DISABLE", None)
-        else:
-            os.environ["TQDM_DISABLE"] = bars
 
 
 def _loudness(args) -> None:
-    """-v / -q: the "mbcontrol" logger's level, and progress bars off with -q."""
+    """-v / -q: the "mbcontrol" logger's level, and progress bars off with -q (the default
+    "log.quiet", which our bars and the BEM solver's read: no environment variable)."""
     import logging
 
     from ..console import set_verbosity
     if args.verbose or args.quiet:
         set_verbosity(logging.DEBUG if args.verbose else logging.WARNING)
     if args.quiet:
-        defaults.set("log.quiet", True)     # our progress bars
-        os.environ["TQDM_DISABLE"] = "1"    # third-party ones (Capytaine's)
+        defaults.set("log.quiet", True)     # progress bars, ours and Capytaine's (BEM)
 
 
 def _main(argv) -> int:

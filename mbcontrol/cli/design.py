@@ -82,7 +82,8 @@ def _robustness_line(result) -> str:
     r = result.tuner["robustness"]
     f = r["floors"]
     how = ""
-    if result.name == "reactive":
+    from mbcontrol.controllers import REGISTRY
+    if REGISTRY[result.name].floors:          # a law tuned within the floors when robust
         how = (" tuned within them (--aggressive: the unconstrained optimum);"
                if result.tuner.get("robust") else " the unconstrained optimum (--aggressive);")
         cost = result.tuner.get("margins_cost") or {}

@@ -35,9 +35,6 @@ estimator; without the linear model's envelope, which the C engine does not hold
 exported MPC and its Python twin both run with envelope=false, and it says so). Not nmpc
 (IPOPT generates no C), nor an MPC oracle (forecast=known).
 """
-NO_ENVELOPE = ("mbcontrol: note: the MPC is exported without the linear model's envelope (its "
-               "relative-heave and angle constraints need a surface probe the C engine does "
-               "not read yet): the export and its Python check both run with envelope=false")
 
 
 def add_parser(sub, model_options, wave_options) -> None:
@@ -78,15 +75,15 @@ def _controller(args, plant, wave):
     if args.controller not in REGISTRY:
         raise InputError(f"export: unknown controller {args.controller!r}; expected one of "
                          f"{', '.join(REGISTRY)}")
-    if args.controller == "mpc" and not any(s.split("=")[0].strip() == "envelope"
-                                            for s in args.set):
-        # the C engine does not hold the linear model's envelope (a surface probe and its
-        # forecast): the exported MPC and its Python twin both run without it, said so
-        print(NO_ENVELOPE, file=sys.stderr)
-        args.set = [*args.set, "envelope=false"] if args.set else []
-        extra_settings = {"envelope": False}
-    else:
-        extra_settings = {}
+    # settings the law's C engine needs (the MPC's: no envelope, which needs a surface probe
+    # the engine does not read): the export and its Python twin both run with them, said so
+    given = {item.split("=")[0].strip() for item in args.set}
+    extra_settings = {k: v for k, v in getattr(REGISTRY[args.controller], "export_settings",
+                                               {}).items() if k not in given}
+    if extra_settings:
+        print(f"mbcontrol: note: {REGISTRY[args.controller].export_note}", file=sys.stderr)
+        args.set = [*args.set, *(f"{k}={str(v).lower()}" for k, v in extra_settings.items())
+                    ] if args.set else []
     if args.set:
         return from_settings(args, wave), "--set"
     pto = plant.scene.ptos[0]
@@ -103,7 +100,8 @@ def _robustness(args, plant, controller, origin: str) -> dict | None:
     """A linear law's margins on every PTO against the floors (controllers.robustness):
     {pto: robustness dict}, None for other laws. InputError below the floors unless
     --aggressive (then flagged on stderr)."""
-    if controller.name not in ("passive", "reactive"):
+    from mbcontrol.sim import law_kind
+    if law_kind(controller) != "linear":      # a loop transfer to check
         return None
     from mbcontrol.controllers import loop_margins, loop_robustness, pto_gains
     gains = pto_gains(plant, controller)
@@ -146,7 +144,7 @@ def run_export(args) -> int:
     plant_fmu = export_plant(plant, wave, out, dt=dt, model=plant.name)
     report = {"model": plant.name, "controller": controller.name, "origin": origin,
               "parameters": {p.name: p.value for p in exported.spec.parameters},
-              "settings": jsonable(controller.describe()),
+              "settings": jsonable(exported.spec.settings),    # as exported, bound
               "inputs": exported.spec.inputs, "outputs": exported.spec.outputs,
               "fmus": {"controller": str(exported.fmu), "plant": str(plant_fmu)},
               "c_library": str(exported.library), "c_sources": str(exported.c_folder),

@@ -78,8 +78,7 @@ def header(spec: ControllerSpec, ident: str) -> str:
               for i, p in enumerate(spec.parameters)]
     lines += [" */", "#ifndef MBC_CONTROLLER_H", "#define MBC_CONTROLLER_H", ""]
     lines += ["#include <math.h>"]
-    if spec.kind == "mpc":
-        lines += ['#include "mbc_qp.h"']
+    lines += [f'#include "{name}"' for name in spec.headers]   # csrc files, named by the spec
     if spec.casadi:
         lines += ["#ifndef casadi_int", "#define casadi_int long long int", "#endif",
                   "#ifndef casadi_real", "#define casadi_real double", "#endif"]
@@ -96,10 +95,7 @@ def header(spec: ControllerSpec, ident: str) -> str:
     for name, (ctype, _) in spec.arrays.items():
         lines += [f"#define {name} MBC_CAT(MBC_PREFIX, {name[4:]})",
                   f"extern const {ctype} {name}[];"]
-    if spec.kind == "mpc":
-        lines += ["typedef struct { int nv, na, soft; const double *H; const int *A_start, *A_col; "
-                  "const double *A_val, *lbx, *ubx, *g_slack; } mbc_form;", "#define MBC_FORMS MBC_CAT(MBC_PREFIX, forms)",
-                  "extern const mbc_form MBC_FORMS[];"]
+    lines += list(spec.declarations)          # the engine's own types and tables
     for fun in spec.casadi:
         lines += [f"int {ident}_{fun.name()}(const casadi_real **arg, casadi_real **res, "
                   f"casadi_int *iw, casadi_real *w, int mem);"]
@@ -121,8 +117,7 @@ def data_source(spec: ControllerSpec, ident: str) -> str:
     out.append(c_array("double", "MBC_PARAMS_DESIGNED", [p.value for p in spec.parameters]))
     for name, (ctype, values) in spec.arrays.items():
         out.append(c_array(ctype, name, values))
-    if spec.kind == "mpc":
-        out.append("const mbc_form MBC_FORMS[] = {" + ", ".join(spec.settings["forms"]) + "};\n")
+    out += list(spec.tables)
     return "\n".join(out)
 
 

@@ -1,9 +1,12 @@
 """Is the exported controller the controller? Closed-loop runs on the same plant and wave:
 the Python controller, its C library (through ctypes, stepped by `simulate`), and, when fmpy is
 installed, the two FMUs co-simulated by fmpy; then the C step timed over the run's own
-measurements, beside the Python step on the same ones."""
+measurements, beside the Python step on the same ones. Each Python run is a private copy of
+the caller's controller (simulate and the timing reset it; the caller's stays as it was):
+the Python run's describe() is in its record, ds.attrs["controller"]."""
 from __future__ import annotations
 
+import copy
 import time
 
 import numpy as np
@@ -22,8 +25,8 @@ def closed_loop_check(plant, wave, controller, exported, *, duration: float, dt:
     from mbcontrol.controllers import mean_power
     from mbcontrol.sim import simulate
     period = period_of(controller)
-    reference = simulate(plant, wave, duration=duration, dt=dt, controller=controller,
-                         method="rk4")
+    reference = simulate(plant, wave, duration=duration, dt=dt,
+                         controller=copy.copy(controller), method="rk4")
     c_ctrl = CController.from_export(exported, period=period)
     c_run = simulate(plant, wave, duration=duration, dt=dt, controller=c_ctrl, method="rk4")
     commands = exported.spec.outputs
@@ -36,7 +39,7 @@ def closed_loop_check(plant, wave, controller, exported, *, duration: float, dt:
     # active sets amplifies it; a static law does not)
     x0 = plant.x0().copy()
     x0[0] += 1e-12
-    nudged = simulate(plant, wave, duration=duration, dt=dt, controller=controller,
+    nudged = simulate(plant, wave, duration=duration, dt=dt, controller=copy.copy(controller),
                       method="rk4", x0=x0)
     u_nudged = np.column_stack([nudged[k].values for k in commands])
     p_nudged = mean_power(nudged, pto)
@@ -92,6 +95,7 @@ def step_timing(controller, exported, record, plant, *, python_steps: int | None
     _, ns = c_ctrl.timed_run(y, t)
     out = {"c": step_statistics(ns)}
     n_py = len(t) if python_steps is None else min(python_steps, len(t))
+    controller = copy.copy(controller)          # a private run: the caller's is left alone
     controller.reset(plant)
     index = [plant.outputs.index(name) for name in inputs]
     full = np.zeros(len(plant.outputs))

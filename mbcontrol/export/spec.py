@@ -1,22 +1,31 @@
 """What an exported controller is made of: its measured inputs, its parameters, its constant
-data and the C engine that runs it, read off a controller bound to its plant.
+data and the C engine that runs it, read off the controller for its plant.
 
-Three engines (`csrc/`): "law" (passive, reactive: the CasADi-generated static law with its
-gains as parameters), "switching" (latching, declutching) and "mpc" (Kalman filter, AR
-forecast and the condensed QP, solved by the dual active-set solver of `csrc/mbc_qp.c`). Oracles
-cannot leave Python: an MPC with the true future wave or the plant's whole state would need
-what no device measures, so they are refused here. NMPC is not exported (its NLP solver,
-IPOPT, is not code-generatable).
+A controller class says whether it leaves Python by the law protocol's class attributes
+(controllers.law): `exportable`, and its `kind`, which picks the engine (`csrc/`) that runs
+it: "linear" (passive, reactive: the CasADi-generated static law with its gains as
+parameters), "switching" (latching, declutching) or "predictive" (the linear MPC, read
+through its `export_view`: Kalman filter, AR forecast and the condensed QP, solved by the
+dual active-set solver of `csrc/mbc_qp.c`). A class that is not exportable may say why in
+`export_refusal` (NMPC: its NLP solver, IPOPT, is not code-generatable). Oracles cannot
+leave Python: an MPC with the true future wave or the plant's whole state would need what
+no device measures, so they are refused here.
+
+The caller's controller is never reset or changed: an MPC is read through
+`Mpc.export_view(plant)` (its frozen settings and a setup built afresh for the plant);
+another law through a private copy bound to the plant (its reset rebinds, so the copy's
+binding leaves the original as it was).
 """
 from __future__ import annotations
 
+import copy
 from dataclasses import dataclass, field
 
 import casadi as ca
 import numpy as np
 
 from ..errors import InputError
-from ..sim import period_of
+from ..sim import export_refusal, exportable, law_kind, name_of, period_of
 
 # The exported QP's iteration cap per variable: the bound on a step's time. Past it the step
 # takes the previous plan's next move (within the force and rate limits; mbc_mpc.c).
@@ -47,23 +56,36 @@ class ControllerSpec:
     casadi: list = field(default_factory=list)
     engine: list = field(default_factory=list)
     context: str = ""                       # the C context struct's fields
-    settings: dict = field(default_factory=dict)
+    settings: dict = field(default_factory=dict)     # the bound controller's describe()
+    headers: list = field(default_factory=list)      # csrc headers mbc_controller.h includes
+    declarations: list = field(default_factory=list)  # more lines of mbc_controller.h
+    tables: list = field(default_factory=list)       # more C definitions of mbc_data.c
 
 
 def controller_spec(controller, plant) -> ControllerSpec:
-    """The spec of `controller` after controller.reset(plant) (called here)."""
-    controller.reset(plant)
-    name = controller.name
-    build = {"passive": _law_spec, "reactive": _law_spec, "latching": _switching_spec,
-             "declutching": _switching_spec, "mpc": _mpc_spec}.get(name)
-    if build is not None:
-        spec = build(controller, plant)
-        # s; the FMU samples on this grid (0: at every communication point)
-        spec.defines["MBC_SAMPLE_PERIOD"] = repr(float(period_of(controller) or 0.0))
-        return spec
-    raise InputError(f"export: controller {name!r} cannot be exported; exportable: passive, "
-                     f"reactive, latching, declutching, mpc (NMPC's solver, IPOPT, generates "
-                     f"no C)")
+    """The spec of `controller` for `plant`, by its class's `kind` (the engine), if it is
+    `exportable`; the controller itself is left as it is (see the module docstring)."""
+    build = ENGINES.get(law_kind(controller))
+    if not exportable(controller) or build is None:
+        from mbcontrol.controllers import REGISTRY
+        can = [n for n, cls in REGISTRY.items() if exportable(cls)]
+        why = export_refusal(controller) or (
+            "its class is not exportable" if build is not None
+            else f"no C engine for a law of kind {law_kind(controller)!r}")
+        raise InputError(f"export: controller {name_of(controller)!r} cannot be exported "
+                         f"({why}); exportable: {', '.join(can)}")
+    spec = build(controller, plant)
+    # s; the FMU samples on this grid (0: at every communication point)
+    spec.defines["MBC_SAMPLE_PERIOD"] = repr(float(period_of(controller) or 0.0))
+    return spec
+
+
+def bound_copy(controller, plant):
+    """A shallow copy of `controller` bound to `plant` by its own reset (which rebinds what
+    it sets): the original keeps its binding and its run."""
+    twin = copy.copy(controller)
+    twin.reset(plant)
+    return twin
 
 
 def sparse_rows(A: np.ndarray):
@@ -78,9 +100,10 @@ def _ptos(plant):
     return [p.name for p in plant.scene.ptos]
 
 
-def _law_spec(c, plant) -> ControllerSpec:
+def _law_spec(controller, plant) -> ControllerSpec:
+    c = bound_copy(controller, plant)
     names = _ptos(plant)
-    reactive = c.name == "reactive"
+    reactive = hasattr(c, "stiffness_per_pto")     # a stiffness term: position measured too
     inputs = ([f"{n}__position" for n in names] if reactive else []) + \
         [f"{n}__velocity" for n in names]
     nu = len(names)
@@ -113,10 +136,11 @@ def _law_spec(c, plant) -> ControllerSpec:
                           settings=c.describe())
 
 
-def _switching_spec(c, plant) -> ControllerSpec:
+def _switching_spec(controller, plant) -> ControllerSpec:
+    c = bound_copy(controller, plant)
     names = _ptos(plant)
     nu = len(names)
-    latching = c.name == "latching"
+    latching = hasattr(c, "brake_inertia")         # a brake holds the body: no motion held
     hold = c.latch_time if latching else c.declutch_time
     inertia = c.brake_inertia if latching else np.ones(nu)
     params = [Parameter(f"damping_{n}", float(v), "N s/m or N m s/rad",
@@ -141,13 +165,13 @@ def _switching_spec(c, plant) -> ControllerSpec:
         settings=c.describe())
 
 
-def _check_exportable_mpc(c) -> None:
+def _check_exportable_mpc(settings, setup) -> None:
     """Refuse an MPC the C engine cannot run as a device would."""
-    if c.forecast == "known" or c.uses_state:
+    if settings.oracle:
         raise InputError("export: this MPC is an oracle (forecast 'known' or estimator "
                          "'state'): it needs the future wave or the whole plant state, which a "
                          "device does not measure; export a causal one (forecast 'ar')")
-    if c.qp.n_env:
+    if setup.qp.n_env:
         raise InputError("export: this MPC keeps the linear model's envelope (relative heave "
                          "against a surface probe, angles), which the C engine does not hold "
                          "yet; export one without it (--set envelope=false, "
@@ -156,8 +180,13 @@ def _check_exportable_mpc(c) -> None:
 
 
 def _mpc_spec(c, plant) -> ControllerSpec:
-    _check_exportable_mpc(c)
-    cp, qp, kal = c.cp, c.qp, c.kalman
+    if not hasattr(c, "export_view"):
+        raise InputError(f"export: the predictive law {c.name!r} has no export_view(plant) "
+                         f"(its settings and setup, as controllers.Mpc gives them)")
+    view = c.export_view(plant)             # settings and a fresh setup: c is left alone
+    settings, setup = view.settings, view.setup
+    _check_exportable_mpc(settings, setup)
+    cp, qp, kal = setup.cp, setup.qp, setup.kalman
     outputs = list(plant.outputs)
     names = list(cp.ptos)
     nu, N = len(names), qp.N
@@ -165,7 +194,7 @@ def _mpc_spec(c, plant) -> ControllerSpec:
     velocity_inputs = [f"{n}__velocity" for n in names]
     inputs = kalman_inputs + [v for v in velocity_inputs if v not in kalman_inputs]
     nz, nd, nxi = cp.nz, cp.nd, kal.nxi
-    ar = c.ar
+    ar = setup.ar                           # the AR predictor's configuration
     ar_order = ar.order if ar is not None else 1
     window = ar.window if ar is not None else 1
     forms = qp.forms
@@ -178,18 +207,18 @@ def _mpc_spec(c, plant) -> ControllerSpec:
         "MBC_PHI_XI": ("double", kal.Phi_xi), "MBC_PPRED": ("double", qp.Phi),
         "MBC_OM": ("double", qp.Om), "MBC_QZ": ("double", qp.Qz), "MBC_QD": ("double", qp.Qd),
         "MBC_STROKE": ("double", qp.stroke), "MBC_RATE": ("double", qp.rate),
-        "MBC_FORCE_MAX": ("double", c.limits["force"]),
+        "MBC_FORCE_MAX": ("double", setup.limits["force"]),
     }
     form_rows = _qp_form_arrays(forms, arrays)
     nv_max = max(f.n_var for f in forms)
     na_max = max(max(f.A.shape[0] for f in forms), 1)
-    warm = [float(v) for v in c.warm_up_damping]
+    warm = [float(v) for v in setup.warm_up_damping]
     params = [Parameter(f"warm_up_damping_{n}", v, "N s/m or N m s/rad",
                         f"passive damper of PTO {n} until the first AR fit")
               for n, v in zip(names, warm)]
-    params += [Parameter("warm_up_s", float(c.warm_up_planned), "s",
+    params += [Parameter("warm_up_s", float(setup.warm_up_planned), "s",
                          "planned warm-up (the AR fit waits for it)"),
-               Parameter("blend_s", float(c.blend_s), "s",
+               Parameter("blend_s", float(setup.blend_s), "s",
                          "take-over from the damper to the MPC")]
     window_max = 4 * window                  # room for a warm-up up to 4x longer
     defines = {
@@ -198,8 +227,8 @@ def _mpc_spec(c, plant) -> ControllerSpec:
         "MBC_P": str(ar_order), "MBC_AR_WINDOW": str(window), "MBC_WINDOW_MAX": str(window_max),
         "MBC_AR_REFIT": str(ar.refit if ar is not None else 1),
         "MBC_AR_RIDGE": repr(ar.ridge if ar is not None else 0.0),
-        "MBC_FORECAST": {"none": "0", "ar": "1", "model": "2"}[c.forecast],
-        "MBC_DT": repr(c.dt_s), "MBC_FS": repr(qp.Fs), "MBC_LS": repr(qp.Ls),
+        "MBC_FORECAST": {"none": "0", "ar": "1", "model": "2"}[settings.forecast],
+        "MBC_DT": repr(settings.dt_s), "MBC_FS": repr(qp.Fs), "MBC_LS": repr(qp.Ls),
         "MBC_HAS_STROKE": str(int(qp.has_stroke)), "MBC_HAS_RATE": str(int(qp.has_rate)),
         "MBC_NFORMS": str(len(forms)),
         "MBC_QP_ITER_PER_VARIABLE": str(QP_MAX_ITER_PER_VARIABLE),
@@ -207,9 +236,18 @@ def _mpc_spec(c, plant) -> ControllerSpec:
     context = _mpc_context(n_params=len(params), n_kalman=kal.Phi.shape[0], nu=nu, nd=nd, N=N,
                            ar_order=ar_order, window_max=window_max, nv_max=nv_max,
                            na_max=na_max, n_forms=len(forms))
-    return ControllerSpec("mpc", "mpc", inputs, [f"u__{n}" for n in names], params,
+    return ControllerSpec("mpc", c.name, inputs, [f"u__{n}" for n in names], params,
                           defines=defines, arrays=arrays, engine=["mbc_mpc.c", "mbc_qp.c"],
-                          context=context, settings={**c.describe(), "forms": form_rows})
+                          context=context, settings=view.description, headers=["mbc_qp.h"],
+                          declarations=MPC_FORM_DECLARATIONS,
+                          tables=["const mbc_form MBC_FORMS[] = {" + ", ".join(form_rows)
+                                  + "};\n"])
+
+
+MPC_FORM_DECLARATIONS = [
+    "typedef struct { int nv, na, soft; const double *H; const int *A_start, *A_col; "
+    "const double *A_val, *lbx, *ubx, *g_slack; } mbc_form;",
+    "#define MBC_FORMS MBC_CAT(MBC_PREFIX, forms)", "extern const mbc_form MBC_FORMS[];"]
 
 
 def _qp_form_arrays(forms, arrays: dict) -> list:
@@ -247,3 +285,7 @@ def _mpc_context(*, n_params, n_kalman, nu, nd, N, ar_order, window_max, nv_max,
         f"double qp_work[MBC_QP_WORK({nv_max}, {na_max})];",
         f"int qp_iwork[MBC_QP_IWORK({nv_max}, {na_max})];",
         "long solves, failures, soft_solves, ar_fits, ar_unstable_fits;"])
+
+
+# the law's kind (controllers.law.KINDS) -> the spec of the engine that runs it
+ENGINES = {"linear": _law_spec, "switching": _switching_spec, "predictive": _mpc_spec}

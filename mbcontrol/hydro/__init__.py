@@ -6,7 +6,7 @@ Sub-packages by stage, each importing only those before it (tests/test_layout.py
 kernel, fits judged by the device's response, passivity) < ``model`` (the HydroModel a plant uses).
 
 Dataset layout returned by :func:`compute` (SI units, NED body frames at each CoG,
-time convention e^{-iωt}, excitation per unit wave amplitude at the n-frame origin):
+time convention e^{-iωt} as Capytaine's, excitation per unit wave amplitude at the n-frame origin):
 
 - coords ``omega`` (rad/s), ``radiating_dof``/``influenced_dof`` (``<body>__<Dof>``),
   ``wave_direction`` (rad, NED: direction waves travel to, +x towards +y starboard), ``body``, ``xyz``
@@ -18,9 +18,15 @@ time convention e^{-iωt}, excitation per unit wave amplitude at the n-frame ori
 Wave directions: the excitation between the data's headings, the headings a spread sea needs and
 axisymmetric data (module data.headings; `HydroModel.excitation_at`).
 
+Phasors: the data stay in e^{-iωt} on disk and in memory (files, the shipped fits and their cache
+keys are unchanged); above this package phasors are e^{+iωt}, the toolbox's public convention
+(python-control's, :mod:`mbcontrol.lti`). The one conversion is :func:`phasor` (the complex
+conjugate), used by `HydroModel.excitation_phasor`.
+
 Arrays: a mirror-symmetric layout is solved on its planes (module bem.array_bem); many bodies' radiation
 is fitted column by column (module fit.array_fit, :func:`fit_radiation_columns`).
 """
+from ..lti import phasor
 from .data.netcdf import read_netcdf, write_netcdf_atomic
 from .fit.baseline import fit_radiation_hankel
 from .bem.solve import cache_key, compute
@@ -49,7 +55,7 @@ from .fit.plots import hydro_figure
 from .source import converted_source, with_displaced_masses
 
 __all__ = [
-    "read_netcdf", "write_netcdf_atomic",
+    "read_netcdf", "write_netcdf_atomic", "phasor",
     "BemBody", "RIGID_DOFS", "compute", "cache_key", "matrix", "validate_body", "hull_mesh", "lid_mesh",
     "to_body_frames", "dof_map", "shift_matrix", "skew", "zup_to_ned",
     "RadiationModel", "fit_radiation", "fit_radiation_columns", "impulse_response", "convolution_force", "kernel_data",

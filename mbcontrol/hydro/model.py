@@ -1,7 +1,7 @@
 """The hydrodynamics a plant needs, restricted to the DOFs its joints can move.
 
-`HydroModel` holds body-frame BEM data (NED, at each CoG, exp(-i omega t); see mbcontrol.hydro)
-for the active DOFs and the radiation state-space model fitted to them. Fits are cached on disk
+`HydroModel` holds body-frame BEM data (NED, at each CoG, stored in exp(-i omega t) as
+Capytaine's; see mbcontrol.hydro) for the active DOFs and the radiation state-space model fitted to them. Fits are cached on disk
 (keyed by the data, the DOFs, the tolerance, the fit band and the fitting code), written to a
 temporary file and renamed.
 """
@@ -17,6 +17,7 @@ import xarray as xr
 from ..cache import cache_dir, rebuilt_once
 from ..console import status
 from ..errors import HydroError
+from ..lti import phasor
 from ..scene import DOF_NAMES, Scene
 from ..waves import Wave, coefficient_series, excitation_series, interpolate_complex
 from .data.netcdf import read_netcdf
@@ -70,7 +71,9 @@ class HydroModel:
         return self._matrix("hydrostatic_stiffness")
 
     def excitation_coefficients(self, direction: float = 0.0) -> np.ndarray:
-        """Complex excitation per unit amplitude (n_omega, n_dof), exp(-i omega t)."""
+        """Complex excitation per unit amplitude (n_omega, n_dof; N/m or N m/m) as stored,
+        exp(-i omega t): for the time-domain synthesis (mbcontrol.waves); phasors in the public
+        exp(+i omega t) convention come from `excitation_phasor`."""
         directions = self.data["wave_direction"].values
         i = int(np.argmin(np.abs(directions - direction)))
         if abs(directions[i] - direction) > 1e-6:
@@ -80,8 +83,16 @@ class HydroModel:
         da = self.data["excitation_force"].isel(wave_direction=i)
         return da.sel(influenced_dof=list(self.dofs)).transpose("omega", "influenced_dof").values
 
+    def excitation_phasor(self, omega, direction=0.0) -> np.ndarray:
+        """The excitation per unit wave amplitude (n, n_dof; N/m or N m/m) as exp(+i omega t)
+        phasors, the public convention (mbcontrol.lti): F(t) = Re[F e^{+i omega t}] for the
+        elevation Re[e^{+i omega t}] at the n-frame origin. The one place the stored
+        exp(-i omega t) data are converted; arguments and errors as `excitation_at`."""
+        return phasor(self.excitation_at(omega, direction))
+
     def excitation_at(self, omega, direction=0.0) -> np.ndarray:
-        """Complex excitation per unit amplitude (n, n_dof), exp(-i omega t), at frequencies
+        """Complex excitation per unit amplitude (n, n_dof), exp(-i omega t) as stored (the
+        public exp(+i omega t) phasors: `excitation_phasor`), at frequencies
         omega (rad/s, n) travelling in `direction` (rad, NED): one float (the data's heading,
         matched exactly, as `excitation_coefficients`) or one direction per frequency (a spread
         sea's components), interpolated between the data's headings (module headings).

@@ -31,7 +31,7 @@ from ..errors import FidelityError
 from ..hydro import HydroModel, fit_hydro_model, fit_method, load_hydro_data
 from ..multibody import build_topology
 from ..scene import DOF_NAMES, Scene, load_scene
-from .freeze import FREEZE_THRESHOLD, as_wave_list, freeze_report, frozen_scene
+from .freeze import as_wave_list, freeze_report, frozen_scene
 from .process import ProcessPlant, active_hydro_dofs, assemble_plant, device_around
 
 AUDIT_OUTPUTS = ("energy", "excitation_power", "radiated_power")   # plus "<pto>__power"
@@ -121,7 +121,7 @@ def linear_pressure_scene(scene: Scene) -> Scene:
 
 def plant_for(scene: Scene | str, fidelity: Fidelity | None = None, *, waves=None,
               hydro: HydroModel | None = None, reference: ProcessPlant | None = None,
-              freeze_threshold: float = FREEZE_THRESHOLD,
+              freeze_threshold: float | None = None,
               hydro_corrections: bool = False) -> ProcessPlant:
     """The process plant of `scene` at `fidelity` (default: the full model).
 

@@ -6,15 +6,17 @@ import dataclasses
 
 import numpy as np
 
+from .. import defaults
 from ..errors import FidelityError
-from ..lti import frequency_response
+from ..lti import frequency_response, phasor
 from ..scene import DOF_NAMES, Scene
 from ..waves import Wave
 from .jacobians import jacobians
 from .process import ProcessPlant
 
-FREEZE_THRESHOLD = 1e-3   # excitation and linear response below this share of the largest of
-                          # their unit class: the DOF contributes < 0.1 % to any compared signal
+# FREEZE_THRESHOLD: the default "fidelity.freeze_threshold" (1e-3: excitation and linear
+# response below this share of the largest of their unit class: the DOF contributes < 0.1 %
+# to any compared signal)
 ROTATIONS = ("Roll", "Pitch", "Yaw")
 
 
@@ -70,18 +72,20 @@ def frozen_scene(scene: Scene, dofs) -> Scene:
     return dataclasses.replace(scene, joints=tuple(new), frictions=frictions)
 
 
-def freeze_report(plant: ProcessPlant, waves, threshold: float = FREEZE_THRESHOLD) -> dict:
+def freeze_report(plant: ProcessPlant, waves, threshold: float | None = None) -> dict:
     """Which free-joint DOFs the waves cannot move, with the evidence, per body DOF.
 
     For each DOF of a free/composite joint: `excitation`, the RMS wave load on it (N or N m)
     over the waves' components relative to the largest of the same unit class (forces or
     moments) on any hydro DOF; and `response`, the RMS of its linear response (the plant
     linearised at rest, driven by the whole excitation, so DOFs moved through coupling count)
-    relative to the largest body motion of its class (m or rad). frozen = both < threshold.
+    relative to the largest body motion of its class (m or rad). frozen = both < threshold
+    (left out: the default "fidelity.freeze_threshold", 1e-3).
     The largest over the waves is kept. A DOF excited only parametrically (nonlinearly) is not
     caught here: `auto` checks the frozen model against the full one in simulation.
     """
     waves = as_wave_list(waves)
+    threshold = defaults.resolve("fidelity.freeze_threshold", threshold)
     dofs = [(f"{j.child}__{d}") for j in plant.scene.joints if j.type == "free" for d in j.dofs]
     bodies = [f"{b}__{d}" for b in plant.topology.bodies for d in DOF_NAMES]
     excitation, response = np.zeros(len(dofs)), np.zeros(len(dofs))
@@ -118,7 +122,7 @@ def _linear_rms(plant, wave, outputs):
         plant.x0(), np.zeros(len(plant.inputs)), np.zeros(n_w), plant.p0))
     rows = [plant.outputs.index(o) for o in outputs]
     G = frequency_response(A, Bw, C[rows], Dw[rows], wave.omega)    # exp(+i w t) phasors
-    y = np.einsum("wom,wm->wo", G, np.conj(F))
+    y = np.einsum("omw,wm->wo", G, phasor(F))
     return rms_w, np.sqrt(np.sum(0.5 * np.abs(y) ** 2, axis=0))
 
 

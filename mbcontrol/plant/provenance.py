@@ -9,6 +9,8 @@ import weakref
 
 import numpy as np
 
+# A cache, not state: a plant's content hashes, computed once per plant object (a plant's
+# scene and hydro data do not change) and dropped with it
 _CACHE: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 
 

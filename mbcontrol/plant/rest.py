@@ -20,6 +20,7 @@ import warnings
 import casadi as ca
 import numpy as np
 
+from .. import defaults
 from ..console import status
 from ..errors import SceneError
 
@@ -30,11 +31,11 @@ from ..errors import SceneError
 # parameters (its scene file says 0.5 %), oswec 9.8e-6 (its STL's centre of buoyancy 0.04 mm off the
 # CoG line). 10 % keeps wavestar with a margin of 1.7 and still refuses a mass 10 % off or a
 # wrong body (1.6 MN on the sphere: 38 % of its weight).
-IMBALANCE_TOL = 0.10
+# IMBALANCE_TOL: the default "plant.imbalance_tol" (mbcontrol.defaults)
 EQUILIBRIUM_TOL = 1e-9   # relative to the largest body weight: rest is an equilibrium
 # ... and what is left below this share of the weight is not worth a warning: a BEM file's
 # displaced volume printed to 7 digits (WEC-Sim's rm3.out: 6.5 N on 15.8 MN, 4e-7)
-EQUILIBRIUM_WARN = 1e-6
+# EQUILIBRIUM_WARN: the default "plant.equilibrium_warn" (mbcontrol.defaults)
 
 
 def _loads_at_rest(scene, topo, q, s, u, w, chi, tau, params):
@@ -123,14 +124,14 @@ def preloads(scene, topo, parts, pto_signals, params, buoyancy):
     worst = max(found, key=lambda e: e["share"], default=None)
     balancing = [p for p in scene.ptos if p.preload == "balance"]
     # a dry body that falls (no buoyancy along the coordinate, no preload) is a pendulum, not an error
-    if worst is not None and worst["share"] > IMBALANCE_TOL and (balancing or worst["buoyancy_scale"] > 0):
+    if worst is not None and worst["share"] > defaults.get("plant.imbalance_tol") and (balancing or worst["buoyancy_scale"] > 0):
         raise SceneError(
             f"{scene.path}: weight and buoyancy do not balance at rest: {_describe(scene, worst)}; more than "
-            f"{IMBALANCE_TOL:.0%}, which no preload may hide. Fix the [[body]] mass, or the draft / "
+            f"{defaults.get('plant.imbalance_tol'):.0%}, which no preload may hide. Fix the [[body]] mass, or the draft / "
             f"geometry (the hydro data's displaced volume), or the mapping of the BEM file's bodies "
             f"([hydro] source_bodies)")
     extra = ca.SX.zeros(tree.n_s)
-    record = {"imbalance": found, "tolerance": IMBALANCE_TOL, "preloads": {}}
+    record = {"imbalance": found, "tolerance": defaults.get("plant.imbalance_tol"), "preloads": {}}
     if balancing:
         d_fun = ca.Function("d", [q], [ca.horzcat(*[pto_signals[p.name][3] for p in balancing])])
         D = np.asarray(d_fun(np.zeros(tree.n_q)))
@@ -148,7 +149,7 @@ def preloads(scene, topo, parts, pto_signals, params, buoyancy):
     return extra, record
 
 
-_SAID: set[str] = set()
+_SAID: set[str] = set()     # said-once messages of this process (messages, never results)
 
 
 def say_once(message: str) -> None:
@@ -167,7 +168,7 @@ def _buoyancy_source(scene) -> str:
 
 def _warn_left(scene, tree, residual):
     weight = sum(b.mass for b in scene.bodies) * scene.water.g
-    floor = EQUILIBRIUM_WARN * max(1.0, max(b.mass for b in scene.bodies) * scene.water.g)
+    floor = defaults.get("plant.equilibrium_warn") * max(1.0, max(b.mass for b in scene.bodies) * scene.water.g)
     if np.max(np.abs(residual), initial=0.0) <= floor:
         return
     worst = np.argsort(-np.abs(residual))[:3]

@@ -8,10 +8,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from .. import defaults
 from ..errors import SimulationError
 
 
-ENERGY_MARGIN = 2.0     # a run may not end up with more than twice the energy put in
+# ENERGY_MARGIN, the default "sim.energy_margin": a run may not end up with more than twice the energy put in
 
 
 def energy_budget(plant, t, Y):
@@ -54,7 +55,7 @@ def energy_audit(plant, t, Y, method: str, dt: float, why=None) -> None:
         # wavestar), a mooring table extrapolated beyond its envelope (not quite
         # conservative), integration error on a free decay. An unstable step grows energy
         # geometrically, by orders of magnitude, and outgrows the floor within a few steps.
-        allowed = ENERGY_MARGIN * work_so_far + 0.05 * work_so_far[-1] + 0.5 * energy0 \
+        allowed = defaults.get("sim.energy_margin") * work_so_far + 0.05 * work_so_far[-1] + 0.5 * energy0 \
             + 1e-12
         with np.errstate(invalid="ignore"):
             bad = np.union1d(bad, np.flatnonzero(gain > allowed))

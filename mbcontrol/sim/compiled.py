@@ -31,6 +31,7 @@ from pathlib import Path
 
 import casadi as ca
 
+from .. import defaults
 from ..atomic import guarded, write_text
 from ..cache import cache_dir, exclusive, reason_of, set_aside
 from ..console import status
@@ -45,6 +46,7 @@ FLAGS = ("-O3", "-march=native", "-fno-math-errno", "-fassociative-math", "-fno-
 # the 6,000 samples of a 60 s record are then mapped in 0.25 s. (Its step, run 24,000 times per
 # 60 s, stays optimised: -O0 made those 15x slower.)
 PLAIN_FLAGS = ("-O0", "-shared", "-fPIC")
+# Said-once flags: which warnings this process has given (messages, never results)
 _warned = False
 _warned_cc = False
 
@@ -108,10 +110,10 @@ def _remove_stale_builds(folder: Path) -> None:
 
 
 def compiler() -> str | None:
-    """The C compiler to use ($CC, else gcc, else cc), or None. A $CC that is not a command
-    here is said once, and gcc or cc used instead."""
+    """The C compiler to use (the default "compile.cc", i.e. $CC, else gcc, else cc), or None.
+    One that is not a command here is said once, and gcc or cc used instead."""
     global _warned_cc
-    wanted = os.environ.get("CC")
+    wanted = str(defaults.get("compile.cc")) or None
     for name in (wanted, "gcc", "cc"):
         if name and shutil.which(name):
             if wanted and name != wanted and not _warned_cc:
@@ -219,7 +221,7 @@ def _interpreted(fun, how, why: str) -> ca.Function:
     return fun
 
 
-_TAGS: dict = {}
+_TAGS: dict = {}            # a cache, not state: compiler -> its version line (pure lookup)
 
 
 def _tag(cc: str) -> str:

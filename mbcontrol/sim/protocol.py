@@ -17,7 +17,9 @@ through the functions below:
 - `estimation_report(t, W) -> dict`: an estimator's accuracy against the true excitation W,
   kept in the run record;
 - `casadi_law_parametric(plant) -> (law(y, theta), theta)`: the law with its gains as
-  parameters, so one compiled function serves every gain.
+  parameters, so one compiled function serves every gain;
+- `kind` ("linear", "switching", "predictive"; controllers.law), `exportable` (bool) and
+  `export_refusal` (why not, a sentence): what the exporters learn of a registered law.
 """
 from __future__ import annotations
 
@@ -41,7 +43,8 @@ class Controller(Protocol):
 
 
 # the optional members and what their absence means
-OPTIONAL = {"uses_state": False, "estimation_report": None, "casadi_law_parametric": None}
+OPTIONAL = {"uses_state": False, "estimation_report": None, "casadi_law_parametric": None,
+            "kind": None, "exportable": False, "export_refusal": None}
 
 
 def name_of(controller) -> str:
@@ -67,3 +70,18 @@ def estimation_report(controller):
 def parametric_law(controller):
     """The controller's casadi_law_parametric method, or None."""
     return getattr(controller, "casadi_law_parametric", OPTIONAL["casadi_law_parametric"])
+
+
+def law_kind(controller) -> str | None:
+    """The registered law's kind ("linear", "switching", "predictive"), None if it has none."""
+    return getattr(controller, "kind", OPTIONAL["kind"])
+
+
+def exportable(controller) -> bool:
+    """Does the law say it can be exported as C?"""
+    return bool(getattr(controller, "exportable", OPTIONAL["exportable"]))
+
+
+def export_refusal(controller) -> str | None:
+    """Why the law cannot be exported, in its own words (None: it does not say)."""
+    return getattr(controller, "export_refusal", OPTIONAL["export_refusal"])

@@ -12,10 +12,8 @@ during the run, chunk by chunk) or a mechanical energy beyond what the waves and
 from __future__ import annotations
 
 import copy
-import platform
 import time
 import warnings
-from importlib import metadata
 
 import numpy as np
 import xarray as xr
@@ -23,16 +21,17 @@ import xarray as xr
 from .. import defaults
 from ..console import progress_bar
 from ..errors import InputError, SimulationError
-from ..plant import controlled_params, provenance
+from ..plant import controlled_params
 from ..results import jsonable
 from . import diagnose, integrators, sampled
 from .alongside import OutputsAlongside
-from .audit import diverged, energy_audit, energy_budget  # noqa: F401 (energy_budget: re-exported)
+from .audit import diverged, energy_audit
 from .held import HeldStepper
 from .methods import time_steps
 from .moordyn_run import prepare_moored, run_moored
 from .moorings import mooring_report
 from .protocol import estimation_report, uses_state
+from .record import run_dataset
 
 
 def simulate(plant, wave=None, *, duration: float, dt: float | None = None, controller=None,
@@ -117,7 +116,7 @@ def simulate(plant, wave=None, *, duration: float, dt: float | None = None, cont
     if audit:
         energy_audit(plant, t, Y, method, dt, why)
     eta = wave.elevation(t) if wave is not None else np.zeros_like(t)
-    ds = _dataset(plant, t, X, U_full, W, Y, eta, wave=wave, controller=controller,
+    ds = run_dataset(plant, t, X, U_full, W, Y, eta, wave=wave, controller=controller,
                   method=method, dt=dt, p=p, wall=wall)
     ds.attrs["output_time_s"] = output_wall
     if not spec.fixed_step:
@@ -324,58 +323,3 @@ def _progress_bar(progress: bool, n: int):
     if not progress:
         return None
     return progress_bar(total=n, unit="step", desc="simulate", leave=False)
-
-
-def _dataset(plant, t, X, U, W, Y, eta, *, wave, controller, method, dt, p, wall):
-    data = {}
-    # the wave field's rows (nonlinear Froude-Krylov) are the plant's internals, not results
-    excitation = plant.disturbances[:len(plant.disturbances) - plant.wave_rows]
-    for names, values in ((plant.outputs, Y), (plant.inputs, U), (excitation, W)):
-        data.update({name: ("time", values[:, i], {"units": plant.units(name)})
-                     for i, name in enumerate(names)})
-    data["eta"] = ("time", eta, {"units": "m", "long_name": "wave elevation at the origin, up"})
-    data["state"] = (("time", "state_name"), X)
-    if wave is not None:        # the wave itself, so the result can be checked against its bound
-        data.update({f"wave_{name}": ("wave_component", np.asarray(getattr(wave, name), float),
-                                      {"units": unit})
-                     for name, unit in (("omega", "rad/s"), ("amplitude", "m"), ("phase", "rad"))})
-        if wave.d_omega:
-            data["wave_omega"][2]["d_omega"] = float(wave.d_omega)
-    ds = xr.Dataset(data, coords={"time": ("time", t, {"units": "s"}),
-                                  "state_name": list(plant.states)})
-    made_by = provenance(plant)
-    ds.attrs.update({
-        "model": plant.name, "scene_sha256": made_by["scene_sha256"],
-        "hydro_sha256": made_by["hydro_sha256"] or "none",
-        "radiation_sha256": made_by["radiation_sha256"] or "none",
-        "method": method, "dt_s": dt,
-        "duration_s": float(t[-1]), "wall_time_s": wall,
-        # the run record (mbcontrol.results.RunInfo): Python values here, JSON only in files
-        # (copies: the describe() dicts may share a controller's own lists, which its next
-        # reset changes)
-        "wave": copy.deepcopy(wave.describe()) if wave is not None else {"type": "none"},
-        "controller": copy.deepcopy(controller.describe()) if controller is not None else None,
-        "parameters": dict(zip(plant.parameters, map(float, p))),
-        "hydro_source": plant.hydro.source if plant.hydro else "none",
-        "radiation_states": int(plant.hydro.radiation.A.shape[0]) if plant.hydro else 0,
-        "conventions": "NED n-frame (z down); body DOFs are CoG displacements (m) and ZYX "
-                       "Euler angles (rad); absorbed power positive",
-        "versions": _versions(),
-    })
-    return ds
-
-
-_VERSIONS: dict = {}
-
-
-def _versions() -> dict:
-    """Python's and the packages' versions: looked up once per process (the package metadata
-    lookups cost ~2-4 ms, every run otherwise); a copy, so callers may change it."""
-    if not _VERSIONS:
-        _VERSIONS["python"] = platform.python_version()
-        for pkg in ("mbcontrol", "casadi", "numpy", "control", "capytaine"):
-            try:
-                _VERSIONS[pkg] = metadata.version(pkg)
-            except metadata.PackageNotFoundError:
-                pass
-    return dict(_VERSIONS)

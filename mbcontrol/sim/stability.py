@@ -154,9 +154,9 @@ def stability_table(scene, wave, *, methods=("rk3", "rk4", "dopri5", "exp-rk4"),
 
     Scenarios: "scene" (as given), "radiation tol X" (the first of tight_radiation_tol, /5,
     /25 that adds states: more, faster poles), "end stop" (end_stop = (joint, travel,
-    stiffness), engaged by the wave; linear analysis at 1.5 x travel, held by the PTO),
-    "latching"
-    (`latching`: a controllers.Latching, sampled every step). dt_hi: the largest step tried
+    stiffness), engaged by the wave; linear analysis at 1.5 x travel, held by the PTO), and
+    one named after the controller `latching` (a controllers.Latching, sampled every step; no
+    linear analysis: it switches). dt_hi: the largest step tried
     (default: a quarter of the wave's period). Rows are dicts: scenario, method, states,
     linear_limit_s (None where the analysis does not apply), stable_s, unstable_s.
     """
@@ -172,7 +172,7 @@ def stability_table(scene, wave, *, methods=("rk3", "rk4", "dopri5", "exp-rk4"),
     if end_stop:
         scenarios.append(("end stop", build_plant(with_end_stop(scene, *end_stop)), None))
     if latching is not None:
-        scenarios.append(("latching", scenarios[0][1], latching))
+        scenarios.append((latching.name, scenarios[0][1], latching))
     rows, jobs = [], [(s, m) for s in scenarios for m in methods]
     bar = None
     if progress:
@@ -183,7 +183,7 @@ def stability_table(scene, wave, *, methods=("rk3", "rk4", "dopri5", "exp-rk4"),
             held = held_equilibrium(plant, end_stop[0], 1.5 * end_stop[1])
             if held is not None:
                 linear = linear_stability_limit(plant, method, dt_hi, x=held[0], u=held[1])
-        elif name != "latching":
+        elif controller is None:
             linear = linear_stability_limit(plant, method, dt_hi)
         stable, unstable = stability_limit(plant, method, wave, duration=duration,
                                            dt_lo=dt_hi / 256, dt_hi=dt_hi,

@@ -29,7 +29,7 @@ from ..scene import Scene, load_scene
 from ..sim import simulate
 
 RADIATION_LADDER = (0.02, 0.05, 0.1, 0.2)   # looser fits tried after the scene's tolerance
-SIGNAL_FLOOR = 1e-3     # signals below this share of their unit class's largest RMS: not compared
+# SIGNAL_FLOOR, the default "fidelity.signal_floor": signals below this share of their unit class's largest RMS: not compared
 INSTRUCTION_TIES = 0.05  # instruction counts within 5 % of the fewest are ties: fewer states
                          # win, then the lower error (so an equal-cost model never beats the full)
 WALL_VETO = 2.0         # a candidate measured this much slower than the fastest is not chosen:
@@ -38,7 +38,7 @@ WALL_VETO = 2.0         # a candidate measured this much slower than the fastest
 WALL_NOISE_S = 0.02     # ... unless it is under 20 ms: the sphere's 4,400-step runs take 3 ms,
                         # and one scheduler hiccup in the full model's runs (5.6 ms against
                         # 2.7 ms for its exact equal) vetoed it and flipped the choice
-STEPS_PER_PERIOD = 200  # default dt = T_p / 200: RK4's error ~ (w dt)^4 ~ 1e-6 at the peak
+# STEPS_PER_PERIOD, the default "fidelity.steps_per_period": default dt = T_p / 200: RK4's error ~ (w dt)^4 ~ 1e-6 at the peak
 ERROR_DEFINITION = ("max over compared signals and waves of RMS(y - y_ref) / RMS(y_ref) after "
                     "the wave ramp; y_ref: the full model at the same dt")
 
@@ -299,7 +299,7 @@ def compared_signals(plant, datasets, t_start) -> tuple[str, ...]:
         for n, value in rms.items():
             largest[plant.units(n)] = max(largest.get(plant.units(n), 0.0), value)
         keep |= {n for n, value in rms.items() if value > 0
-                 and value >= SIGNAL_FLOOR * largest[plant.units(n)]}
+                 and value >= defaults.get("fidelity.signal_floor") * largest[plant.units(n)]}
     return tuple(n for n in names if n in keep)
 
 
@@ -310,7 +310,7 @@ def _converged_step(run, full, dt, period, tol):
     given dt is kept and its step error only reported.
     """
     fixed = dt is not None
-    dt = period / STEPS_PER_PERIOD if dt is None else float(dt)
+    dt = period / defaults.get("fidelity.steps_per_period") if dt is None else float(dt)
     coarse = [ds for ds, _ in run.simulate(full, dt)]
     for halving in range(4):
         fine = [ds for ds, _ in run.simulate(full, dt / 2)]

@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .. import defaults
 from ..errors import WaveError
 from .spectra import jonswap_spectrum
 from .spreading import Spreading, component_directions
@@ -70,7 +71,7 @@ class Wave:
 
 # A wave steeper than this breaks (Michell 1893: H/L = 0.142 in deep water); no sea holds one,
 # and linear theory, which every model here builds on, holds only far below it.
-BREAKING_STEEPNESS = 1 / 7
+# BREAKING_STEEPNESS: the default "waves.breaking_steepness" (mbcontrol.defaults)
 MAX_PERIOD_S = 1000.0       # ocean swell stays below 30 s; past 1000 s it is a tide, not a wave
 # A sea's components: 600 s of a Tp 8 s sea is 276, three hours 5,000; 1e5 is 60 hours, while
 # "--duration 1e308" would ask numpy for more than memory holds
@@ -85,10 +86,10 @@ def check_steepness(height: float, period: float, what: str) -> None:
         raise WaveError(f"{what}: expected a finite height and a period of at most "
                         f"{MAX_PERIOD_S:g} s, got {height} m, {period} s")
     wavelength = 9.80665 * period ** 2 / (2 * math.pi)
-    if height > BREAKING_STEEPNESS * wavelength:
+    if height > defaults.get("waves.breaking_steepness") * wavelength:
         raise WaveError(f"{what}: {height:g} m over a {period:g} s period is steeper than a "
                         f"wave can be (it breaks at H/L = 1/7; the deep-water wavelength is "
-                        f"{wavelength:.4g} m, so at most {BREAKING_STEEPNESS * wavelength:.4g} m); "
+                        f"{wavelength:.4g} m, so at most {defaults.get('waves.breaking_steepness') * wavelength:.4g} m); "
                         f"expected a smaller height or a longer period")
 
 

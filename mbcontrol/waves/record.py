@@ -38,8 +38,9 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import defaults
 from ..errors import WaveError
-from .realisation import BREAKING_STEEPNESS, MAX_COMPONENTS, Wave
+from .realisation import MAX_COMPONENTS, Wave
 
 MAX_ROWS = 10_000_000      # 10^7 rows: 28 h at 100 Hz, a year at 1/3 Hz; more is not one run
 MAX_BYTES = 1 << 29        # 512 MiB: 10^7 rows of two 20-digit numbers, with room to spare
@@ -293,7 +294,7 @@ def _check_kept(settings: dict, keep, power, data_band) -> None:
     or with nothing inside the hydro data's band; note the share of its variance left out."""
     name, hs, tp = settings["source"], settings["hs_m"], settings["tp_s"]
     wavelength = 9.80665 * tp ** 2 / (2 * math.pi)
-    if hs > BREAKING_STEEPNESS * wavelength:
+    if hs > defaults.get("waves.breaking_steepness") * wavelength:
         raise WaveError(f"{name}: Hs {hs:.4g} m (4 std) at a peak period of {tp:.4g} s is "
                         f"steeper than a wave can be (it breaks at H/L = 1/7); expected the "
                         f"elevation column in metres (not mm or cm)")

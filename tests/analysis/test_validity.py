@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 from scipy.optimize import minimize
 
-from mbcontrol import build_plant, load_scene, waves
+from mbcontrol import build_plant, defaults, load_scene, waves
 from mbcontrol.analysis import summary
 from mbcontrol.analysis.ports import multiport_bound, port_responses, window_mean_power
-from mbcontrol.analysis.validity import POWER_ALLOWANCE, assess
+from mbcontrol.analysis.validity import assess
 from mbcontrol.sim import simulate
 
 from ..sphere_reference import heave_impedance
@@ -104,8 +104,9 @@ def test_a_corrupted_result_is_invalid_with_its_reasons(rm3):
     text = " ".join(verdict["invalid_reasons"])
     assert "complex-conjugate bound" in text and "energy balance" in text
     checks = verdict["checks"]
-    assert checks["mean_power_W"] > (1 + POWER_ALLOWANCE) * max(checks["bound_W"],
-                                                                 checks["window_bound_W"])
+    allowance = defaults.get("validity.power_allowance")
+    assert checks["mean_power_W"] > (1 + allowance) * max(checks["bound_W"],
+                                                          checks["window_bound_W"])
     assert ds.attrs["valid"] == 0 and ds.attrs["invalid_reasons"]
 
 

@@ -174,7 +174,7 @@ def test_hard_stroke_limit_infeasible_is_reported_not_a_crash(sphere):
         warnings.simplefilter("error", RuntimeWarning)
         mpc, _ = _run(sphere, REGULAR, 40.0, 0.02, horizon_s=6.0, dt_s=0.2, forecast="known",
                       force_max=2e5, stroke_max=0.05)
-    assert mpc.stats["failures"] == 0 and mpc.qp.soft_solves > 0
+    assert mpc.stats["failures"] == 0 and mpc.run.qp.soft_solves > 0
 
 
 def test_balanced_truncation_within_glover_bound():

@@ -41,9 +41,9 @@ def recorded():
     hard = mpc.qp.forms[0]
     solve = hard.solve
 
-    def recording(q, free, u_prev, warm):
+    def recording(q, free, u_prev, warm, memory=None):
         calls.append((q.copy(), [np.array(f) for f in free], np.array(u_prev)))
-        return solve(q, free, u_prev, warm)
+        return solve(q, free, u_prev, warm, memory)
 
     hard.solve = recording
     reset = mpc.reset
@@ -57,13 +57,14 @@ def _compare(form, calls):
     """(largest relative difference, calls the shortcut solved, infeasible calls, rows
     binding per kind in qpOASES's solutions: force bounds, stroke rows, rate rows)."""
     fast = ActiveSetQp(form.H, form.A)
+    memory = fast.memory()                  # this replay's warm start
     solver = ca.conic("ref", "qpoases", {"h": ca.DM(form.H).sparsity(),
                                           "a": ca.DM(form.A).sparsity()}, OPTIONS)
     worst, infeasible, solved, n = 0.0, 0, 0, form.n_u
     binding = {"force": 0, "stroke": 0, "rate": 0}
     for q, free, u_prev in calls:
         g, lba, uba = form.bounds(q, free, u_prev)
-        x = fast.solve(g, form.lbx, form.ubx, lba, uba)
+        x = fast.solve(g, form.lbx, form.ubx, lba, uba, memory)
         with contextlib.redirect_stdout(io.StringIO()):
             out = solver(h=form.H, a=form.A, g=g, lbx=form.lbx, ubx=form.ubx, lba=lba, uba=uba)
         if not solver.stats()["success"]:
@@ -76,7 +77,7 @@ def _compare(form, calls):
         binding["stroke"] += bool(np.any(lam_a[:n] != 0))
         binding["rate"] += bool(np.any(lam_a[-n:] != 0))
         if x is None:
-            fast.remember(lam_x, lam_a)
+            fast.remember(lam_x, lam_a, memory)
             continue
         solved += 1
         worst = max(worst, float(np.max(np.abs(x - ref)) / max(1.0, np.max(np.abs(ref)))))

@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from drivetrain_scenes import with_drivetrain
-from mbcontrol import build_plant, simulate, waves
+from mbcontrol import build_plant, waves
+from mbcontrol.analysis import simulate_checked as simulate  # the checked Dataset
 from mbcontrol.errors import SceneError
 from mbcontrol.scene import load_scene
 

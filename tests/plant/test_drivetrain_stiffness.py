@@ -18,7 +18,8 @@ import numpy as np
 import pytest
 
 from drivetrain_scenes import DRIVETRAIN, catalogue_copy
-from mbcontrol import build_plant, simulate, waves
+from mbcontrol import build_plant, waves
+from mbcontrol.analysis import simulate_checked as simulate  # the checked Dataset
 from mbcontrol.analysis.electrical import electrical_bound
 from mbcontrol.controllers.impedance import electrical_optimum, intrinsic_impedance
 from mbcontrol.errors import SceneError

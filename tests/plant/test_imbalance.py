@@ -7,8 +7,10 @@ import pytest
 
 from mbcontrol.errors import SceneError
 from mbcontrol.plant import build_plant
-from mbcontrol.plant.rest import IMBALANCE_TOL
+from mbcontrol import defaults
 from mbcontrol.scene import catalogue_dir
+
+IMBALANCE_TOL = defaults.get("plant.imbalance_tol")
 
 G = 9.81
 RHO_V = 1000.0 * 261.724          # kg: rho x sphere.out's displaced volume (VOLZ, m^3)

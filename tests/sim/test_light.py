@@ -7,7 +7,7 @@ from mbcontrol import waves
 from mbcontrol.errors import SimulationError
 from mbcontrol.plant import build_plant
 from mbcontrol.sim import integrators, light, simulate
-from mbcontrol.sim.run import _versions
+from mbcontrol.sim.record import _versions
 
 
 def _sea(plant, hs, tp, seed, duration):

@@ -23,6 +23,7 @@ import xarray as xr
 
 from mbcontrol.errors import HydroError
 
+from ... import defaults
 from ...cache import load_or_make
 
 from ...console import progress_bar
@@ -148,8 +149,9 @@ def _capytaine_bodies(bodies, lid: bool, depth: float):
 
 def _solve(solver, problems, *, progress: bool, n_jobs: int):
     """Solve ``problems`` (grouped by ω so each influence matrix is built and factorised once)."""
-    if n_jobs != 1:
-        return solver.solve_all(problems, n_jobs=n_jobs, progress_bar=progress)
+    if n_jobs != 1:         # Capytaine's own bar: off with "log.quiet" too, as ours are
+        return solver.solve_all(problems, n_jobs=n_jobs,
+                                progress_bar=progress and not defaults.get("log.quiet"))
     try:  # Capytaine's resolution / depth / irregular-frequency warnings, once for the whole set;
         # its log handler writes to stdout, which `--json` keeps for the JSON alone
         from capytaine.bem import problems_checks as chk

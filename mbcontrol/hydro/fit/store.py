@@ -75,7 +75,9 @@ def cached_fit(data: xr.Dataset, dofs, tol, source: str, omega_max: float = np.i
             _save_fit(path, model)             # a reused fit, under this device's name from now on
         return model
     started = time.perf_counter()
-    status(f"fitting the radiation model of {Path(source).name} ({len(dofs)} DOFs, tolerance "
+    # a label "FILE ([hydro] source of SCENE)" names the file; a plain path, its name
+    label = Path(source.split(" (")[0]).name if isinstance(source, str) else source
+    status(f"fitting the radiation model of {label} ({len(dofs)} DOFs, tolerance "
            f"{tol:g}, {method}): typically 5-90 s, once; cached afterwards", __name__)
     judged = {"device": device} if device is not None else {}
     fitter = fit_radiation if method == "coupled" else array_fit.fit_radiation_columns

@@ -17,6 +17,7 @@ import warnings
 import numpy as np
 import xarray as xr
 
+from ... import defaults
 from ...errors import HydroError
 from ..data.frames import split_dof
 from .damping import repair_negative_damping
@@ -30,7 +31,7 @@ ASYM_TOL = 1e-3
 # convergence guidance; its output carries 5-6 digits). An asymmetry up to BEM_ASYM_TOL (scaled, module
 # docs) is therefore that error, not a wrong file: symmetrised with a warning. Larger ones, where the fit
 # looks, are refused (rm3.out's float/spar roll pair: 2 % in A, 24 % in B).
-BEM_ASYM_TOL = 1e-2
+# BEM_ASYM_TOL: the default "hydro.bem_asymmetry_tol" (mbcontrol.defaults)
 DIAG_TOL = 1e-6
 EIG_TOL = 1e-3
 MAX_INTERP_RUN = 3
@@ -216,7 +217,7 @@ def _symmetry(ds, src, record, notes, *, tol, force, band_max=None):
                 in_band = (float(diff[ds["omega"].values <= band_max].max(initial=0.0))
                            if band_max is not None and x.ndim == 3 else worst)
                 outside = in_band <= tol
-                if not (force or outside or in_band <= BEM_ASYM_TOL):
+                if not (force or outside or in_band <= defaults.get("hydro.bem_asymmetry_tol")):
                     raise HydroError(msg + f" — set [hydro] source_options = {{ force_symmetric = true }} "
                                      f"in the scene to symmetrise it (Python: force_symmetric=True), or "
                                      f"[hydro] fit_omega_max below {w:.3g} rad/s if the device's seas lie "
@@ -227,7 +228,7 @@ def _symmetry(ds, src, record, notes, *, tol, force, band_max=None):
                        f"it lies above the radiation fit's band ([hydro] fit_omega_max = {band_max:g} "
                        f"rad/s; set [hydro] source_options = {{ force_symmetric = true }} to say so)"
                        if outside else
-                       f"{worst:.2g} is within the BEM's discretisation error ({BEM_ASYM_TOL:g}: a "
+                       f"{worst:.2g} is within the BEM's discretisation error ({defaults.get('hydro.bem_asymmetry_tol'):g}: a "
                        f"panel solution is reciprocal only to its accuracy); set [hydro] source_options "
                        f"= {{ asym_tol = {float(f'{worst * 1.05:.2g}'):g} }} to accept it without this warning")
                 warnings.warn(msg + f"; symmetrised because {why}", HydroCleaningWarning, stacklevel=4)

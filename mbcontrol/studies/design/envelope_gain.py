@@ -44,13 +44,14 @@ def lifted_envelope(plant, wave, name: str, pto_obj, design: dict, *, duration: 
     design inside the envelope, {"parameters", "mean_power_W", "excursions" (its verdict's
     checks)}; where the lifted law is the same, its run is the design's and the gain is 0.
     Scored as the design was: from score_from_s (s; None: after the ramp). None where it does
-    not apply: a plant without nonlinear pressure, a law other than passive or reactive,
+    not apply: a plant without nonlinear pressure, a law that is not linear (kind),
     several PTOs (tuned jointly, without an envelope already). robust: as the design was
     tuned (within the robustness floors, or the unconstrained optimum)."""
-    if not plant.pressure or name not in ("passive", "reactive") or len(plant.scene.ptos) > 1:
+    from mbcontrol.controllers import REGISTRY, make
+    if (not plant.pressure or REGISTRY[name].kind != "linear"
+            or len(plant.scene.ptos) > 1):
         return None
     from mbcontrol.analysis import pto_metrics, summary
-    from mbcontrol.controllers import make
     from mbcontrol.errors import SimulationError
     from mbcontrol.sim import simulate
 

@@ -32,12 +32,14 @@ import math
 
 import numpy as np
 
+from mbcontrol.controllers import DAMPER
 from mbcontrol.errors import ControllerError
+from ... import defaults
 
 SATURATED = "passive, saturated at force_max"
 # the clipped damper is taken at most this close to the Coulomb limit (c -> inf): beyond it
 # its damping c grows without bound for a few % more resistance
-COULOMB_SHARE = 0.98
+# COULOMB_SHARE: the default "design.coulomb_share" (mbcontrol.defaults)
 
 
 class NoLawForSea(ControllerError):
@@ -143,7 +145,7 @@ def saturated_damper(plant, wave, pto_obj, *, share: float | None = None,
                                       wave.direction, check_passive=False).impedance[0]))
     c_eq = np.geomspace(1e-3 * scale, 1e4 * scale, 600)
     st = _statistics(plant, wave, pto_obj.name, c_eq, exceedance)
-    reach = c_eq < COULOMB_SHARE * coulomb_limit(f_max, st["spread_v"], st["regular"])
+    reach = c_eq < defaults.get("design.coulomb_share") * coulomb_limit(f_max, st["spread_v"], st["regular"])
     holds = reach & (st["stroke_peak"] <= s_max)
     if math.isfinite(pto_obj.rated_power):
         holds &= st["power_W"] <= pto_obj.rated_power
@@ -151,7 +153,7 @@ def saturated_damper(plant, wave, pto_obj, *, share: float | None = None,
         j = int(np.argmin(np.where(reach, st["stroke_peak"], np.inf))) if reach.any() else 0
         raise NoLawForSea(
             f"even the force held at +-{f_max:.4g} N (a clipped damper at "
-            f"{100 * COULOMB_SHARE:.0f} % of its Coulomb limit, the most any force within "
+            f"{100 * defaults.get('design.coulomb_share'):.0f} % of its Coulomb limit, the most any force within "
             f"force_max resists) leaves the predicted stroke peak at "
             f"{st['stroke_peak'][j]:.3g} m, past stroke_max {s_max:.3g} m: no law within the "
             f"PTO's limits serves this sea (survival)", [])
@@ -174,14 +176,15 @@ def saturated_damper(plant, wave, pto_obj, *, share: float | None = None,
 def tune_with_fallback(plant, wave, name: str, pto_obj, notes: list, *, robust: bool = True,
                        model_params=None, limits: bool = True) -> dict:
     """The law for one sea, through the chain of the module doc: {"controller": the law to
-    make (name, or "passive" after a fallback), "parameters" (make(controller, **parameters,
-    **extra)), "predicted" (W, linear theory; None where there is none), "tuner" (its info;
-    a saturated law's numbers under "saturated"), "extra", "fallback": None, or {"fell_back":
-    true, "from": name, "to": the law used, "why": the tuned law's error}}. The tuned law is
-    used as it is when it holds the limits and the envelope; one the tuner could only bring
-    closest to the envelope (envelope inside false) is replaced by the saturated damper when
-    that holds it. Several PTOs or no limits: the tuner alone. NoLawForSea when nothing holds
-    (its attempts: every law tried and why not); a note says each fallback."""
+    make (name, or controllers.DAMPER after a fallback), "parameters" (make(controller,
+    **parameters, **extra)), "predicted" (W, linear theory; None where there is none),
+    "tuner" (its info; a saturated law's numbers under "saturated"), "extra", "fallback":
+    None, or {"fell_back": true, "from": name, "to": the law used, "why": the tuned law's
+    error}}. The tuned law is used as it is when it holds the limits and the envelope; one
+    the tuner could only bring closest to the envelope (envelope inside false) is replaced by
+    the saturated damper when that holds it. Several PTOs or no limits: the tuner alone.
+    NoLawForSea when nothing holds (its attempts: every law tried and why not); a note says
+    each fallback."""
     from ...controllers import LimitsUnreachable
 
     from .tuning import tune
@@ -246,22 +249,22 @@ def _fall_back(plant, wave, name, pto_obj, notes, why: str, robust: bool) -> dic
     if conflict:                       # the numbers that explain it, from the fallback's own check
         why = conflict
     attempts = [{"law": name, "why": why}]
-    if name != "passive":
-        passive_notes: list[str] = []
+    if name != DAMPER:
+        damper_notes: list[str] = []
         try:
-            parameters, predicted, tuner, extra = tune(plant, wave, "passive", pto_obj, True,
-                                                       None, passive_notes, robust=robust)
+            parameters, predicted, tuner, extra = tune(plant, wave, DAMPER, pto_obj, True,
+                                                       None, damper_notes, robust=robust)
         except ControllerError as exc:
-            attempts.append({"law": "passive", "why": str(exc)})
+            attempts.append({"law": DAMPER, "why": str(exc)})
         else:
             if (tuner.get("envelope") or {}).get("inside") is not False:
-                notes += passive_notes
-                notes.append(f"FELL BACK: {name} -> passive (detuned): {why}")
-                return {"controller": "passive", "parameters": parameters,
+                notes += damper_notes
+                notes.append(f"FELL BACK: {name} -> {DAMPER} (detuned): {why}")
+                return {"controller": DAMPER, "parameters": parameters,
                         "predicted": predicted, "tuner": tuner, "extra": extra,
-                        "fallback": {"fell_back": True, "from": name, "to": "passive",
+                        "fallback": {"fell_back": True, "from": name, "to": DAMPER,
                                      "why": why}}
-            attempts.append({"law": "passive", "why": tuner["envelope"].get("reason", "")})
+            attempts.append({"law": DAMPER, "why": tuner["envelope"].get("reason", "")})
     try:
         return _saturated(plant, wave, name, pto_obj, notes, why)
     except NoLawForSea as exc:
@@ -281,7 +284,7 @@ def _saturated(plant, wave, name, pto_obj, notes, why: str) -> dict:
                               f"the closest reaches {law['envelope_ratio']:.2f} of its limit")
         notes.append(f"OUTSIDE ITS ENVELOPE: {envelope['reason']}")
     tuner = {"function": "fallback.saturated_damper", "saturated": law, "envelope": envelope}
-    return {"controller": "passive",
+    return {"controller": DAMPER,
             "parameters": {"damping": law["damping"], "force_max": law["force_max"]},
             "predicted": law["predicted_W"], "tuner": tuner, "extra": {},
             "fallback": {"fell_back": True, "from": name, "to": SATURATED, "why": why}}

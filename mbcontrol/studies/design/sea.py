@@ -3,11 +3,13 @@ tuned as `design` tunes them (studies.design.tuning.tune, the PTO's limits and t
 model's envelope respected), and the bound the same envelope sets (analysis.envelope)."""
 from __future__ import annotations
 
+from mbcontrol.controllers import REGISTRY
 from mbcontrol.errors import ControllerError
 from mbcontrol.results import jsonable
 
-# what --design tunes: the controllers with a tuner or defaults fitted to the sea
-DESIGNABLE = ("passive", "reactive", "latching", "declutching", "mpc", "nmpc")
+# what --design tunes: every registered law, each with its tune() (a tuner, or defaults
+# fitted to the sea; controllers.register checks that it has one)
+DESIGNABLE = REGISTRY
 
 
 def design_for_sea(plant, wave, name: str, dt: float | None = None,
@@ -19,7 +21,7 @@ def design_for_sea(plant, wave, name: str, dt: float | None = None,
     several PTOs: the multiport complex-conjugate bound, no envelope), "bound": how it was
     made, "envelope": the tuner's verdict (inside, ratio, reason), "robustness": the linear
     laws' margins against controllers.robustness' floors (None for the others), "notes",
-    "controller": the law to make (`name`, or "passive" where the design fell back),
+    "controller": the law to make (`name`, or controllers.DAMPER where it fell back),
     "fell_back" and "fallback" (None, or {"fell_back", "from", "to", "why"}:
     studies.design.fallback)}. JSON-ready. robust: a reactive law tuned within those floors.
     A sea no law serves raises fallback.NoLawForSea (a ControllerError) with the reason."""
@@ -48,7 +50,7 @@ def design_for_sea(plant, wave, name: str, dt: float | None = None,
     envelope = tuner.get("envelope") or {"inside": None,
                                          "reason": f"{name}'s tuner does not take the envelope"}
     robust = None
-    if name in ("passive", "reactive") and len(ptos) == 1:   # the floors of `design`
+    if REGISTRY[name].kind == "linear" and len(ptos) == 1:   # the floors of `design`
         from ...controllers import loop_margins, loop_robustness
         gains = {k: parameters[k] for k in ("damping", "stiffness") if k in parameters}
         robust = loop_robustness(loop_margins(plant, gains, pto=ptos[0].name))

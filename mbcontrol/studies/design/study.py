@@ -54,17 +54,17 @@ import numpy as np
 from mbcontrol.errors import ControllerError, SimulationError
 from mbcontrol.results import jsonable
 
+from ... import defaults
 from ...controllers import REGISTRY, make
 from ...sim import period_of
 from .fallback import NoLawForSea, tune_with_fallback
-from .tuning import CONTRACT
 from .envelope_gain import lifted_envelope
 
-MAX_HARMONICS = 25            # the constrained bound's QP stays < 0.1 s (0.07 s at 15)
-SETTLE_TIME_CONSTANTS = 12      # e^-12 = 6e-6: the start-up transient left in the window
+# MAX_HARMONICS, the default "design.max_harmonics": the constrained bound's QP stays < 0.1 s (0.07 s at 15)
+# SETTLE_TIME_CONSTANTS, the default "design.settle_time_constants": e^-12 = 6e-6: the start-up transient left in the window
 # simulated power above a bound by more than this share is noted: the nonlinear plant, its
 # radiation fit and the held command move a run's power by well under 1 % of linear theory
-BOUND_TOLERANCE = 0.01
+# BOUND_TOLERANCE: the default "design.bound_tolerance" (mbcontrol.defaults)
 
 
 @dataclass
@@ -134,8 +134,8 @@ def design(plant, wave, name: str, *, pto: str | None = None, simulate_s: float 
     """Tune controller `name` for `wave`, check, bound, simulate and score it.
 
     plant: a ProcessPlant; wave: mbcontrol.waves.Wave (regular or a sea); name: a REGISTRY
-    name (passive, reactive, latching, declutching, mpc). pto: the PTO tuned and scored
-    (default the first).
+    name (passive, reactive, latching, declutching, mpc, nmpc, or a registered law). pto:
+    the PTO tuned and scored (default the first).
     simulate_s, dt: closed-loop simulation length and step (s; defaults in the module
     docstring). bounds: True (complex-conjugate, and pseudo-spectral with a sea's force band cut
     to analysis.constrained.MAX_FORCE_COMPONENTS frequencies, then a reference, not a bound),
@@ -181,7 +181,7 @@ def design(plant, wave, name: str, *, pto: str | None = None, simulate_s: float 
     if isinstance(predicted, dict):                  # jointly tuned: one figure per PTO
         predicted = predicted[pto_obj.name]
     many = len(plant.scene.ptos) > 1
-    linear = name in ("passive", "reactive")
+    linear = REGISTRY[name].kind == "linear"     # a loop transfer and linear theory
     # the other PTOs as the controller closes them: the same plant for margins and bounds
     others = None
     if linear and many:
@@ -222,7 +222,7 @@ def design(plant, wave, name: str, *, pto: str | None = None, simulate_s: float 
             repeat=repeat if whole else None, bound=bound, percent=percent, notes=notes)
     for key, value in percent.items():     # a bound beaten: linear theory failed this run
         kind = bound.get("constrained_kind", "bound") if key == "constrained" else "bound"
-        if value is not None and kind == "bound" and value > 100 * (1 + BOUND_TOLERANCE):
+        if value is not None and kind == "bound" and value > 100 * (1 + defaults.get("design.bound_tolerance")):
             notes.append(f"the simulated power is {value:.1f} % of the {key.replace('_', '-')} "
                          f"bound: the linear theory behind the bound does not hold for this run")
     lifted = None if not limits or metrics is None else lifted_envelope(
@@ -246,7 +246,7 @@ def _loop_checks(plant, wave, name, parameters, pto, predicted, others, tuner, n
     the share of the prediction linear theory explains; what the reader should know into
     `notes`."""
     from ...controllers import loop_margins, loop_robustness, share_explained
-    gains = {k: parameters[k] for k in CONTRACT[name]}
+    gains = {k: parameters[k] for k in REGISTRY[name].tuned}
     margins = loop_margins(plant, gains, pto=pto, params=others)
     if not margins.stable:
         notes.append(f"{name}: the closed loop is unstable on the plant, so it was not "
@@ -314,7 +314,7 @@ def _duration(wave, margins) -> float:
     T = float(wave.period)
     periods = 30
     if margins is not None and margins.pole_margin > 0:
-        need = wave.ramp_time + SETTLE_TIME_CONSTANTS / margins.pole_margin + 10 * T
+        need = wave.ramp_time + defaults.get("design.settle_time_constants") / margins.pole_margin + 10 * T
         periods = max(periods, math.ceil(need / T))
     return periods * T
 
@@ -327,7 +327,7 @@ def _harmonics(plant, wave) -> int:
     if wave.omega.size != 1 or plant.hydro is None:
         return 1
     k = int(np.floor(float(plant.hydro.omega[-1]) / float(wave.omega[0]) * (1 - 1e-9)))
-    return max(1, min(k, MAX_HARMONICS))
+    return max(1, min(k, defaults.get("design.max_harmonics")))
 
 
 def _bounds(plant, wave, pto, limit_values, mode, params=None, whole=False) -> dict:

@@ -40,16 +40,21 @@ import warnings
 
 import numpy as np
 
+from ... import defaults
 from ...console import progress_bar
 from .conformal import cv_plus_guarantee, cv_plus_interval, quantile_index
 
-ALPHA = 0.05          # 95 % intervals
-KAPPA = 0.3           # weight of the frequency slope in the scale (see the README's comparison)
+# ALPHA and KAPPA: the defaults "identify.alpha" (0.05: 95 % intervals) and "identify.kappa"
+# (0.3: the frequency slope's weight in the scale; see the README's comparison)
 SLOPE_STEP = 0.02     # relative step in omega for d ln a / d ln omega
 MAX_FOLDS = 5         # folds of frequencies when the fitted runs are one series
 MIN_SCORES = 9        # fewer than 1/ALPHA - 1 (19) scores: the largest, if n/(n+1) >= 90 %
-SCORE = (f"|measured - model| / (model * sqrt(1 + ({KAPPA} * d ln a / d ln omega)^2)), "
-         f"each fold's runs predicted by a fit on the other folds")
+
+
+def score_text() -> str:
+    """The calibration score as the JSON block states it, with the "identify.kappa" in force."""
+    return (f"|measured - model| / (model * sqrt(1 + ({defaults.get('identify.kappa')} * d ln a "
+            f"/ d ln omega)^2)), each fold's runs predicted by a fit on the other folds")
 
 
 def folds(runs) -> tuple[str, list[tuple[str, set]]]:
@@ -87,8 +92,9 @@ def frequency_slopes(problem, values: dict) -> dict:
 
 
 def scale(model: float, slope: float) -> float:
-    """The score's scale (channel unit): model * sqrt(1 + (KAPPA slope)^2)."""
-    return model * float(np.hypot(1.0, KAPPA * slope))
+    """The score's scale (channel unit): model * sqrt(1 + (KAPPA slope)^2), KAPPA the default
+    "identify.kappa"."""
+    return model * float(np.hypot(1.0, defaults.get("identify.kappa") * slope))
 
 
 def _fold_rows(problem, values, runs) -> dict:
@@ -103,13 +109,14 @@ def _fold_rows(problem, values, runs) -> dict:
 
 
 def calibrate(model: str, runs, validation, *, fit=(), method=None, progress: bool = False,
-              alpha: float = ALPHA, **options) -> dict:
+              alpha: float | None = None, **options) -> dict:
     """CV+ intervals for the `validation` runs' amplitudes from folds of the fitted `runs`
     (see the module). fit, method, options: as the main fit's (`setup.flume_identification`,
     `fit.fit`). Returns {"calibration": the JSON block (method, folds, score, n_scores,
     quantile_index, guarantee, ...), "intervals": {(run, channel): [lo, hi]} (channel unit;
-    empty when not calibrated)}."""
+    empty when not calibrated)}. alpha left out: the default "identify.alpha" (0.05)."""
     from .fit import fit as fit_problem
+    alpha = defaults.resolve("identify.alpha", alpha)
     from .setup import flume_identification
     how, parts = folds(runs)
     n = sum(len(r.channels) for r in runs)
@@ -156,8 +163,8 @@ def calibrate(model: str, runs, validation, *, fit=(), method=None, progress: bo
     ordered = np.sort(scores)
     block.update({
         "method": "CV+ (jackknife+ over folds of runs; Barber et al. 2021)",
-        "fold_runs": {name: sorted(held) for name, held in parts}, "score": SCORE,
-        "kappa": KAPPA, "quantile_index": k, "quantile": float(ordered[k - 1]),
+        "fold_runs": {name: sorted(held) for name, held in parts}, "score": score_text(),
+        "kappa": defaults.get("identify.kappa"), "quantile_index": k, "quantile": float(ordered[k - 1]),
         "guarantee": f"if new runs are exchangeable with the fitted ones: coverage >= "
                      f"{cv_plus_guarantee(n, len(parts), alpha):.1%} in the worst case "
                      f"(1 - 2 alpha - O(K/n)), about {1 - alpha:.1%} in practice; none for "

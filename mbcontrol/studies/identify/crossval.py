@@ -15,10 +15,11 @@ import warnings
 
 import numpy as np
 
+from ... import defaults
 from ...console import progress_bar
 from ...errors import InputError
 
-TIE = 0.01           # scores within 1 % (relative) of the best: the smaller structure wins
+# TIE, the default "identify.structure_tie": scores within 1 % (relative) of the best: the smaller structure wins
 
 
 def cross_validate(model: str, runs, candidates: dict, *, progress: bool = False,
@@ -62,7 +63,7 @@ def cross_validate(model: str, runs, candidates: dict, *, progress: bool = False
     if bar is not None:
         bar.close()
     low = min(c["score"] for c in out.values())
-    near = [n for n, c in out.items() if c["score"] <= low * (1 + TIE)]
+    near = [n for n, c in out.items() if c["score"] <= low * (1 + defaults.get("identify.structure_tie"))]
     best = min(near, key=lambda n: (out[n]["n_parameters"], out[n]["score"]))
     return {"groups": groups, "candidates": out, "best": best}
 

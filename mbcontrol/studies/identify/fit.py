@@ -37,8 +37,8 @@ from ...console import progress_bar
 from ...errors import InputError
 
 METHODS = ("gauss-newton", "nelder-mead")
-CORRELATION_LIMIT = 0.95
-CONDITION_LIMIT = 1e6
+# CORRELATION_LIMIT: the default "identify.correlation_limit" (mbcontrol.defaults)
+# CONDITION_LIMIT: the default "identify.condition_limit" (mbcontrol.defaults)
 AT_BOUND = 1e-6          # share of a parameter's span (in theta) that counts as on the bound
 
 
@@ -226,10 +226,10 @@ def _covariance(params, theta, r, J, blocks=None):
                 for k in np.flatnonzero(unseen)]
     for i in range(n):
         for j in range(i + 1, n):
-            if abs(corr[i, j]) > CORRELATION_LIMIT:
+            if abs(corr[i, j]) > defaults.get("identify.correlation_limit"):
                 messages.append(f"{names[i]} and {names[j]} are correlated "
                                 f"{corr[i, j]:+.3f}: the data cannot separate them")
-    if condition > CONDITION_LIMIT and not unseen.any():
+    if condition > defaults.get("identify.condition_limit") and not unseen.any():
         _, _, Vt = np.linalg.svd(Js)
         weak = Vt[-1]
         lead = [names[k] for k in np.argsort(-np.abs(weak)) if abs(weak[k]) > 0.3]

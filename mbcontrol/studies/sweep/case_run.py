@@ -1,4 +1,4 @@
-"""One case of a sweep: its plant (built once per process), its wave, its controller (tuned for
+"""One case of a sweep: its plant (built once per sweep run: `PlantCache`), its wave, its controller (tuned for
 its sea with --design), its run and its record. With ``--nonlinear invalid`` a sea whose linear
 run leaves the linear range is run again on the nonlinear plant (the scene with
 [hydro] hydrostatics = froude_krylov = "nonlinear"), with the same controller: the controller
@@ -8,45 +8,66 @@ from __future__ import annotations
 import math
 import time
 
-# The plants this process built, most recent last: cases run a plant at a time (`groups`),
-# so a few suffice, and a sweep over scene parameters (each value a plant with its compiled
-# code) does not keep every one it has passed
+# The plants a run keeps, most recent last: cases run a plant at a time (`groups`), so a few
+# suffice, and a sweep over scene parameters (each value a plant with its compiled code) does
+# not keep every one it has passed
 PLANTS_KEPT = 4
-_PLANTS: dict = {}
-# The last light run of this process, kept until the next one has its arrays: freed at once,
-# a run's records (35 MB for rm3 over an hour) top glibc's heap and go back to the kernel, and
-# the next case faults them in again page by page (rm3: 4,300 page faults, 12 ms of 70 a case)
-_LAST_RUN: list = []
 
 
-def _plant(model: str, scene_params: tuple, nonlinear: bool = False):
-    """The plant of a model and scene parameters (with ``nonlinear``: the scene's hydro bodies
-    under the nonlinear pressure, `mbcontrol.plant.with_nonlinear_pressure`), built once
-    while it is among the last PLANTS_KEPT used in this process."""
-    key = (model, scene_params) + (("nonlinear",) if nonlinear else ())
-    if key in _PLANTS:
-        _PLANTS[key] = _PLANTS.pop(key)                 # most recent last
-    else:
+class PlantCache:
+    """The plants one sweep run has built, and its last light run: owned by the caller (the
+    sweep makes one per run; a Dask worker holds one per run in `worker_plants.RunPlants`),
+    never kept between runs, so a scene edited on disk between two sweeps is built afresh.
+
+    plant(model, scene_params, nonlinear) builds a plant once while it is among the last
+    `kept` used; keep(...) gives it one the caller has already built. hold(run) keeps a light
+    run until the next one has its arrays: freed at once, a run's records (35 MB for rm3 over
+    an hour) top glibc's heap and go back to the kernel, and the next case faults them in
+    again page by page (rm3: 4,300 page faults, 12 ms of 70 a case)."""
+
+    def __init__(self, kept: int = PLANTS_KEPT):
+        self.kept = kept
+        self._plants: dict = {}
+        self._last_run = None
+
+    @staticmethod
+    def _key(model: str, scene_params: tuple, nonlinear: bool) -> tuple:
+        return (model, scene_params) + (("nonlinear",) if nonlinear else ())
+
+    def __len__(self) -> int:
+        return len(self._plants)
+
+    def plant(self, model: str, scene_params: tuple, nonlinear: bool = False):
+        """The plant of a model and sorted scene-parameter items (with ``nonlinear``: the
+        scene's hydro bodies under the nonlinear pressure,
+        `mbcontrol.plant.with_nonlinear_pressure`)."""
+        key = self._key(model, scene_params, nonlinear)
+        if key in self._plants:
+            self._plants[key] = self._plants.pop(key)          # most recent last
+            return self._plants[key]
         from ...plant import build_plant, with_nonlinear_pressure
         from ...scene import load_scene
         scene = load_scene(model, dict(scene_params) or None)
-        _PLANTS[key] = build_plant(with_nonlinear_pressure(scene) if nonlinear else scene)
-        while len(_PLANTS) > PLANTS_KEPT:
-            _PLANTS.pop(next(iter(_PLANTS)))
-    return _PLANTS[key]
+        return self.keep(model, scene_params,
+                         build_plant(with_nonlinear_pressure(scene) if nonlinear else scene),
+                         nonlinear)
+
+    def keep(self, model: str, scene_params: tuple, plant, nonlinear: bool = False):
+        """Remember `plant` as the one of (model, sorted scene-parameter items[, nonlinear]);
+        returns it."""
+        key = self._key(model, scene_params, nonlinear)
+        self._plants.pop(key, None)
+        self._plants[key] = plant
+        while len(self._plants) > self.kept:
+            self._plants.pop(next(iter(self._plants)))
+        return plant
+
+    def hold(self, run) -> None:
+        """Keep `run` (a light run's arrays) until the next one; the previous is let go now."""
+        self._last_run = run
 
 
-def keep_plant(model: str, scene_params: tuple, plant, nonlinear: bool = False) -> None:
-    """Remember `plant` as the one of (model, sorted scene-parameter items[, nonlinear]) for
-    the cases run in this process (a plant the caller has already built is not built again)."""
-    key = (model, scene_params) + (("nonlinear",) if nonlinear else ())
-    _PLANTS.pop(key, None)
-    _PLANTS[key] = plant
-    while len(_PLANTS) > PLANTS_KEPT:
-        _PLANTS.pop(next(iter(_PLANTS)))
-
-
-def run_case(case) -> dict:
+def run_case(case, plants: PlantCache | None = None) -> dict:
     """Simulate one case in closed loop and measure it: {"case": key, "metrics": {name:
     value} (per PTO `<pto>__<metric>` as `mbcontrol.analysis.metrics.pto_metrics`, and the
     totals mean_power_W, mean_electrical_power_W), "valid", "invalid_reasons",
@@ -59,10 +80,12 @@ def run_case(case) -> dict:
     the linear one, then, where that run leaves the linear range (an INVALID reason whose
     remedy is the nonlinear model), the nonlinear plant with the same controller: its record
     is the case's, with "model": "nonlinear" and the linear run's under "linear". A case of a
-    measured record (case.record, --records) runs in that record's wave (`records.record_wave`)."""
+    measured record (case.record, --records) runs in that record's wave (`records.record_wave`).
+    plants: the run's PlantCache (None: a new one, the plant built for this case alone)."""
+    plants = PlantCache() if plants is None else plants
     params, scene_params, settings = case.resolved()
     scene_key = tuple(sorted(scene_params.items()))
-    plant = _plant(case.model, scene_key, case.nonlinear == "always")
+    plant = plants.plant(case.model, scene_key, case.nonlinear == "always")
     direction = None if case.direction_deg is None else math.radians(case.direction_deg)
     if case.record:                       # a measured record (--records): its own wave
         from .records import record_wave
@@ -85,24 +108,26 @@ def run_case(case) -> dict:
         if law != case.controller:     # fell back to another law: only what it takes
             settings = {k: v for k, v in settings.items() if k in designed["settings"]}
         settings = {**designed["settings"], **settings}
-    record = _run(case, plant, wave, settings, params, start, law)
+    record = _run(case, (plant, plants), wave, settings, params, start, law)
     if case.nonlinear == "invalid":    # every record says which model made it
-        record = _escalated(case, record, scene_key, wave, settings, params, law) \
+        record = _escalated(case, record, (scene_key, plants), wave, settings, params, law) \
             if _left_linear_range(record) else {**record, "model": "linear"}
     if designed is not None:
         record["design"] = designed
     return record
 
 
-def _run(case, plant, wave, settings: dict, params: dict, start: float,
+def _run(case, where: tuple, wave, settings: dict, params: dict, start: float,
          law: str | None = None) -> dict:
-    """Run `case` with the controller `law` (default case.controller: --design may have
-    fallen back to another) made from `settings`; its record (failed_record if it raises)."""
+    """Run `case` on where = (plant, the run's PlantCache) with the controller `law` (default
+    case.controller: --design may have fallen back to another) made from `settings`; its
+    record (failed_record if it raises)."""
     import inspect
 
     from mbcontrol.controllers import REGISTRY, make
 
     from ...sim import can_run_light, simulate, simulate_arrays
+    plant, plants = where
     controller, law = None, law or case.controller
     if law:
         cls = REGISTRY[law]
@@ -113,7 +138,7 @@ def _run(case, plant, wave, settings: dict, params: dict, start: float,
         if can_run_light(plant, controller, case.method):
             run = simulate_arrays(plant, wave, duration=case.duration, dt=case.dt,
                                   method=case.method, params=params or None)
-            _LAST_RUN[:] = [run]     # the previous run is let go only now (see _LAST_RUN)
+            plants.hold(run)     # the previous run is let go only now (PlantCache.hold)
         else:
             run = simulate(plant, wave, duration=case.duration, dt=case.dt,
                            controller=controller, method=case.method, params=params or None)
@@ -128,18 +153,20 @@ def _left_linear_range(record: dict) -> bool:
     return left_linear_range(record["invalid_reasons"])
 
 
-def _escalated(case, linear: dict, scene_key: tuple, wave, settings, params,
+def _escalated(case, linear: dict, key: tuple, wave, settings, params,
                law: str | None = None) -> dict:
-    """The case run again on the nonlinear plant; the linear record under "linear". A
-    nonlinear run that cannot be made keeps the linear record, with the reason added."""
+    """The case run again on the nonlinear plant (key = (sorted scene-parameter items, the
+    run's PlantCache)); the linear record under "linear". A nonlinear run that cannot be made
+    keeps the linear record, with the reason added."""
+    scene_key, plants = key
     summary = {k: linear[k] for k in ("metrics", "valid", "invalid_reasons", "wall_time_s")}
     start = time.perf_counter()
     try:
-        plant = _plant(case.model, scene_key, True)
+        plant = plants.plant(case.model, scene_key, True)
     except Exception as exc:       # noqa: BLE001 - reported in the record, as a failed run
         record = failed_record(case, exc, start)
     else:
-        record = _run(case, plant, wave, settings, params, start, law)
+        record = _run(case, (plant, plants), wave, settings, params, start, law)
     if record.get("failed"):
         return {**linear, "model": "linear", "invalid_reasons": linear["invalid_reasons"] + [
             f"the nonlinear plant could not run this sea ({record['failure']})"]}

@@ -16,8 +16,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from ... import defaults
 
-QUADRATURE_STEP = math.radians(1.0)  # rad: direction bins of the expected power
+# QUADRATURE_STEP, the default "sweep.direction_step": rad: direction bins of the expected power
 
 
 def spread_sector(headings, spread: float) -> float:
@@ -51,7 +52,7 @@ def spread_power(plant, wave, velocities, damping) -> float:
     spreading = spreading_from_settings(wave.settings)
     omega = np.asarray(wave.omega, float)
     omega_p = 2 * math.pi / wave.settings["tp"]
-    n = max(2, math.ceil(2 * spreading.sector / QUADRATURE_STEP))
+    n = max(2, math.ceil(2 * spreading.sector / defaults.get("sweep.direction_step")))
     theta = spreading.mean - spreading.sector + (np.arange(n) + 0.5) * 2 * spreading.sector / n
     W = spreading.bin_weights(theta, omega, omega_p)                  # (n_omega, n)
     headings = plant.hydro.data["wave_direction"].values

@@ -23,9 +23,11 @@ from pathlib import Path
 
 import numpy as np
 
+from ... import defaults
 from ...errors import InputError
 
-MIN_HOURS = {"year": 24 * 120, "month": 24 * 7}
+# MIN_HOURS: the defaults "resource.min_hours_year" (24 x 120) and "resource.min_hours_month"
+# (24 x 7)
 
 
 @dataclass(frozen=True)
@@ -95,9 +97,10 @@ def ndbc_resource(paths, seas) -> Resource:
     weights, hours, notes = {}, {}, []
     for label in sorted(set(labels)):
         mine = index[[lab == label for lab in labels]]
-        if mine.size < MIN_HOURS[kind]:
+        least = defaults.get(f"resource.min_hours_{kind}")
+        if mine.size < least:
             notes.append(f"{kind} {label} left out: {mine.size} valid hours (fewer than "
-                         f"{MIN_HOURS[kind]})")
+                         f"{least})")
             continue
         weights[label] = np.bincount(mine, minlength=len(seas)) / mine.size
         hours[label] = int(mine.size)

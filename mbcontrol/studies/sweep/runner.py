@@ -12,8 +12,12 @@ the stepping, so a case without a controller skips the Dataset (`sim.light`), an
 cluster is started only when the sweep is long enough to pay for it (`execute`). Its workers
 are spawned (fresh interpreters): forking this process, which runs threads (Dask's event loop,
 the cluster's starter, progress bars, BLAS), can copy a lock another thread holds and hang the
-copy for ever; a CI run did. MBCONTROL_SWEEP_START=fork keeps the faster start for those who
-accept that, behind a start watchdog.
+copy for ever; a CI run did. The default "sweep.start" = "fork" (MBCONTROL_SWEEP_START=fork)
+keeps the faster start for those who accept that, behind a start watchdog.
+
+The plants live in the run's `PlantCache` (this process) and in a worker plugin registered for
+the run (`worker_plants.RunPlants`, Dask workers): nothing is kept in module state, so a second
+sweep in the same process builds its plants from the scene as it is then.
 """
 from __future__ import annotations
 
@@ -22,14 +26,21 @@ import os
 import time
 from collections import defaultdict
 
+from ... import defaults
 from ...console import progress_bar
+from ...errors import InputError
 
-from .case_run import _plant, keep_plant, run_case, sea_wave  # noqa: F401  (this module's face)
+from .case_run import PlantCache, run_case, sea_wave  # noqa: F401  (this module's face)
 
 
-def run_group(cases) -> list[dict]:
-    """A task: the cases of one plant, run in order."""
-    return [run_case(c) for c in cases]
+def run_group(cases, plants: str | PlantCache | None = None) -> list[dict]:
+    """A task: the cases of one plant, run in order. plants: the run's PlantCache, or on a
+    Dask worker the name of the run's `worker_plants.RunPlants` plugin (None: a new cache)."""
+    if isinstance(plants, str):
+        from .worker_plants import worker_plants
+        plants = worker_plants(plants)
+    plants = PlantCache() if plants is None else plants
+    return [run_case(c, plants) for c in cases]
 
 
 def groups(cases, per_task: int) -> list[list]:
@@ -50,13 +61,13 @@ def groups(cases, per_task: int) -> list[list]:
 # 0.03-0.05 s to close), opt-in only: a fork copies every lock of every thread (Dask's loop,
 # BLAS, tqdm's monitor) in whatever state it is, and one held lock hangs the copy; a CI run
 # hung 70 min that way. A sweep starts a cluster only when its cases, timed here, would take
-# longer serially (`_cluster_pays`); a start that has not finished in START_TIMEOUT_S is
-# abandoned with a warning and the cases run here.
+# longer serially (`_cluster_pays`; the default "sweep.cluster" = "always" starts it whatever
+# it costs); a start that has not finished in START_TIMEOUT_S is abandoned with a warning and
+# the cases run here.
 CLUSTER_COSTS = {"spawn": (3.0, 1.0), "fork": (0.5, 0.2)}
 START_TIMEOUT_S = 180.0
 CLOSE_MARGIN = 1.5          # the close counted 1.5 times: what the estimate leaves for noise
-CLUSTER_ENV = "MBCONTROL_SWEEP_CLUSTER"   # "always": start the local cluster whatever it costs
-START_ENV = "MBCONTROL_SWEEP_START"       # "spawn" (the default) or "fork" (faster, may hang)
+CLUSTER_CHOICES = ("auto", "always")
 # Dask starts workers with MALLOC_TRIM_THRESHOLD_=65536, which also turns off glibc's
 # adaptive mmap threshold: every array over 128 kB is then fresh pages from the kernel, and a
 # light case's NumPy work (records of 72,000 samples) ran 2-3x slower on a worker than here
@@ -66,18 +77,21 @@ WORKER_MALLOC = {"MALLOC_MMAP_THRESHOLD_": 1 << 25, "MALLOC_TRIM_THRESHOLD_": 1 
 
 
 def execute(cases, store, *, workers: int | None = None, scheduler: str | None = None,
-            progress: bool = True, per_task: int | None = None) -> dict:
+            progress: bool = True, per_task: int | None = None,
+            plants: PlantCache | None = None) -> dict:
     """Run the cases the store lacks; workers=0 runs serially in this process, None or N
     on a local Dask cluster of N workers (default: one per core), scheduler an address.
 
     A local cluster is started only when it pays: the first cases run here, timed; when the
     rest would finish sooner serially than with the cluster's start and close
     (CLUSTER_COSTS), they run here too (a small or light sweep, or one worker). Workers are
-    spawned in the background while this process keeps running cases
-    (MBCONTROL_SWEEP_START=fork: forked, faster to start, unsafe in a threaded process). A
-    cluster not started within START_TIMEOUT_S is abandoned (warning). Same cases, same
-    function, same numbers wherever a case runs. Returns {"computed", "reused", "wall_time_s", "where"}: "serial",
-    "cluster" or "scheduler"."""
+    spawned in the background while this process keeps running cases (default "sweep.start"
+    = "fork": forked, faster to start, unsafe in a threaded process). A cluster not started
+    within START_TIMEOUT_S is abandoned (warning). Same cases, same function, same numbers
+    wherever a case runs. plants: the run's PlantCache for the cases run here (None: a new
+    one); workers keep their own for this call. Returns {"computed", "reused",
+    "wall_time_s", "where"}: "serial", "cluster" or "scheduler"."""
+    plants = PlantCache() if plants is None else plants
     todo = [c for c in cases if not store.has(c.key)]
     reused = len(cases) - len(todo)
     start = time.perf_counter()
@@ -101,9 +115,9 @@ def execute(cases, store, *, workers: int | None = None, scheduler: str | None =
         where = "scheduler"
     elif queue and workers != 0:
         n = workers or os.cpu_count() or 1
-        where = _local(queue, save, n, per_task)
+        where = _local(queue, (save, plants), n, per_task)
     for case in queue:                     # serial, or what the local path left here
-        save([run_case(case)])
+        save([run_case(case, plants)])
     queue.clear()
     if bar is not None:
         bar.close()
@@ -112,8 +126,21 @@ def execute(cases, store, *, workers: int | None = None, scheduler: str | None =
 
 
 def _start_method() -> str:
-    chosen = os.environ.get(START_ENV, "")
-    return chosen if chosen in CLUSTER_COSTS else "spawn"
+    """How local workers start: the default "sweep.start" ("spawn" or "fork")."""
+    chosen = str(defaults.get("sweep.start"))
+    if chosen not in CLUSTER_COSTS:
+        raise InputError(f"sweep.start (MBCONTROL_SWEEP_START) = {chosen!r}: expected one of "
+                         f"{', '.join(CLUSTER_COSTS)}")
+    return chosen
+
+
+def _cluster_forced() -> bool:
+    """Whether the default "sweep.cluster" asks for the local cluster whatever it costs."""
+    chosen = str(defaults.get("sweep.cluster"))
+    if chosen not in CLUSTER_CHOICES:
+        raise InputError(f"sweep.cluster (MBCONTROL_SWEEP_CLUSTER) = {chosen!r}: expected one "
+                         f"of {', '.join(CLUSTER_CHOICES)}")
+    return chosen == "always"
 
 
 def _cluster_pays(serial_s: float, n_workers: int, method: str = "spawn") -> bool:
@@ -138,12 +165,14 @@ def idle_cores() -> int:
     return max(1, cores - busy)
 
 
-def _local(queue: list, save, n: int, per_task) -> str:
+def _local(queue: list, here: tuple, n: int, per_task) -> str:
     """Run `queue` (emptied) on a local cluster of n workers when it pays, else leave it to
-    the caller's serial loop. Returns where the cases ran. Workers only share the cores other
-    work leaves idle: on a machine already busy (a test suite with a worker per core) a
-    cluster's processes would only take turns with it, and its start and close are lost."""
-    forced = os.environ.get(CLUSTER_ENV) == "always"
+    the caller's serial loop; here = (save, the run's PlantCache) for the cases run here.
+    Returns where the cases ran. Workers only share the cores other work leaves idle: on a
+    machine already busy (a test suite with a worker per core) a cluster's processes would
+    only take turns with it, and its start and close are lost."""
+    save, plants = here
+    forced = _cluster_forced()
     method = _start_method()
     if not forced:
         usable = min(n, idle_cores())
@@ -152,7 +181,7 @@ def _local(queue: list, save, n: int, per_task) -> str:
         timed = []
         while queue and len(timed) < 2:    # the first pays one-off costs (code, caches)
             t0 = time.perf_counter()
-            save([run_case(queue.pop(0))])
+            save([run_case(queue.pop(0), plants)])
             timed.append(time.perf_counter() - t0)
         if not queue or not _cluster_pays(min(timed) * len(queue), usable, method):
             return "serial"
@@ -163,7 +192,7 @@ def _local(queue: list, save, n: int, per_task) -> str:
     starter.start()
     deadline = time.perf_counter() + START_TIMEOUT_S
     while queue and not forced and method == "spawn" and not starter.ready.is_set():
-        save([run_case(queue.pop(0))])      # while the workers start: nothing waits
+        save([run_case(queue.pop(0), plants)])   # while the workers start: nothing waits
     if not starter.ready.wait(max(0.0, deadline - time.perf_counter())):
         import warnings                     # its thread is a daemon: left behind, not joined
         warnings.warn(f"sweep: the local Dask cluster ({method}) did not start within "
@@ -179,7 +208,7 @@ def _local(queue: list, save, n: int, per_task) -> str:
             return "serial"
         if not queue:                       # this process finished them while it started
             return "serial"
-        _on_dask(queue, save, starter.client, per_task)
+        _on_dask(queue, save, starter.client, per_task, starter.plants)
         return "cluster"
     finally:
         starter.join()
@@ -188,13 +217,13 @@ def _local(queue: list, save, n: int, per_task) -> str:
 
 class _ClusterStarter:
     """A LocalCluster of n single-threaded worker processes, started by `method` ("spawn" or
-    "fork") on a thread (each worker's plant built and its compiled code loaded), so the
-    caller can keep computing."""
+    "fork") on a thread (the run's plant plugin registered, each worker's plant built and
+    its compiled code loaded), so the caller can keep computing."""
 
     def __init__(self, n: int, warm: tuple, method: str = "spawn"):
         import threading
         self.n, self.warm, self.method = n, warm, method
-        self.cluster = self.client = self.error = None
+        self.cluster = self.client = self.error = self.plants = None
         self.ready = threading.Event()
         self._thread = threading.Thread(target=self._run, name="sweep-cluster", daemon=True)
 
@@ -216,7 +245,8 @@ class _ClusterStarter:
             with dask.config.set(config):       # a worker restarted later is spawned
                 self.cluster = local_cluster(self.n, silence_logs=40)
             self.client = Client(self.cluster)
-            self.client.run(_warm, *self.warm)
+            self.plants = _register_plants(self.client)
+            self.client.run(_warm, *self.warm, plants=self.plants)
         except Exception as exc:           # reported by the caller, which runs on serially
             self.error = exc
         finally:
@@ -229,10 +259,19 @@ class _ClusterStarter:
             self.cluster.close()
 
 
+def _register_plants(client) -> str:
+    """Register a fresh `worker_plants.RunPlants` on the client's workers; its name."""
+    from .worker_plants import RunPlants
+    plugin = RunPlants()
+    client.register_plugin(plugin, name=plugin.name)
+    return plugin.name
+
+
 def _warm(model: str, scene_params: tuple, n_steps: int, method: str,
-          nonlinear: bool = False) -> None:
+          nonlinear: bool = False, *, plants: str, dask_worker=None) -> None:
     """On a worker: import what a case uses (the checks' control and scipy: ~1 s), build the
-    plant and load its compiled stepping and output code, before cases come."""
+    plant into the run's cache (the plugin `plants`) and load its compiled stepping and
+    output code, before cases come."""
     import numpy as np
 
     import mbcontrol.controllers  # noqa: F401
@@ -240,7 +279,9 @@ def _warm(model: str, scene_params: tuple, n_steps: int, method: str,
     import mbcontrol.analysis  # noqa: F401   (its metrics and validity checks)
     from ...sim import method as method_of
     from ...sim import plant_outputs, prepare
-    plant = _plant(model, scene_params, nonlinear)
+
+    from .worker_plants import worker_plants
+    plant = worker_plants(plants, dask_worker).plant(model, scene_params, nonlinear)
     if method_of(method).fixed_step:
         prepare(plant, n_steps, method)
         rows = n_steps + 1
@@ -248,19 +289,27 @@ def _warm(model: str, scene_params: tuple, n_steps: int, method: str,
                       np.zeros((rows, len(plant.disturbances))), plant.p0)
 
 
-def _on_dask(queue: list, save, client, per_task) -> None:
+def _on_dask(queue: list, save, client, per_task, plants: str | None = None) -> None:
     """Run `queue` (emptied) on a Dask client's workers, in tasks of a plant's cases: by
     default an eighth of each worker's share (at least one case; 13 light rm3 cases, ~1 s, in
     a 200-case sweep on 2 workers), so a task amortises its scheduling (milliseconds) and the
-    last tasks still balance."""
+    last tasks still balance. plants: the run's plant plugin on the workers (None: one is
+    registered for this call and removed after it, so a shared cluster keeps no plants)."""
     from dask.distributed import as_completed
     todo = list(queue)
     queue.clear()
-    n_workers = max(1, len(client.scheduler_info()["workers"]))
-    size = per_task or max(1, math.ceil(len(todo) / (8 * n_workers)))
-    futures = [client.submit(run_group, g, pure=False, retries=2) for g in groups(todo, size)]
-    for future in as_completed(futures):
-        save(future.result())
+    ours = plants is None
+    plants = _register_plants(client) if ours else plants
+    try:
+        n_workers = max(1, len(client.scheduler_info()["workers"]))
+        size = per_task or max(1, math.ceil(len(todo) / (8 * n_workers)))
+        futures = [client.submit(run_group, g, plants, pure=False, retries=2)
+                   for g in groups(todo, size)]
+        for future in as_completed(futures):
+            save(future.result())
+    finally:
+        if ours:
+            client.unregister_worker_plugin(plants)
 
 
 def _bar(progress: bool, total: int, reused: int):

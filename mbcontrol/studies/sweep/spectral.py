@@ -12,14 +12,15 @@ import math
 
 import numpy as np
 
-LINEAR_LAWS = (None, "passive", "reactive")
 STEP = 1e-3                       # relative central-difference step on a parameter
 
 
 def law_gains(plant, controller: str | None, settings: dict, params=None):
     """(gains, why): pto -> (damping, stiffness) of a linear law, or (None, why not).
     controller None: the scene PTOs' own law with `params` overrides."""
-    if controller not in LINEAR_LAWS:
+    from mbcontrol.controllers import REGISTRY
+    if controller is not None and (controller not in REGISTRY
+                                   or REGISTRY[controller].kind != "linear"):
         return None, f"the {controller} law is not linear"
     if any(f.coulomb for f in plant.scene.frictions):
         return None, "the scene's Coulomb friction is not linear"
@@ -33,8 +34,8 @@ def law_gains(plant, controller: str | None, settings: dict, params=None):
     from mbcontrol.controllers import make
     law = make(controller, **{k: v for k, v in settings.items() if k != "wave"})
     law.reset(plant)
-    c = law.damping_per_pto
-    k = law.stiffness_per_pto if controller == "reactive" else np.zeros_like(c)
+    c = law.damping_per_pto                  # a linear law's gains (controllers.law)
+    k = law.stiffness_per_pto if hasattr(law, "stiffness_per_pto") else np.zeros_like(c)
     return {p.name: (float(ci), float(ki)) for p, ci, ki in zip(plant.scene.ptos, c, k)}, None
 
 
@@ -101,8 +102,8 @@ def expected_power(plant, wave, gains, *, params=None, statespace: bool = False)
         G = excitation_transfer(plant, wave.omega, params=values, outputs=outputs, sys=sys)
 
         def velocities(direction):          # linear in the excitation: one G for all
-            F = np.conj(plant.hydro.excitation_at(wave.omega, direction))
-            return np.einsum("ioh,ih->io", G, F)
+            F = plant.hydro.excitation_phasor(wave.omega, direction)
+            return np.einsum("ohi,ih->io", G, F)
         return spread_power(plant, wave, velocities, [c for c, _ in gains.values()])
     if not statespace:
         responses = law_responses(plant, wave.omega, gains, direction=wave.direction,

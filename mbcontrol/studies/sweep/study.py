@@ -19,7 +19,7 @@ from .cases import build_cases, roles_for
 from .made_by import sweep_provenance
 from .records import label_summary, measured_seas, with_records
 from ...waves import annual_energy_MWh, site_energy_flux
-from .runner import execute, keep_plant
+from .runner import PlantCache, execute
 from .store import CaseStore, assemble
 from .zero import fell_back_summary, zero_note, zero_seas
 
@@ -60,7 +60,6 @@ def sweep(model: str, seas, *, seeds: int = 1, vary: dict | None = None, params=
     case runs, duration left out each record's own length (`records`; no annual energy)."""
     from mbcontrol.controllers import REGISTRY
 
-    from ...plant import build_plant
     from ...scene import load_scene
     start, given_duration = time.perf_counter(), duration
     duration = defaults.resolve("sweep.duration", duration)
@@ -68,10 +67,8 @@ def sweep(model: str, seas, *, seeds: int = 1, vary: dict | None = None, params=
     vary = {k: list(v) for k, v in (vary or {}).items()}
     scene = load_scene(model, scene_params or None)
     robust = _check_controller(controller, design, robust)
-    plant = build_plant(scene)
-    scene_key = tuple(sorted((scene_params or {}).items()))
-    keep_plant(model, scene_key, plant)   # serial path: reuse
-    _keep_nonlinear_plant(model, scene, scene_key, nonlinear)
+    plants, plant = _run_plants(model, scene, tuple(sorted((scene_params or {}).items())),
+                                nonlinear)
     roles = roles_for(vary, scene, plant.parameters, REGISTRY.get(controller))
     if identified is not None:
         from .uncertainty import read_identified
@@ -93,7 +90,8 @@ def sweep(model: str, seas, *, seeds: int = 1, vary: dict | None = None, params=
     if measured is not None:
         cases = with_records(cases, measured)
     case_store = CaseStore(store, inputs)
-    run = execute(cases, case_store, workers=workers, scheduler=scheduler, progress=progress)
+    run = execute(cases, case_store, workers=workers, scheduler=scheduler, progress=progress,
+                  plants=plants)
     depth, rho, g = scene.water.depth, scene.water.rho, scene.water.g
     made_by = sweep_provenance(inputs, controller, settings, vary, roles, amplitudes=amplitudes,
                                nonlinear=nonlinear, identified=identified, design=design,
@@ -154,14 +152,18 @@ def _check_controller(controller, design: bool, robust: bool) -> bool:
     return bool(robust and design)
 
 
-def _keep_nonlinear_plant(model: str, scene, scene_key: tuple, nonlinear: str) -> None:
-    """--nonlinear invalid|always: the nonlinear plant built now (a scene that cannot have it
-    fails before any case runs) and kept for the cases."""
+def _run_plants(model: str, scene, scene_key: tuple, nonlinear: str) -> tuple:
+    """(this run's PlantCache, the scene's plant): the plant built and kept for the cases run
+    here; with --nonlinear invalid|always the nonlinear plant too, built now (a scene that
+    cannot have it fails before any case runs). Nothing outlives the run."""
     if nonlinear not in NONLINEAR_MODES:
         raise InputError(f"--nonlinear {nonlinear}: expected one of {', '.join(NONLINEAR_MODES)}")
+    from ...plant import build_plant, with_nonlinear_pressure
+    plants = PlantCache()
+    plant = plants.keep(model, scene_key, build_plant(scene))
     if nonlinear != "scene":
-        from ...plant import build_plant, with_nonlinear_pressure
-        keep_plant(model, scene_key, build_plant(with_nonlinear_pressure(scene)), True)
+        plants.keep(model, scene_key, build_plant(with_nonlinear_pressure(scene)), True)
+    return plants, plant
 
 
 def _summary(ds, seas, run, wall, n_cases) -> dict:

@@ -2,6 +2,8 @@
 keys, same numbers to 1e-9); a local cluster starts only when the sweep pays for it."""
 import pytest
 
+from mbcontrol.errors import InputError
+
 from mbcontrol.sim import light
 from mbcontrol.studies.sweep import grid
 from mbcontrol.studies.sweep import case_run, runner
@@ -47,9 +49,9 @@ def test_spawned_workers_agree_with_serial(monkeypatch):
     cases = build_cases("rm3", grid([1.5, 3.0], [8.0, 11.0]), duration=200.0, dt=0.05)
     serial = CaseStore(None)
     runner.execute(cases, serial, workers=0, progress=False)
-    monkeypatch.delenv(runner.START_ENV, raising=False)
+    monkeypatch.delenv("MBCONTROL_SWEEP_START", raising=False)
     assert runner._start_method() == "spawn"
-    monkeypatch.setenv(runner.CLUSTER_ENV, "always")
+    monkeypatch.setenv("MBCONTROL_SWEEP_CLUSTER", "always")
     clustered = CaseStore(None)
     assert runner.execute(cases, clustered, workers=2, progress=False)["where"] == "cluster"
     for c in cases:
@@ -62,7 +64,7 @@ def test_small_sweep_on_workers_runs_here_and_forced_cluster_agrees(monkeypatch)
     assert runner.execute(cases, serial, workers=0, progress=False)["where"] == "serial"
     small = CaseStore(None)
     assert runner.execute(cases, small, workers=2, progress=False)["where"] == "serial"
-    monkeypatch.setenv(runner.CLUSTER_ENV, "always")
+    monkeypatch.setenv("MBCONTROL_SWEEP_CLUSTER", "always")
     clustered = CaseStore(None)
     result = runner.execute(cases, clustered, workers=2, progress=False)
     assert result["where"] == "cluster" and result["computed"] == len(cases)
@@ -83,7 +85,7 @@ def test_a_cluster_that_never_starts_is_abandoned_and_the_cases_run_here(monkeyp
 
     monkeypatch.setattr(runner, "_ClusterStarter", Stuck)
     monkeypatch.setattr(runner, "START_TIMEOUT_S", 0.5)
-    monkeypatch.setenv(runner.CLUSTER_ENV, "always")
+    monkeypatch.setenv("MBCONTROL_SWEEP_CLUSTER", "always")
     cases = build_cases("sphere", grid([1.0], [8.0, 10.0]), duration=50.0, dt=0.1)
     store = CaseStore(None)
     with pytest.warns(RuntimeWarning, match="did not start within 0 s"):
@@ -104,26 +106,36 @@ def test_a_busy_machine_runs_the_sweep_here(monkeypatch):
     monkeypatch.setattr(runner, "_cluster_pays", lambda *args: True)
     monkeypatch.setattr(runner._ClusterStarter, "start", lambda self: started.append(self))
     monkeypatch.setattr(runner, "START_TIMEOUT_S", 0.1)
-    monkeypatch.setattr(runner, "run_case", lambda case: {"case": case.key})
+    monkeypatch.setattr(runner, "run_case", lambda case, plants=None: {"case": case.key})
     cases = build_cases("sphere", grid([1.0], [8.0, 10.0, 12.0]), duration=50.0, dt=0.1)
     store = CaseStore(None)
     assert runner.execute(cases, store, workers=2, progress=False)["where"] == "serial"
     assert not started and all(store.has(c.key) for c in cases)
 
 
-def test_a_process_keeps_only_its_last_plants(monkeypatch):
-    """A sweep over scene parameters builds a plant per value; a worker keeps the last
-    PLANTS_KEPT (cases run a plant at a time), not every one it has passed."""
-    monkeypatch.setattr(case_run, "_PLANTS", {})
+def test_a_run_keeps_only_its_last_plants(monkeypatch):
+    """A sweep over scene parameters builds a plant per value; a run's PlantCache keeps the
+    last PLANTS_KEPT (cases run a plant at a time), not every one it has passed."""
     built = []
     monkeypatch.setattr("mbcontrol.plant.build_plant", lambda scene: built.append(scene) or object())
     monkeypatch.setattr("mbcontrol.scene.load_scene", lambda model, params=None: (model, params))
+    cache = case_run.PlantCache()
     keys = [(("mass", float(m)),) for m in range(case_run.PLANTS_KEPT + 3)]
-    plants = [case_run._plant("sphere", key) for key in keys]
-    assert len(case_run._PLANTS) == case_run.PLANTS_KEPT and len(built) == len(keys)
-    assert case_run._plant("sphere", keys[-1]) is plants[-1] and len(built) == len(keys)
-    case_run._plant("sphere", keys[0])                     # dropped long ago: built again
+    plants = [cache.plant("sphere", key) for key in keys]
+    assert len(cache) == case_run.PLANTS_KEPT and len(built) == len(keys)
+    assert cache.plant("sphere", keys[-1]) is plants[-1] and len(built) == len(keys)
+    cache.plant("sphere", keys[0])                          # dropped long ago: built again
     assert len(built) == len(keys) + 1
     mine = object()
-    case_run.keep_plant("sphere", (("mass", -1.0),), mine)   # a plant the caller built
-    assert case_run._plant("sphere", (("mass", -1.0),)) is mine and len(built) == len(keys) + 1
+    cache.keep("sphere", (("mass", -1.0),), mine)           # a plant the caller built
+    assert cache.plant("sphere", (("mass", -1.0),)) is mine and len(built) == len(keys) + 1
+    assert case_run.PlantCache().plant("sphere", keys[-1]) is not plants[-1]   # another run
+
+
+def test_unknown_cluster_choices_are_refused_by_name(monkeypatch):
+    monkeypatch.setenv("MBCONTROL_SWEEP_START", "thread")
+    with pytest.raises(InputError, match="sweep.start .*'thread'.*spawn, fork"):
+        runner._start_method()
+    monkeypatch.setenv("MBCONTROL_SWEEP_CLUSTER", "sometimes")
+    with pytest.raises(InputError, match="sweep.cluster .*'sometimes'.*auto, always"):
+        runner._cluster_forced()

@@ -16,7 +16,6 @@ from mbcontrol.plant import build_plant
 from mbcontrol.results import read_dataset
 from mbcontrol.sim import simulate
 from mbcontrol.studies.sweep import grid, sweep
-from mbcontrol.studies.sweep.runner import CLUSTER_ENV
 
 SEAS = grid([1.0, 2.0], [8.0, 11.0])
 # 140 s: the 2 Tp ramp and 10 peak periods of the longest sea, 11 s ("stats.min_periods")
@@ -44,7 +43,7 @@ def test_cases_equal_separate_simulate_runs():
 
 def test_serial_and_two_workers_agree(monkeypatch):
     serial, _ = sweep("sphere", SEAS, workers=0, **SHORT)
-    monkeypatch.setenv(CLUSTER_ENV, "always")        # too small to start one by itself
+    monkeypatch.setenv("MBCONTROL_SWEEP_CLUSTER", "always")   # too small to start one
     dask, result = sweep("sphere", SEAS, workers=2, **SHORT)
     assert result["computed"] == len(SEAS)
     xr.testing.assert_identical(serial.drop_attrs(), dask.drop_attrs())
