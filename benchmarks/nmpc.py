@@ -6,7 +6,7 @@ Case: the 10 m sphere in the regular wave H 2.5 m, T 9.6664 s (ramp one period),
 
 - sphere: the catalogue sphere (linear hydrostatics; 10 states), NMPC on its own model;
 - sphere, large-angle buoyancy: the same sphere with large_angle hydrostatics, NMPC on that
-  nonlinear model (as tests/test_nmpc.py's nonlinear case); skip with --no-nonlinear.
+  nonlinear model (as tests/controllers/test_nmpc.py's nonlinear case); skip with --no-nonlinear.
 
 Reported per row: median, 95th percentile and largest solve time per controller step (ms),
 mean IPOPT iterations, failures, the share of the controller period the 95th-percentile

@@ -8,7 +8,7 @@ import inspect
 import math
 from typing import Any, NamedTuple
 
-from mbcontrol.analysis import ENVELOPE_SHARE
+from mbcontrol import defaults
 from mbcontrol.errors import ControllerError
 from mbcontrol.results import jsonable
 
@@ -33,10 +33,10 @@ class Tuning(NamedTuple):
     extra: dict
 
 
-# a predictive law's default limit on the force rate (when it has a force limit): a full
-# reversal, -F_max to +F_max, takes at least a fifth of the wave period. A real drive cannot
-# switch within a few samples.
-RATE_REVERSALS_PER_PERIOD = 5
+# RATE_REVERSALS_PER_PERIOD, the default "design.rate_reversals_per_period" (5): a predictive
+# law's default limit on the force rate (when it has a force limit): a full reversal, -F_max
+# to +F_max, takes at least a fifth of the wave period. A real drive cannot switch within a
+# few samples.
 
 
 def accepts(func, keyword: str) -> bool:
@@ -96,7 +96,7 @@ def tune_linear(cls, tuner, plant, wave, pto_obj, *, limits=True, params=None, n
     info = {"function": tuner.__name__, "settings": dict(kw)}
     if limits and envelope:   # and the linear model's range (analysis.envelope)
         kw["envelope"] = True
-        info["envelope"] = {"share": ENVELOPE_SHARE, "inside": True}
+        info["envelope"] = {"share": defaults.get("envelope.share"), "inside": True}
     if limits:
         if math.isfinite(pto_obj.rated_power):     # detuned to the PTO's rated power
             kw["rated_power"] = info["settings"]["rated_power"] = pto_obj.rated_power
@@ -185,8 +185,8 @@ def untuned(cls, plant, wave, pto_obj, *, limits=True, params=None, notes=None) 
         own.setdefault("horizon_s", float(wave.period))
         own.setdefault("dt_s", float(wave.period) / 40)
         if "force_max" in finite:      # a drive's slew: a full reversal in a fifth of a period
-            own.setdefault("rate_max", RATE_REVERSALS_PER_PERIOD * 2 * finite["force_max"]
-                           / float(wave.period))
+            own.setdefault("rate_max", defaults.get("design.rate_reversals_per_period") * 2
+                           * finite["force_max"] / float(wave.period))
     controller = cls(**own, **extra)
     settings = {}
     for key in cls.tuned:

@@ -99,11 +99,12 @@ def limits_report(limits) -> list | None:
 
 def linear_range(plant, pto: str) -> float:
     """Default stroke limit (rad or m) of a PTO the scene leaves unlimited: LINEAR_RANGE_SHARE
-    of the range where linear hydrodynamics hold (ANGLE_MAX_RAD for a rotary PTO, the
+    of the range where linear hydrodynamics hold ("validity.angle_max" for a rotary PTO, the
     shallowest body's mean draft for a linear one); inf without hydro data."""
-    from mbcontrol.analysis import ANGLE_MAX_RAD, mean_draft
+    from mbcontrol import defaults
+    from mbcontrol.analysis import mean_draft
     if plant.units(f"{pto}__position") == "rad":
-        return LINEAR_RANGE_SHARE * ANGLE_MAX_RAD
+        return LINEAR_RANGE_SHARE * defaults.get("validity.angle_max")
     data = plant.hydro.data if plant.hydro is not None else None
     if data is None or "body" not in data.coords:
         return math.inf

@@ -50,7 +50,8 @@ holds (see LINEAR_RANGE_SHARE; reported in describe()["stroke_max_default"]).
 Envelope (envelope=True, the default): the quantities the physics checks measure, each
 body's heave relative to the surface (a probe measures the surface at the body; needs the
 wave) and its roll and pitch, are soft constraints at every step of the horizon, each within
-PEAK_SHARE of the check's limit (controllers.mpc_envelope; describe()["envelope"]). Without
+analysis.peak_share() of the check's limit (controllers.mpc_envelope;
+describe()["envelope"]). Without
 it the MPC rode PacWave's seas outside the linear model's range: sphere 28, rm3 17, OSWEC 10
 of 32 seas INVALID (200 s each); with it none.
 
@@ -81,8 +82,9 @@ from .limits import LINEAR_RANGE_SHARE
 from .mpc_settings import ORACLE_LABEL, SETTING_NAMES, MpcSettings
 from .mpc_setup import WARM_UP_PERIODS, MpcRun, MpcSetup, build_setup
 
-__all__ = ["Mpc", "MpcSettings", "MpcSetup", "MpcRun", "MpcView", "ORACLE_LABEL",
-           "WARM_UP_PERIODS"]
+# defined here (MpcSettings, MpcSetup, MpcRun and WARM_UP_PERIODS are documented where they
+# are defined, controllers.mpc_settings and mpc_setup; they stay importable from here)
+__all__ = ["Mpc", "MpcView", "ORACLE_LABEL"]
 
 
 class MpcView(NamedTuple):

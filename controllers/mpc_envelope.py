@@ -2,8 +2,8 @@
 
 Each quantity the physics checks measure (a surface-piercing body's heave relative to the
 surface, roll and pitch) becomes a row of the control plant's state, scaled by its peak
-limit PEAK_SHARE x the check's limit: an MPC bounds every sample, not a statistic, and
-std <= max |q| whatever the motion, so 2 std stays within ENVELOPE_SHARE of the limit. A
+limit analysis.peak_share() x the check's limit: an MPC bounds every sample, not a statistic,
+and std <= max |q| whatever the motion, so 2 std stays within "envelope.share" of it. A
 relative heave needs the surface at the body: a probe measures it each period (the wave seen
 at the body's centre of buoyancy, now: causal) and it is forecast as the excitation is (an
 AR model of the probe's samples), or taken from the wave with the oracle forecast "known".
@@ -25,14 +25,14 @@ class MpcEnvelope:
     probes: (wave seen at the body, item index) per relative heave."""
 
     def __init__(self, plant, wave, *, on: bool, forecast: str, dt: float):
-        from mbcontrol.analysis import PEAK_SHARE, envelope_items
+        from mbcontrol.analysis import envelope_items, peak_share
         from mbcontrol.analysis import wave_at
         self.items, self.probes = [], []
         if on and plant.hydro is not None:
             self.items = [i for i in envelope_items(plant) if not i.relative or wave is not None]
             self.probes = [(wave_at(plant, wave, *i.point), k)
                            for k, i in enumerate(self.items) if i.relative]
-        self.limits = PEAK_SHARE * np.array([i.limit for i in self.items])
+        self.limits = peak_share() * np.array([i.limit for i in self.items])
         self.forecast, self.dt = forecast, dt
 
     def surface_config(self, ar: ArConfig | None) -> ArConfig | None:

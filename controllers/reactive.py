@@ -103,7 +103,7 @@ class Reactive(Law):
 
     @property
     def saturation(self) -> np.ndarray:
-        """The command's limit per PTO, N or N m (inf: none), after reset()."""
+        """The command's limit per PTO in N or N m, inf where there is none, after reset()."""
         return self._limits.copy()
 
     def casadi_law(self, plant):

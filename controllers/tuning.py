@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from mbcontrol.analysis import ENVELOPE_SHARE, envelope_response
+from mbcontrol import defaults
+from mbcontrol.analysis import envelope_response
 from mbcontrol.errors import ControllerError
 
 from .impedance import (base_params, default_bounds, fd_statistics, hull_impedance,
@@ -41,7 +42,7 @@ def constrained_tuning(plant, wave, *, pto: str | None = None, params=None,
     peaks <= force_max (N) and stroke_max (m) (None: no limit) and, for a spring, a stable
     closed loop with margin >= min_margin (1/s), and with `envelope` every quantity of the
     linear model's range (analysis.envelope: relative heave against the mean draft, roll and
-    pitch against 30 deg) within ENVELOPE_SHARE of its limit, as predicted for this sea, and
+    pitch against 30 deg) within "envelope.share" of its limit, as predicted for this sea, and
     with `rated_power` (W) the predicted mean power (the objective's: electrical or
     mechanical) at most that: in a sea that would give more, the law detunes to it. With
     `min_stability` (controllers.robustness.STABILITY_FLOOR) the loop's least distance from
@@ -92,7 +93,7 @@ def constrained_tuning(plant, wave, *, pto: str | None = None, params=None,
             cc, kk = np.asarray(c, float)[..., None], np.asarray(k, float)[..., None]
             force = -(cc - 1j * kk / w) * F * wave.amplitude / (Z + cc - 1j * kk / w)
             st["envelope_ratio"] = env.ratio(np.conj(force))
-            feasible = feasible & (st["envelope_ratio"] <= ENVELOPE_SHARE)
+            feasible = feasible & (st["envelope_ratio"] <= defaults.get("envelope.share"))
         return st[key], feasible, st
 
     if bounds is None:

@@ -25,6 +25,7 @@ import tempfile
 import time
 import warnings
 import zipfile
+from contextvars import ContextVar
 from pathlib import Path
 
 from . import defaults
@@ -245,3 +246,28 @@ def in_cache(path) -> bool:
         return Path(path).resolve().is_relative_to(cache_dir().resolve())
     except OSError:
         return False
+
+
+class ServedLog:
+    """What a cache served, told to a caller that asks: inside `with log.recording() as
+    served:` every entry noted (`log.note`) is appended to `served`, for each recorder active
+    (nested ones each get it); with none active, noting does nothing. The active recorders are
+    a ContextVar, so nothing is kept between calls and no caller sees another's (threads and
+    tasks each start with none). models/generate_hydro.py --ship-fits records the fits and
+    MoorDyn statics the catalogue's plants use."""
+
+    def __init__(self, name: str):
+        self._recorders: ContextVar[tuple] = ContextVar(name, default=())
+
+    def note(self, item) -> None:
+        for served in self._recorders.get():
+            served.append(item)
+
+    @contextlib.contextmanager
+    def recording(self):
+        served: list = []
+        token = self._recorders.set(self._recorders.get() + (served,))
+        try:
+            yield served
+        finally:
+            self._recorders.reset(token)

@@ -129,6 +129,19 @@ _REGISTRY: dict[str, Default] = {
                                                       "resource's per-year weights", int),
     "resource.min_hours_month": Default(24 * 7, "h", "valid hours a month needs to enter a "
                                                      "resource's per-month weights", int),
+    "validity.angle_max": Default(math.radians(30.0), "rad", "roll and pitch (significant) "
+                                                             "beyond which linear "
+                                                             "hydrodynamics do not describe "
+                                                             "a body"),
+    "validity.draft_factor": Default(1.0, "", "relative heave limit in mean drafts (V / A_wp)"),
+    "envelope.share": Default(0.9, "", "share of the validity limits a tuned setting's "
+                                       "predicted significant motion is kept within; a "
+                                       "predictive controller bounds every sample at half "
+                                       "of it"),
+    "design.rate_reversals_per_period": Default(5, "", "force reversals per peak period a "
+                                                       "tuned law's rate limit allows "
+                                                       "(rate_max = this x 2 force_max / Tp)",
+                                                int),
 }
 
 _set: dict[str, object] = {}

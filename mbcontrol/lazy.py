@@ -1,7 +1,7 @@
 """Package faces that load what they export on first use (PEP 562): `mbcontrol`,
 `mbcontrol.sim` and `mbcontrol.controllers` name their exports here rather than importing every module, so that
 a quick answer of the command line (`--help`, `models`) imports no simulator, CasADi, xarray
-or python-control (tests/cli/test_startup.py)."""
+or python-control (tests/features/cli/test_startup.py)."""
 from __future__ import annotations
 
 from importlib import import_module

@@ -108,17 +108,18 @@ def ship_fits(names=None) -> int:
     """Build the plants, copy the fits they used into models/radiation_fits (atomically)."""
     from mbcontrol.atomic import write_bytes
     from mbcontrol.cache import cache_dir
-    from mbcontrol.hydro import FITS_SERVED, shipped_fits_dir
-    from mbcontrol.plant import Fidelity, build_plant
+    from mbcontrol.hydro import recording_served_fits, shipped_fits_dir
+    from mbcontrol.plant import Fidelity, build_plant, recording_served_statics
     from mbcontrol.scene import list_models
     out = shipped_fits_dir()
     out.mkdir(parents=True, exist_ok=True)
     wanted = set()
-    for name in names or list_models():
-        for freeze in [()] + SHIP_VARIANTS.get(name, []):
-            FITS_SERVED.clear()
-            build_plant(name, fidelity=Fidelity(freeze=freeze) if freeze else None)
-            wanted.update(FITS_SERVED)
+    with recording_served_statics() as statics:
+        for name in names or list_models():
+            for freeze in [()] + SHIP_VARIANTS.get(name, []):
+                with recording_served_fits() as fits:
+                    build_plant(name, fidelity=Fidelity(freeze=freeze) if freeze else None)
+                wanted.update(fits)
     for fit in sorted(wanted):
         if (out / fit).exists():
             continue
@@ -126,20 +127,21 @@ def ship_fits(names=None) -> int:
     stale = [p for p in out.glob("radiation_*.npz") if p.name not in wanted and not names]
     for path in stale:
         path.unlink()
-    _ship_statics(out.parent)
+    _ship_statics(out.parent, statics)
     print(f"models/radiation_fits: {len(wanted)} fits ({len(stale)} stale removed)")
     return 0
 
 
-def _ship_statics(models: Path) -> None:
-    """The MoorDyn statics of the catalogue's lines files, beside them (plant.moordyn_statics)."""
+def _ship_statics(models: Path, served) -> None:
+    """The MoorDyn statics of the catalogue's lines files, beside them (plant.moordyn_statics):
+    served, the (lines file, key, statics) the plants asked for (the first of each key)."""
     import json
     from mbcontrol.atomic import write_bytes
-    from mbcontrol.plant import STATICS_SERVED, shipped_statics
+    from mbcontrol.plant import shipped_statics
     shipped = {}
-    for lines, key, statics in STATICS_SERVED:
+    for lines, key, statics in served:
         if Path(lines).resolve().parent == models.resolve():
-            shipped.setdefault(lines, {})[key] = statics
+            shipped.setdefault(lines, {}).setdefault(key, statics)
     for lines, entries in shipped.items():
         write_bytes(shipped_statics(lines), json.dumps(entries, indent=1).encode())
         print(f"{shipped_statics(lines).name}: {len(entries)} statics")

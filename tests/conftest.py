@@ -1,10 +1,6 @@
-"""Test-suite set-up: the shared helpers beside this file (sphere_reference.py) import by name
-from any test folder (tests run with --import-mode=importlib, which adds no folder to sys.path)."""
-import sys
-from pathlib import Path
-
-sys.path.insert(0, str(Path(__file__).parent))
-
+"""Test-suite set-up. The shared helpers live in tests/helpers/ (a package) and are imported as
+`tests.helpers.<name>`: tests run with --import-mode=importlib, which names each module by its path
+from the rootdir, so `tests` resolves without any folder on sys.path (no test touches sys.path)."""
 import os
 
 import pytest
@@ -42,13 +38,16 @@ def pytest_runtest_makereport(item, call):
 # reads.) Files start longest first (these, measured on a cold cache on a 2-core machine; the
 # order only balances the workers, it changes no result), the rest in collection order.
 LONGEST_FIRST = (
-    "tests/test_notebooks.py", "tests/test_readme.py", "tests/studies/sweep/test_sweep.py",
-    "tests/test_cli.py", "tests/controllers/test_nmpc.py", "tests/controllers/test_joint.py",
-    "tests/studies/identify/test_identify.py", "tests/controllers/test_electrical.py",
-    "tests/studies/identify/test_flume_data.py", "tests/hydro/test_bem.py",
-    "tests/controllers/test_wecccomp.py", "tests/hydro/test_fit_where_it_matters.py",
-    "tests/export/test_export.py", "tests/hydro/test_fixed_bodies.py",
-    "tests/cli/test_identify.py", "tests/hydro/test_radiation.py",
+    "tests/features/test_notebooks.py", "tests/features/test_readme.py",
+    "tests/features/studies/sweep/test_sweep.py", "tests/features/test_cli.py",
+    "tests/controllers/test_nmpc.py", "tests/controllers/test_joint.py",
+    "tests/features/studies/identify/test_identify.py",
+    "tests/features/controllers/test_electrical.py",
+    "tests/features/studies/identify/test_flume_data.py", "tests/hydro/test_bem.py",
+    "tests/features/controllers/test_wecccomp.py",
+    "tests/features/hydro/test_fit_where_it_matters.py", "tests/features/export/test_export.py",
+    "tests/features/hydro/test_fixed_bodies.py", "tests/cli/test_identify.py",
+    "tests/hydro/fit/test_radiation.py",
 )
 
 

@@ -196,7 +196,7 @@ def test_the_face_is_the_curated_list():
 
 
 def test_import_mbcontrol_stays_cheap():
-    """The face loads nothing heavy until a name is used (tests/cli/test_startup.py's rule)."""
+    """The face loads nothing heavy until a name is used (tests/features/cli/test_startup.py's rule)."""
     probe = ("import sys\nimport mbcontrol as mbc\ndir(mbc)\nmbc.__version__\n"
              "print(*[m for m in ('casadi', 'xarray', 'control', 'capytaine', 'dask') "
              "if m in sys.modules])")

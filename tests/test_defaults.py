@@ -146,7 +146,9 @@ MOVED = {"validity.power_allowance": 0.10, "validity.energy_tolerance": 0.05,
          "fidelity.signal_floor": 1e-3, "fidelity.freeze_threshold": 1e-3,
          "waves.breaking_steepness": 1 / 7, "sweep.direction_step": 0.017453292519943295,
          "resource.min_hours_year": 2880, "resource.min_hours_month": 168,
-         "sweep.cluster": "auto", "sweep.start": "spawn", "compile.cc": ""}
+         "sweep.cluster": "auto", "sweep.start": "spawn", "compile.cc": "",
+         "validity.angle_max": 0.5235987755982988, "validity.draft_factor": 1.0,
+         "envelope.share": 0.9, "design.rate_reversals_per_period": 5}
 
 
 def test_moved_constants_are_listed_with_their_values(capsys, monkeypatch):
@@ -168,6 +170,24 @@ def test_moved_constants_are_read_at_call_time():
         assert scale(2.0, -10.0) == pytest.approx(2.0 * np.hypot(1, 6.0))
         assert "(0.6 * d ln a" in score_text()
     assert "(0.3 * d ln a" in score_text()
+
+
+def test_moved_envelope_constants_are_read_at_call_time():
+    """The envelope's share and the validity limits (issue 59): an override reaches the
+    excursion ratios and the MPC's peak share without a module reloaded."""
+    from mbcontrol.analysis import peak_share
+    from mbcontrol.studies.design.envelope_gain import excursion_ratios
+    excursions = {"float": {"relative_heave_significant": 2.0, "relative_heave_limit_m": 4.0,
+                            "pitch_significant": 0.2}}
+    assert peak_share() == 0.45
+    assert excursion_ratios(excursions) == {"float relative heave": 0.5,
+                                            "float pitch": 0.2 / (np.pi / 6)}
+    with defaults.override(envelope_share=0.6, validity_draft_factor=2.0,
+                           validity_angle_max=0.4):
+        assert peak_share() == 0.3
+        assert excursion_ratios(excursions) == {"float relative heave": 0.25,
+                                                "float pitch": 0.5}
+    assert peak_share() == 0.45
 
 
 def test_the_cli_quiet_flag_sets_the_default_not_the_environment(monkeypatch):

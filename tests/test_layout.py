@@ -229,11 +229,13 @@ def test_every_package_is_installed():
 
 
 def test_cited_test_files_exist():
-    """README and docstrings point readers at tests as evidence: every cited tests/...py path
-    exists (they moved once, and five citations went stale)."""
+    """README, the guide and docstrings point readers at tests as evidence: every cited
+    tests/...py path exists (they moved once, and five citations went stale; they moved again
+    when the tests came to mirror the source)."""
     import re
     cited = {}
-    for path in [ROOT / "README.md", *MODULES.values()]:
+    for path in [ROOT / "README.md", ROOT / "notebooks" / "guide.md", *MODULES.values(),
+                 *(ROOT / "benchmarks").rglob("*.py"), *(ROOT / "tests").rglob("*.py")]:
         for name in re.findall(r"tests/[A-Za-z0-9_/]+\.py", path.read_text()):
             cited.setdefault(name, str(path.relative_to(ROOT)))
     missing = {name: where for name, where in cited.items() if not (ROOT / name).exists()}
@@ -373,9 +375,6 @@ DOCUMENTED_STATE = {
     "mbcontrol/plant/provenance.py:_CACHE": "cache: an immutable plant's content hashes (weak)",
     "mbcontrol/sim/record.py:_VERSIONS": "cache: package versions",
     "mbcontrol/sim/run.py:_VERSIONS": "cache: package versions",
-    # known, still to go (issue 59): logs of what generate_hydro --ship-fits ships
-    "mbcontrol/hydro/fit/store.py:FITS_SERVED": "TODO: a recorder the caller owns",
-    "mbcontrol/plant/moordyn_statics.py:STATICS_SERVED": "TODO: a recorder the caller owns",
 }
 MUTATORS = {"append", "add", "update", "pop", "clear", "setdefault", "extend", "insert",
             "remove", "discard", "popitem"}
@@ -444,3 +443,74 @@ def test_no_environment_variable_is_a_switch_inside_the_library():
              or path.parent.name != "mbcontrol" for line in _environment_reads(path)}
     assert found == set()
     assert _environment_reads(ROOT / "mbcontrol" / "defaults.py")     # the scan sees it there
+
+
+# Tests mirror the source (issue 59): tests/<package>/.../test_<module>.py tests
+# mbcontrol/<package>/.../<module>.py, or the subpackage <module>/ (controllers/ for
+# tests/controllers/); tests/test_<name>.py a top-level module or package of mbcontrol.
+# A test of a feature across modules sits in tests/features/ (its folders mirror the package it
+# mostly exercises); shared helpers sit in tests/helpers/, imported as tests.helpers.<name>.
+TESTS = ROOT / "tests"
+NOT_NAMED_BY_A_MODULE = {
+    "tests/test_layout.py": "the repository's layout, read from every module: no one module",
+    "tests/controllers/test_mpc_causal.py": "the Mpc's causal preview; named by its module once "
+                                            "the Mpc split (issue 59, item 2) settles",
+    "tests/controllers/test_mpc_device.py": "the Mpc on a device model; as above",
+    "tests/controllers/test_mpc_parts.py": "the Mpc's settings/setup/log parts; as above",
+    "tests/controllers/test_mpc_qp_fast.py": "the Mpc's fast QP path; as above",
+}
+NOT_A_TEST_OR_HELPER = {   # .py files under tests/ that are neither tests, conftest nor helpers
+    "tests/waves/make_mhkit_reference.py": "the script that computed test_mhkit_reference.py's "
+                                           "values (needs MHKiT, run by hand)",
+}
+
+
+def _tested_module(test: Path) -> Path | None:
+    """The source a module test names, or None: tests/<a>/<b>/test_<c>.py -> mbcontrol/<a>/<b>/<c>.py
+    or the subpackage mbcontrol/<a>/<b>/<c>/."""
+    parts = test.relative_to(TESTS).parts
+    name = parts[-1].removeprefix("test_").removesuffix(".py")
+    base = ROOT / "controllers" if parts[0] == "controllers" else ROOT / "mbcontrol" / parts[0]
+    folder = base.joinpath(*parts[1:-1]) if len(parts) > 1 else ROOT / "mbcontrol"
+    for source in (folder / f"{name}.py", folder / name / "__init__.py"):
+        if source.exists():
+            return source
+    return None
+
+
+def test_tests_mirror_the_source():
+    """Every test outside tests/features/ is named by the module (or subpackage) it tests, in
+    the folder that mirrors the module's; the rest is listed above with its reason."""
+    misplaced = []
+    for test in sorted(TESTS.rglob("test_*.py")):
+        where = str(test.relative_to(ROOT))
+        if test.relative_to(TESTS).parts[0] in ("features", "helpers") \
+                or where in NOT_NAMED_BY_A_MODULE:
+            continue
+        if _tested_module(test) is None:
+            misplaced.append(where)
+    assert misplaced == [], "name each by its module, or move it to tests/features/"
+    stale = [name for name in NOT_NAMED_BY_A_MODULE if not (ROOT / name).exists()
+             or _tested_module(ROOT / name) is not None]
+    assert stale == []          # the list only shrinks: a listed test that moved leaves it
+
+
+def test_helpers_are_a_package_and_no_test_touches_sys_path():
+    """Shared code lives in tests/helpers/ (imported as tests.helpers.<name>); no file under
+    tests/ puts a folder on sys.path (strings, such as a script a test writes, do not count)."""
+    loose = [str(p.relative_to(ROOT)) for p in TESTS.rglob("*.py")
+             if not p.name.startswith("test_") and p.name != "conftest.py"
+             and p.relative_to(TESTS).parts[0] != "helpers"
+             and str(p.relative_to(ROOT)) not in NOT_A_TEST_OR_HELPER]
+    assert loose == []
+    assert (TESTS / "helpers" / "__init__.py").exists()
+    touching = []
+    for path in TESTS.rglob("*.py"):
+        for n in ast.walk(ast.parse(path.read_text())):
+            if isinstance(n, ast.Attribute) and n.attr == "path" and isinstance(n.value, ast.Name) \
+                    and n.value.id == "sys":
+                touching.append(f"{path.relative_to(ROOT)}:{n.lineno}")
+            elif isinstance(n, ast.ImportFrom) and n.module == "sys" and any(
+                    a.name == "path" for a in n.names):
+                touching.append(f"{path.relative_to(ROOT)}:{n.lineno}")
+    assert touching == []

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from mbcontrol.waves import irregular, jonswap_spectrum, ramp, regular
-from wave_reference import HS, TP, WP, half_cosine, jonswap_reference, m0_quad, pm_reference
+from tests.helpers.wave_reference import HS, TP, WP, half_cosine, jonswap_reference, m0_quad, pm_reference
 
 # ------------------------------------------------------------------------ regular and ramp
 

@@ -11,7 +11,7 @@ passes), `summary` (a run's metrics, verdict and provenance: the simulate --json
 from .bounds import complex_conjugate_bound, pseudo_spectral_bound, pto_thevenin
 from .constrained import constrained_figure, window_share
 from .electrical import electrical_bound, winding_coefficient
-from .envelope import ENVELOPE_SHARE, PEAK_SHARE, envelope_bound, envelope_items, envelope_response
+from .envelope import envelope_bound, envelope_items, envelope_response, peak_share
 from .frequency import (excitation_transfer, frequency_domain_response, mechanical_matrices,
                         regular_wave_amplitudes, statespace_response)
 from .linearize import linearize
@@ -22,7 +22,7 @@ from .power_statistics import law_params, law_responses, record_power_statistics
 from .reduce import balanced_truncation
 from .result import Result
 from .summary import summary
-from .validity import (ANGLE_MAX_RAD, DRAFT_FACTOR, assess, left_linear_range, mean_draft,
+from .validity import (assess, left_linear_range, mean_draft,
                        simulate_checked, split_remedy, wave_at)
 
 # the documented public part; the other names above serve the later stages of the flow

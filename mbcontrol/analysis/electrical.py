@@ -4,7 +4,7 @@ The winding loss of a machine whose current is I = F / (gear kt') is R F^2 / (ge
 the pseudo-spectral problem (analysis.bounds.PseudoSpectralProblem) it is one more term of the
 same diagonal quadratic, so the electrical optimum under force and stroke limits is the same
 convex QP with a heavier diagonal. Without limits it equals the closed form of
-controllers.impedance.electrical_optimum (tests/controllers/test_electrical.py checks both).
+controllers.impedance.electrical_optimum (tests/features/controllers/test_electrical.py checks both).
 """
 from __future__ import annotations
 

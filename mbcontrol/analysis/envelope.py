@@ -2,10 +2,10 @@
 
 `analysis.validity` marks a run INVALID when a surface-piercing body's significant heave
 relative to the free surface exceeds its mean draft, or a body's significant roll or pitch
-exceeds ANGLE_MAX_RAD: beyond them linear hydrodynamics do not describe the device. This
-module predicts those same quantities before a run, from the BEM data alone, for any PTO
-force, so that tuners choose settings that stay inside (controllers.tuning) and a sea where
-none can is known before it is simulated.
+exceeds "validity.angle_max" (30 deg): beyond them linear hydrodynamics do not describe the
+device. This module predicts those same quantities before a run, from the BEM data alone,
+for any PTO force, so that tuners choose settings that stay inside (controllers.tuning) and
+a sea where none can is known before it is simulated.
 
 Linear theory, phasors exp(-i omega t) as analysis.ports (the bound stack's documented
 exception to the public exp(+i omega t), `lti.phasor`): each envelope quantity q is
@@ -15,7 +15,7 @@ surface elevation at the body's centre of buoyancy, e^{i k (x cos beta + y sin b
 amplitude (the convention of mbcontrol.waves and of the excitation coefficients), as
 validity.excursions measures it. Its statistic is the one the check uses: the significant
 amplitude, 2 std over a sea's components (sqrt(sum |q_j|^2 / 2) per std), or a regular
-wave's amplitude |q|. Limits are the check's own times ENVELOPE_SHARE: a tuned setting is
+wave's amplitude |q|. Limits are the check's own times "envelope.share": a tuned setting is
 kept a margin inside, for what one finite record and the nonlinear plant add to the
 spectral prediction.
 """
@@ -26,17 +26,22 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .validity import ANGLE_MAX_RAD, DRAFT_FACTOR, mean_draft
+from .. import defaults
+from .validity import mean_draft
 
-# a tuned setting's predicted significant motion is kept within this share of the check's
-# limit: a 200 s record's 2 std scatters by a few % about the spectral value (sphere, rm3:
-# tests/analysis/test_envelope.py), and the nonlinear plant's motion differs by a few % more
-ENVELOPE_SHARE = 0.9
-# A predictive controller bounds each quantity at every sample, |q| <= L, not its statistic.
-# Whatever the motion, std(q) <= max |q|, so L = ENVELOPE_SHARE / 2 of the limit keeps 2 std
-# within the tuners' share; the bound is what an MPC does: it rides L like a square wave
-# (sphere, Hs 2.64 m, Tp 12.58 s, L at 0.64 of the draft: 2 std = 1.64 L, 4 % past the draft)
-PEAK_SHARE = ENVELOPE_SHARE / 2
+# ENVELOPE_SHARE, the default "envelope.share" (0.9): a tuned setting's predicted significant
+# motion is kept within this share of the check's limit: a 200 s record's 2 std scatters by a
+# few % about the spectral value (sphere, rm3: tests/analysis/test_envelope.py), and the
+# nonlinear plant's motion differs by a few % more.
+
+
+def peak_share() -> float:
+    """The share of the check's limit a predictive controller bounds each quantity to at every
+    sample, |q| <= L, not its statistic: half of "envelope.share" (read now). Whatever the
+    motion, std(q) <= max |q|, so L = share / 2 of the limit keeps 2 std within the tuners'
+    share; the bound is what an MPC does: it rides L like a square wave (sphere, Hs 2.64 m,
+    Tp 12.58 s, L at 0.64 of the draft: 2 std = 1.64 L, 4 % past the draft)."""
+    return defaults.get("envelope.share") / 2
 
 
 @dataclass(frozen=True)
@@ -68,12 +73,14 @@ def envelope_items(plant) -> list[EnvelopeItem]:
         if draft is not None:
             cob = data["center_of_buoyancy"].sel(body=body).values
             items.append(EnvelopeItem(f"{body} relative heave", f"{body}__Heave",
-                                      DRAFT_FACTOR * draft, "mean draft V / A_wp",
+                                      defaults.get("validity.draft_factor") * draft,
+                                      "mean draft V / A_wp",
                                       (float(cob[0]), float(cob[1]))))
         for angle in ("Roll", "Pitch"):
             if f"{body}__{angle}" in dofs:
+                angle_max = defaults.get("validity.angle_max")
                 items.append(EnvelopeItem(f"{body} {angle.lower()}", f"{body}__{angle}",
-                                          ANGLE_MAX_RAD, f"{math.degrees(ANGLE_MAX_RAD):.0f} deg"))
+                                          angle_max, f"{math.degrees(angle_max):.0f} deg"))
     return items
 
 
@@ -145,10 +152,11 @@ def envelope_response(plant, wave, pto: str, params=None) -> EnvelopeResponse:
     return EnvelopeResponse(items, G, H, amplitude, omega.size == 1)
 
 
-def envelope_bound(plant, wave, pto: str, *, share: float = ENVELOPE_SHARE,
+def envelope_bound(plant, wave, pto: str, *, share: float | None = None,
                    params=None) -> dict:
     """The most PTO `pto` can absorb in `wave` (W, linear theory, the spectral mean) with every
-    envelope quantity's predicted significant motion within `share` of its limit: the
+    envelope quantity's predicted significant motion within `share` (default
+    "envelope.share") of its limit: the
     complex-conjugate bound with the envelope as constraints. No force history, causal or
     not, that keeps the device inside absorbs more; a tuned law inside the same envelope
     reaches a share of it. A second-order cone programme in the force phasors U_j (cvxpy,
@@ -170,6 +178,7 @@ def envelope_bound(plant, wave, pto: str, *, share: float = ENVELOPE_SHARE,
 
     from ..plant import controlled_params
     from .ports import port_responses, undamped_note
+    share = defaults.resolve("envelope.share", share)
     base = controlled_params(plant, params, whole=[pto], linear=True)
     Y, H = port_responses(plant, wave.omega, [pto], wave.direction, base)
     y, h = Y[:, 0, 0], H[:, 0] * np.asarray(wave.amplitude, float)

@@ -21,7 +21,7 @@ its reasons. The checks, each independent of the time-domain model that made the
    window, the significant amplitude, as Hs / 2 is the sea's) may not exceed its mean draft
    (in a regular wave, its amplitude) (displaced volume over waterplane area: beyond it the body leaves the water or buries
    its deck, and constant added mass, damping and waterplane stiffness no longer describe
-   it); roll and pitch likewise within ANGLE_MAX_RAD (30 deg). The verdict is on a mean over
+   it); roll and pitch likewise within "validity.angle_max" (30 deg). The verdict is on a mean over
    the record, so it is the typical motion that decides; a peak beyond the limit is
    reported as a warning (with the share of time spent there), not an invalid result.
 4. **Statistics window.** The window the statistics are read over may not overlap the wave's
@@ -52,8 +52,8 @@ from ..results import jsonable, record
 # POWER_ALLOWANCE and ENERGY_TOLERANCE: the defaults "validity.power_allowance" (share above
 # the bound a reported mean power may reach) and "validity.energy_tolerance" (of the
 # excitation's absolute work over the record)
-ANGLE_MAX_RAD = math.radians(30.0)
-DRAFT_FACTOR = 1.0                # relative heave limit in mean drafts
+# ANGLE_MAX_RAD and DRAFT_FACTOR: the defaults "validity.angle_max" (rad, roll and pitch) and
+# "validity.draft_factor" (the relative heave limit in mean drafts)
 
 # [hydro] hydrostatics = "large_angle" in waves: said with every result it makes
 LARGE_ANGLE_IN_WAVES = (
@@ -175,13 +175,15 @@ def assess_values(plant, wave, params, *, window, mean_power_W: float, energy=No
     warnings = []
     nonlinear = plant.scene.hydro.froude_krylov == "nonlinear"
     for body, e in (excursions or {}).items():
+        angle_max = defaults.get("validity.angle_max")
         limits = (("relative heave", "relative_heave", e.get("relative_heave_limit_m"), "m", 1.0),
-                  ("roll", "roll", ANGLE_MAX_RAD, "deg", 180 / math.pi),
-                  ("pitch", "pitch", ANGLE_MAX_RAD, "deg", 180 / math.pi))
+                  ("roll", "roll", angle_max, "deg", 180 / math.pi),
+                  ("pitch", "pitch", angle_max, "deg", 180 / math.pi))
         for what, key, limit, unit, scale in limits:
             if limit is None or f"{key}_significant" not in e:
                 continue
-            limit = DRAFT_FACTOR * limit if key == "relative_heave" else limit
+            limit = (defaults.get("validity.draft_factor") * limit if key == "relative_heave"
+                     else limit)
             where = "beyond its mean draft" if key == "relative_heave" else "beyond"
             if e[f"{key}_significant"] > limit and nonlinear:
                 warnings.append(
@@ -237,7 +239,7 @@ def excursions(plant, ds, wave, mask) -> dict:
             signals["relative_heave"] = up
         regular = wave is not None and np.size(wave.omega) == 1
         for key, x in signals.items():
-            bound = limit if key == "relative_heave" else ANGLE_MAX_RAD
+            bound = limit if key == "relative_heave" else defaults.get("validity.angle_max")
             # a sea's significant amplitude is 2 std (Rayleigh peaks); a regular wave's is
             # its amplitude
             entry[f"{key}_significant"] = float(np.max(np.abs(x)) if regular else 2 * np.std(x))

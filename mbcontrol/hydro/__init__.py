@@ -50,7 +50,7 @@ from .mesh.panels import Panels, body_panels, hydrostatic_pressure, pressure_wre
 from .mesh.surface_sums import calm_water_function, pressure_wrench_function
 from .mesh.axisymmetric import AxisymmetricFK
 from .mesh.axisymmetric import from_geometry as axisymmetric_fk
-from .model import FITS_SERVED, obstacle_bodies, shipped_fits_dir
+from .model import obstacle_bodies, recording_served_fits, shipped_fits_dir
 from .fit.plots import hydro_figure
 from .source import converted_source, with_displaced_masses
 
@@ -67,5 +67,5 @@ __all__ = [
     "buoyancy_potential", "Panels", "body_panels", "hydrostatic_pressure", "pressure_wrench",
     "pressure_wrench_function", "calm_water_function",
     "AxisymmetricFK", "axisymmetric_fk",
-    "FITS_SERVED", "obstacle_bodies", "shipped_fits_dir", "converted_source", "with_displaced_masses", "hydro_figure",
+    "recording_served_fits", "obstacle_bodies", "shipped_fits_dir", "converted_source", "with_displaced_masses", "hydro_figure",
 ]

@@ -29,7 +29,8 @@ from .bem.neighbours import compute_within
 from .fit.radiation import RadiationModel, coupled_groups
 from .fit.band import default_fit_band
 from .fit.response_error import Device
-from .fit.store import FITS_SERVED, cached_fit, fit_band_limit, model_from_arrays, shipped_fits_dir  # noqa: F401 (the model's face)
+from .fit.store import (cached_fit, fit_band_limit, model_from_arrays,  # noqa: F401 (the model's face)
+                         recording_served_fits, shipped_fits_dir)
 from .fit.ssforms import modal_blocks
 from .readers.physical import DAMPING_EIG_TOL, check_physical
 from .readers.layout import force_first, kind_scales

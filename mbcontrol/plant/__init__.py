@@ -18,7 +18,7 @@ from .freeze import as_wave_list
 from .held_pressure import stage_load
 from .jacobians import jacobians
 from .moordyn_loads import kinematics_function as moordyn_kinematics
-from .moordyn_statics import STATICS_SERVED, shipped_statics
+from .moordyn_statics import recording_served_statics, shipped_statics
 from .moordyn_system import MoorDynSystem
 from .mechanical import MechanicalMatrices, dof_selector, mechanical_matrices
 from .nonlinear import with_nonlinear_pressure
@@ -33,5 +33,5 @@ __all__ = ["build_plant", "ProcessPlant", "active_hydro_dofs", "dof_selector", "
            "catenary_line", "solve_catenary", "provenance", "MechanicalMatrices", "mechanical_matrices",
            "device_around", "linear_params", "controlled_params", "response_error_of",
            "derived", "has_couplings", "as_wave_list", "f_by_parts", "with_nonlinear_pressure",
-           "stage_load", "moordyn_kinematics", "MoorDynSystem", "STATICS_SERVED",
+           "stage_load", "moordyn_kinematics", "MoorDynSystem", "recording_served_statics",
            "shipped_statics"]

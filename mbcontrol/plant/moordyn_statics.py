@@ -22,7 +22,7 @@ on RM3, J is MoorPy's analytic quasi-static stiffness to 2.4 % of its largest en
 (tests/plant/test_moordyn_statics.py). RM3 costs 8.5 s once, the catalogue sphere's chains 3 s.
 
 What the linear model leaves out: the lines' damping (their drag) and their mass; RM3's surge
-swings 5-6 % slower in a run than the linear model says (tests/sim/test_moordyn.py).
+swings 5-6 % slower in a run than the linear model says (tests/features/sim/test_moordyn.py).
 Computed once per file, pose, environment and MoorDyn version, and kept in the cache; the
 catalogue's ship beside their lines files (`shipped_statics`).
 """
@@ -35,6 +35,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..cache import ServedLog
 from ..console import status
 from ..errors import SceneError
 from ..scene import TO_MOORDYN, read_moordyn
@@ -49,7 +50,14 @@ MEAN_WINDOW_S = 20.0     # ... averaged over windows longer than its slowest swi
 MEAN_TOL = 2e-5          # ... until two windows' means agree to this share of the forces
 
 
-STATICS_SERVED: list = []   # (lines file, key, statics) asked for: generate_hydro --ship-fits
+_STATICS_SERVED = ServedLog("statics_served")
+
+
+def recording_served_statics():
+    """`with recording_served_statics() as served:` the (lines file, key, statics) asked for
+    while it is active, in order, a key again each time it is asked for
+    (models/generate_hydro.py --ship-fits keeps the first); off otherwise."""
+    return _STATICS_SERVED.recording()
 
 
 def shipped_statics(lines_file) -> Path:
@@ -104,8 +112,7 @@ def mooring_statics(scene, mooring, P0: np.ndarray) -> MooringStatics:
     solved = _shipped(mooring.file, key) or load_or_make(
         cache_dir() / "moordyn" / f"statics-{key}.json", lambda path: json.loads(path.read_bytes()),
         make, what="MoorDyn mooring statics")
-    if all(served[1] != key for served in STATICS_SERVED):   # once: a sweep builds many plants
-        STATICS_SERVED.append((mooring.file, key, solved))
+    _STATICS_SERVED.note((mooring.file, key, solved))
     flip = np.tile(TO_MOORDYN, P0.shape[1])
     F = np.asarray(solved["force"]) * flip                 # MoorDyn's frame -> n-frame
     J = flip[:, None] * np.asarray(solved["jacobian"]) * flip[None, :]

@@ -162,7 +162,7 @@ class MoorDynSystem:
         change by less than SETTLE_TOL of their size over SETTLE_WINDOW_S (at most
         SETTLE_MAX_S), then its state copied into this one. MoorDyn's own relaxation stops
         short on some systems: RM3's subsurface buoys leave its fairleads at 4 kN, 168 kN at
-        rest (tests/sim/test_moordyn.py)."""
+        rest (tests/features/sim/test_moordyn.py)."""
         twin = self.md.Create(twin_file)
         back, change = int(SETTLE_WINDOW_S / SETTLE_STEP_S), None
         try:

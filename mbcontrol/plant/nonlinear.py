@@ -5,7 +5,7 @@ The pressure is p = rho g z + p_dyn (Pa; NED, z down), p_dyn the linear incident
 taken to the instantaneous free surface by Wheeler stretching, so p vanishes on the incident
 surface and the wetted surface ends there. Radiation and diffraction stay linear: the
 disturbance w carries the BEM excitation minus the linear Froude-Krylov force of this same
-surface model, so for small waves the plant is the linear one (tests/plant/test_nonlinear_fk.py).
+surface model, so for small waves the plant is the linear one (tests/features/plant/test_nonlinear_fk.py).
 
 Two paths (`[hydro] nonlinear_path`):
   analytic  bodies of revolution with a vertical axis (mbcontrol.hydro.mesh.axisymmetric):

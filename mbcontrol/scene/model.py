@@ -161,7 +161,7 @@ class Drivetrain:
 
     @property
     def force_per_current(self) -> float:
-        """N (or N m) of PTO force per A: gear_ratio x kt'."""
+        """PTO force per ampere, gear_ratio x kt' (N/A, or N m/A for a rotary PTO)."""
         return self.gear_ratio * self.kt
 
     def reflected_impedance(self, s):

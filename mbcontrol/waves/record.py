@@ -22,7 +22,7 @@ T = N dt, k = 1..N/2, so that `Wave.elevation` reproduces the record at its samp
 round-off; from_record measures time from the record's first sample (the simulation's t = 0),
 from_elevation keeps the series' own time unless asked. The wave repeats with period T: a
 longer run repeats the record (allowed; noted). Tests: tests/waves/test_record.py,
-tests/test_waves_excitation.py.
+tests/waves/test_excitation.py.
 """
 from __future__ import annotations
 
@@ -219,7 +219,7 @@ def from_elevation(t, eta, *, band=None, ramp_time: float | None = 0.0, directio
     t = 0), unless from_start (from_record's convention: t = 0 is the first sample). ramp_time:
     none by default (None: chosen as from_record chooses it); direction: rad. Excitation from
     this wave equals the (non-causal) circular convolution of the series with the excitation
-    impulse response (tests/test_waves_excitation.py).
+    impulse response (tests/waves/test_excitation.py).
     """
     t, eta, info = _arrays((t, eta))
     return _decompose(t, eta, info, band=band, ramp_time=ramp_time, duration=duration,

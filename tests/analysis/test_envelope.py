@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 
 from mbcontrol import build_plant, load_scene, waves
-from mbcontrol.analysis.envelope import (ENVELOPE_SHARE, envelope_bound, envelope_items,
-                                         envelope_response)
+from mbcontrol import defaults
+from mbcontrol.analysis.envelope import envelope_bound, envelope_items, envelope_response
 from mbcontrol.analysis.metrics import analysis_window
-from mbcontrol.analysis.validity import ANGLE_MAX_RAD, excursions, mean_draft
+from mbcontrol.analysis.validity import excursions, mean_draft
 from mbcontrol.controllers import make
 from mbcontrol.controllers.impedance import (fd_statistics, intrinsic_impedance,
                                              margin_function)
@@ -49,7 +49,7 @@ def test_items_are_what_the_validity_check_measures(rm3):
     assert items["float relative heave"].limit == pytest.approx(mean_draft(rm3.hydro.data, "float"))
     oswec = build_plant(load_scene("oswec"))
     pitch = [i for i in envelope_items(oswec) if i.name == "flap pitch"]
-    assert len(pitch) == 1 and pitch[0].limit == ANGLE_MAX_RAD
+    assert len(pitch) == 1 and pitch[0].limit == defaults.get("validity.angle_max")
 
 
 @pytest.mark.parametrize("model, damping, hs, tp", [("sphere", 2e5, 2.0, 9.0),
@@ -88,7 +88,7 @@ def _brute_force(plant, wave, env, *, passive):
         for i in np.argsort(power)[::-1]:
             if power[i] <= best:
                 break
-            if ratio[i] <= ENVELOPE_SHARE and margin(c[i], k) >= 1e-3:
+            if ratio[i] <= defaults.get("envelope.share") and margin(c[i], k) >= 1e-3:
                 best = float(power[i])
                 break
     return best
@@ -111,8 +111,8 @@ def test_tuned_law_is_the_best_inside_the_envelope(rm3, passive):
     else:
         c, k, power = reactive_tuning(rm3, wave, "pto", envelope=True)
         c_free, k_free, power_free = reactive_tuning(rm3, wave, "pto")
-    assert env.ratio(_damper_force(rm3, wave, c, k)) <= ENVELOPE_SHARE * (1 + 1e-9)
-    assert env.ratio(_damper_force(rm3, wave, c_free, k_free)) > ENVELOPE_SHARE
+    assert env.ratio(_damper_force(rm3, wave, c, k)) <= defaults.get("envelope.share") * (1 + 1e-9)
+    assert env.ratio(_damper_force(rm3, wave, c_free, k_free)) > defaults.get("envelope.share")
     assert power_free > power
     best = _brute_force(rm3, wave, env, passive=passive)
     assert best <= power * 1.005, (best, power)
@@ -142,9 +142,8 @@ def test_a_sea_no_setting_can_serve_is_flagged_with_the_closest(sphere, monkeypa
     Hs 2 m: the sea alone moves the surface by 1 m) no damping keeps it inside: the tuner
     raises OutsideEnvelope with the damper that comes closest, which is the least-ratio point
     of the same scan, and `design` flags the sea instead of stopping."""
-    from mbcontrol.controllers import tuning
     from mbcontrol.studies.design import tune
-    monkeypatch.setattr(tuning, "ENVELOPE_SHARE", 0.01)
+    monkeypatch.setenv("MBCONTROL_ENVELOPE_SHARE", "0.01")     # its environment layer
     wave = _sea(sphere, 2.0, 9.0, duration=600.0)
     with pytest.raises(OutsideEnvelope, match="linear model's range") as caught:
         optimal_damping(sphere, wave, pto="pto", envelope=True)

@@ -15,7 +15,7 @@ from mbcontrol.analysis.ports import multiport_bound, port_responses, window_mea
 from mbcontrol.analysis.validity import assess
 from mbcontrol.sim import simulate
 
-from ..sphere_reference import heave_impedance
+from tests.helpers.sphere_reference import heave_impedance
 
 
 @pytest.fixture(scope="module")
@@ -166,7 +166,9 @@ def test_every_invalid_reason_says_what_to_do():
     linear hydrodynamics) names its remedy after ". Remedy: ", which the CLI prints on a line
     of its own (issue 40: "INVALID ... linear hydrodynamics do not hold there" named none)."""
     from mbcontrol.analysis import split_remedy
-    from mbcontrol.analysis.validity import DRAFT_FACTOR, assess_values
+    from mbcontrol import defaults
+    from mbcontrol.analysis.validity import assess_values
+    DRAFT_FACTOR = defaults.get("validity.draft_factor")
     plant = build_plant("sphere")
     wave = waves.regular(1.0, 8.0)
     draft = 3.33                                              # V / A_wp of the hemisphere, m

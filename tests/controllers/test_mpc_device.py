@@ -14,7 +14,7 @@ from mbcontrol.controllers.mpc import Mpc
 from mbcontrol.analysis import summary
 from mbcontrol.sim import simulate
 
-from ..sphere_reference import heave_impedance
+from tests.helpers.sphere_reference import heave_impedance
 
 
 def test_device_frequency_is_the_heave_resonance_of_the_hand_written_impedance():

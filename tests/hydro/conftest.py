@@ -4,7 +4,7 @@ import warnings
 import pytest
 
 from mbcontrol.hydro.readers import HydroCleaningWarning, read_bemio, read_wamit
-from reader_data import RM3, RM3_FORCE, SPHERE, WAVESTAR
+from tests.helpers.reader_data import RM3, RM3_FORCE, SPHERE, WAVESTAR
 
 
 @pytest.fixture(scope="module")

@@ -22,7 +22,7 @@ from mbcontrol.errors import HydroError
 from mbcontrol.hydro import BemBody, compute, write_netcdf_atomic
 from mbcontrol.hydro.readers import (HydroCleaningWarning, clean, read_bemio, read_capytaine,
                                      read_hydro, read_wamit, to_scene_frames)
-from reader_data import DATA, R_SPHERE, RHO, SPHERE, WAVESTAR, _m
+from tests.helpers.reader_data import DATA, R_SPHERE, RHO, SPHERE, WAVESTAR, _m
 
 if not SPHERE.exists():
     pytest.skip(f"reference data not found in {DATA}", allow_module_level=True)

@@ -11,7 +11,7 @@ import xarray as xr
 
 from mbcontrol.hydro import load_hydro_data, read_netcdf
 from mbcontrol.scene import catalogue_dir, load_scene
-from reader_data import SPHERE, WAVESTAR
+from tests.helpers.reader_data import SPHERE, WAVESTAR
 
 pytestmark = pytest.mark.skipif(not (SPHERE.exists() and WAVESTAR.exists()),
                                 reason=f"reference data not found in {SPHERE.parent.parent}")

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from mbcontrol.multibody import Link, Motion, Tree
-from tree_reference import (BRANCHING_SPEC, Y_AXIS, G, dynamics_function, free_root_tree, num,
+from tests.helpers.tree_reference import (BRANCHING_SPEC, Y_AXIS, G, dynamics_function, free_root_tree, num,
                             random_tree, rel_err, symbols, two_body_tree)
 
 # ---- 1. ERRATA section 5 and section 1 ----------------------------------------------------

@@ -16,7 +16,7 @@ from mbcontrol.errors import SimulationError
 from mbcontrol.plant import build_plant
 from mbcontrol.scene import catalogue_dir, parse_scene
 from mbcontrol.sim import simulate
-from scene_fixture import TUMBLER
+from tests.helpers.scene_fixture import TUMBLER
 
 G = 9.81
 PENDULUM = """

@@ -22,7 +22,7 @@ from mbcontrol.scene import load_scene, parse_scene
 from mbcontrol.sim import simulate
 from mbcontrol.studies.fidelity_auto import auto
 
-from kernel_fits import judged_by_kernel   # tests/ is on sys.path (conftest.py)
+from tests.helpers.kernel_fits import judged_by_kernel
 
 NO_COULOMB = {"hinge_friction__coulomb": 0.0}   # a smoothed Coulomb law is not linearisable
 TP_SPHERE = 9.67                                # s, the sphere's sea state (WEC-Sim's)

@@ -9,6 +9,7 @@ References, independent of the code under test:
 - hydrostatics: at the moored rest of the heave-only sphere the lines' vertical pull equals
   rho g A_wp times the sinkage.
 """
+import json
 import math
 import os
 from pathlib import Path
@@ -82,3 +83,18 @@ def test_the_moored_rest_balances_the_lines_pull_with_hydrostatics():
     xdot = np.asarray(plant.f(rest, np.zeros(len(plant.inputs)),
                               np.zeros(len(plant.disturbances)), plant.p0)).ravel()
     assert np.max(np.abs(xdot)) < 1e-9
+
+
+def test_the_statics_served_are_recorded_only_for_a_caller_that_asks():
+    """generate_hydro --ship-fits records the statics the catalogue's plants ask for: RM3's,
+    from the file shipped beside its lines; with no recorder active nothing is kept."""
+    from mbcontrol.plant import recording_served_statics, shipped_statics
+    lines = ROOT / "models" / "rm3_moored_lines.txt"
+    with recording_served_statics() as served:
+        assemble_plant("rm3_moored", radiation=False)
+    assert {Path(file).name for file, _, _ in served} == {lines.name}   # twice, one key
+    shipped = json.loads(shipped_statics(lines).read_text())
+    assert all(shipped[key] == statics for _, key, statics in served)
+    n = len(served)
+    assemble_plant("rm3_moored", radiation=False)     # nobody records: nothing kept
+    assert len(served) == n

@@ -11,7 +11,7 @@ import pytest
 
 from mbcontrol.errors import SceneError
 from mbcontrol.scene import load_scene
-from scene_fixture import B_HYDRO, VALID, fails, hydro_table, jb_type, variant, write
+from tests.helpers.scene_fixture import B_HYDRO, VALID, fails, hydro_table, jb_type, variant, write
 
 # ------------------------------------------------------------------------------ bad scenes
 

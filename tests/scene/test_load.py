@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from mbcontrol.scene import catalogue_dir, list_models, load_scene
-from scene_fixture import VALID, variant, write  # tests/ is on sys.path (conftest.py)
+from tests.helpers.scene_fixture import VALID, variant, write
 
 
 def test_valid_fixture_loads(tmp_path):

@@ -11,7 +11,7 @@ import pytest
 from mbcontrol.errors import SceneError
 from mbcontrol.scene import list_models, load_scene
 from mbcontrol.textsafe import NAME_MAX, NAME_RULE, name_problem
-from scene_fixture import VALID, fails, variant, write
+from tests.helpers.scene_fixture import VALID, fails, variant, write
 
 # the issue's PTO name, as TOML writes it: a newline, then a compiled #include
 ISSUE_NAME = r'"pto*/\n#include\t\"/some/file\"\n/*"'

@@ -3,7 +3,7 @@ key a section allows is listed with a meaning, no meaning names a key the parser
 recorder leaves no trace, and the README's "Scene keys" section is the current output."""
 import pytest
 
-import readme
+from tests.helpers import readme
 from mbcontrol.errors import SceneError
 from mbcontrol.scene import load_scene, reference
 from mbcontrol.scene.checks import Reader

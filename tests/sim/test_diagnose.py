@@ -11,7 +11,7 @@ from mbcontrol.plant import build_plant
 from mbcontrol.sim import simulate
 from mbcontrol.sim.diagnose import closed_loop_poles, unstable
 
-from kernel_fits import judged_by_kernel   # tests/ is on sys.path (conftest.py)
+from tests.helpers.kernel_fits import judged_by_kernel
 
 
 @pytest.fixture(scope="module")

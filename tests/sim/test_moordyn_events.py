@@ -5,7 +5,7 @@ its pull at rest.
 
 References: the tether's geometry (its lowest point is the pile's end, 10 m above the 50 m
 bed: it rises from there to the sphere); the chains lie on the bed (34 m each, the elastic
-catenary of tests/sim/test_moordyn.py).
+catenary of tests/features/sim/test_moordyn.py).
 """
 import json
 from pathlib import Path

@@ -17,7 +17,7 @@ from mbcontrol.sim import linear_stability_limit, simulate, stability_limit, sta
 from mbcontrol.sim.methods import DOPRI5, RK3, RK4
 from mbcontrol.sim.stability import held_equilibrium, with_end_stop
 
-from kernel_fits import judged_by_kernel   # tests/ is on sys.path (conftest.py)
+from tests.helpers.kernel_fits import judged_by_kernel
 
 
 @pytest.fixture(scope="module")

@@ -6,7 +6,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from drivetrain_scenes import DRIVETRAIN, catalogue_copy
+from tests.helpers.drivetrain_scenes import DRIVETRAIN, catalogue_copy
 from mbcontrol.cli import main
 from mbcontrol.studies.codesign import Spec, codesign
 from mbcontrol.studies.codesign.objectives import evaluate

@@ -26,7 +26,7 @@ from mbcontrol.controllers.impedance import intrinsic_impedance
 from mbcontrol.controllers.margins import loop_margins
 from mbcontrol.plant import build_plant
 from mbcontrol.studies.design import design
-from sphere_reference import heave_impedance
+from tests.helpers.sphere_reference import heave_impedance
 
 H, T = 2.5, 9.6664     # m, s: the regular wave of the brief; the sphere's T_n is 4.36 s
 WAVE_ARGS = ["--wave", "regular", "--height", str(H), "--period", str(T)]
@@ -102,7 +102,9 @@ def test_constrained_reactive_design_keeps_the_limits(plant, wave):
     tuned law's prediction (a Nelder-Mead search over damping and stiffness) must equal the
     bound inside the same envelope (a second-order cone programme over the force phasor):
     two different optimisations, measured 614.5149 kW both (relative difference 2e-10)."""
-    from mbcontrol.analysis.envelope import ENVELOPE_SHARE, envelope_bound
+    from mbcontrol import defaults
+    from mbcontrol.analysis.envelope import envelope_bound
+    ENVELOPE_SHARE = defaults.get("envelope.share")
     result = design(plant, wave, "reactive", robust=False)   # the optimum, no margin floors
     m, b = result.metrics, result.bound
     assert result.tuner["settings"] == {"force_max": 2e6, "stroke_max": 4.0}

@@ -6,7 +6,7 @@ from mbcontrol import waves
 from mbcontrol.cli import main
 from mbcontrol.studies import workprecision as wp
 
-from kernel_fits import judged_by_kernel   # tests/ is on sys.path (conftest.py)
+from tests.helpers.kernel_fits import judged_by_kernel
 
 
 @pytest.fixture(scope="module")

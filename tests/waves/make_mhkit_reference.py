@@ -3,7 +3,7 @@
     python3 -m venv /tmp/mhkit-venv && /tmp/mhkit-venv/bin/pip install "mhkit[wave]==1.1.2"
     /tmp/mhkit-venv/bin/python tests/waves/make_mhkit_reference.py
 
-and paste what it prints into tests/waves/test_mhkit_reference.py (MHKiT is not a test extra:
+and paste what it prints into tests/features/waves/test_mhkit_reference.py (MHKiT is not a test extra:
 its wave module needs the [wave] extra, ~40 packages including the AWS and scikit-learn stacks,
 and it downgrades python-dateutil in the project environment). Only MHKiT, numpy and pandas
 are used here: nothing from mbcontrol.

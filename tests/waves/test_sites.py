@@ -23,7 +23,7 @@ def test_pacwave_file_keeps_its_own_te_tp_and_J():
     # a sweep's J is the flux of the site's own sea (Hm0, Tp, its Te / Tp = 0.858: JONSWAP
     # gamma 1.02), which in deep water is rho g^2 Hm0^2 Te / (64 pi) for any spectrum: 1e-3
     # (quadrature on the flux's grid); the file's own J column is 2 % off for this row (the
-    # MHKiT example's frequency slip, tests/waves/test_mhkit_reference.py)
+    # MHKiT example's frequency slip, tests/features/waves/test_mhkit_reference.py)
     deep = 1025.0 * 9.81 ** 2 * first.hs ** 2 * first.te / (64 * np.pi)
     assert site_energy_flux(first, rho=1025.0, g=9.81) == pytest.approx(deep, rel=1e-3)
     assert abs(first.j / deep - 1) > 0.015

@@ -17,7 +17,7 @@ import xarray as xr
 
 from ... import defaults
 from ...atomic import atomic_path
-from ...cache import UNREADABLE, cache_dir, read_entry, reason_of
+from ...cache import UNREADABLE, ServedLog, cache_dir, read_entry, reason_of
 from ...console import status
 from ...errors import HydroError
 from . import (array_fit, array_passivity, fit_error, group_fit, kernel, passive_order, passivity, radiation,
@@ -38,7 +38,13 @@ def fit_band_limit(data: xr.Dataset, scene_limit: float = np.inf) -> float | Non
     return limit if np.isfinite(limit) else None
 
 
-FITS_SERVED: list = []      # the fit files asked for, in order (models/generate_hydro.py --ship-fits)
+_FITS_SERVED = ServedLog("fits_served")
+
+
+def recording_served_fits():
+    """`with recording_served_fits() as names:` the radiation fit files asked for while it is
+    active, in order (models/generate_hydro.py --ship-fits); off otherwise."""
+    return _FITS_SERVED.recording()
 
 
 def cached_fit(data: xr.Dataset, dofs, tol, source: str, omega_max: float = np.inf, response_band=None,
@@ -68,7 +74,7 @@ def cached_fit(data: xr.Dataset, dofs, tol, source: str, omega_max: float = np.i
     name = (f"radiation_{base[:20]}.npz" if device is None else
             f"radiation_{base[:16]}_{hashlib.sha256(json.dumps(device.key()).encode()).hexdigest()[:12]}.npz")
     path = cache_dir() / name
-    FITS_SERVED.append(name)
+    _FITS_SERVED.note(name)
     model = _load_fit(name) or (_reused_fit(base[:16], data, band, tol, device) if device is not None else None)
     if model is not None:
         if not path.exists() and not (shipped_fits_dir() / name).exists():

@@ -23,7 +23,7 @@ linear FK force of the mean wetted hull (a cylinder: its bottom's, -rho g a exp(
 The last term (eta'_c = d eta / d xi at the axis) stretches with the local plane
 eta_c + eta'_c (xi - xi_c), to first order and up to O((k r)^2): on a sphere R 5 m in
 H/(g T^2) = 0.01, T = 8 s it cuts the surge error from 14 % to 1 % of the surge amplitude; the
-heave error, from the flat wetting, stays 1-2 % (tests/hydro/test_axisymmetric_fk.py).
+heave error, from the flat wetting, stays 1-2 % (tests/features/hydro/test_axisymmetric_fk.py).
 Moments: zero about c, exact for a sphere; other bodies' buoyancy acts on the axis, but their
 dynamic moment is NOT modelled: use this path for spheres or bodies without rotational freedom.
 
@@ -173,7 +173,7 @@ class AxisymmetricFK:
 
     @property
     def pieces(self) -> tuple:
-        """((a, b, n), ...): the s ranges (m) and their orders."""
+        """The s ranges (m) and their orders, as ((a, b, n), ...)."""
         return self._cuts
 
     @property

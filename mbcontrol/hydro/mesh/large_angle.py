@@ -33,7 +33,7 @@ outside and it is wholly wet or dry by the sign of its depth, the correct limit.
 
 Accuracy and cost
 -----------------
-References (tests/hydro/test_large_angle.py): convex-polyhedron clipping for boxes; circular-segment
+References (tests/hydro/mesh/test_large_angle.py): convex-polyhedron clipping for boxes; circular-segment
 slices integrated by adaptive quadrature for cylinders (itself agreeing to 1e-10 with a clipped
 360-sided prism and to 5e-8 with Capytaine's immersed_part volume). The wet fibre length is
 piecewise linear across the cross-section, with kinks where the waterline meets the fibre ends,

@@ -23,7 +23,7 @@ Default ``panel_size``: sqrt(surface area / 500), 580-750 points for compact pri
 584, boxes 640, cylinders 690-750); a mesh file's default is its own faces. A revolution profile
 of many short segments gets at least one ring per segment.
 
-Accuracy and cost (measured; tests/hydro/test_panels.py checks the default)
+Accuracy and cost (measured; tests/hydro/mesh/test_panels.py checks the default)
 --------------------------------------------------------------------------
 The only error on a primitive is the kink of max(z, 0) in the cells the waterline cuts: second
 order in the cell size, irregular in the draft. Worst relative force error, sphere R = 5 m,

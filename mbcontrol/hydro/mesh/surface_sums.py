@@ -70,7 +70,7 @@ def pressure_wrench_function(panels: Panels, pressure_of, n_rows: int, name: str
     of the pressure p(x, y, z) = pressure_of(rows)(x, y, z) (Pa; CasADi SX 1 x n rows in,
     elementwise, zero where dry) on the posed surface, n-frame axes, moment about the current
     CoG; N and N m. The same numbers as `panels.pressure_wrench`
-    (tests/hydro/test_surface_sums.py), as one never-inlined call.
+    (tests/hydro/mesh/test_surface_sums.py), as one never-inlined call.
 
     largest: pressure_of(rows)(x, y, z) gives (p, v), and a third output is the largest v
     over the points (zero-weight padding included, at the CoG): e.g. how much of its incident

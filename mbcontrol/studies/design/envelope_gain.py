@@ -2,7 +2,7 @@
 
 `design` tunes a passive or reactive law inside the envelope of linear hydrodynamics
 (analysis.envelope: significant relative heave within the mean draft, roll and pitch within
-30 deg, times ENVELOPE_SHARE), because beyond it the linear model's numbers are not to be
+30 deg, times "envelope.share"), because beyond it the linear model's numbers are not to be
 trusted. A plant with nonlinear hydrostatics and Froude-Krylov forces ([hydro] hydrostatics =
 froude_krylov = "nonlinear") covers those motions, so the envelope need not hold the
 controller back there. `lifted_envelope` tunes the same law with the envelope lifted (the
@@ -13,7 +13,7 @@ not what linear theory predicted (both are reported).
 """
 from __future__ import annotations
 
-from ...analysis import ANGLE_MAX_RAD, DRAFT_FACTOR
+from ... import defaults
 
 GAINS_RTOL = 1e-3      # gains closer than this (relative) are the same law
 
@@ -21,13 +21,15 @@ GAINS_RTOL = 1e-3      # gains closer than this (relative) are the same law
 def excursion_ratios(excursions: dict) -> dict:
     """{"<body> relative heave" | "<body> roll" | "<body> pitch": significant value / the
     validity check's limit} from a verdict's checks["excursions"] (1 is the edge of the
-    linear model's range: the draft times DRAFT_FACTOR, ANGLE_MAX_RAD)."""
+    linear model's range: the draft times "validity.draft_factor", "validity.angle_max")."""
     out = {}
+    angle_max = defaults.get("validity.angle_max")
     for body, e in excursions.items():
         limits = {"relative heave": ("relative_heave",
                                      None if e.get("relative_heave_limit_m") is None
-                                     else DRAFT_FACTOR * e["relative_heave_limit_m"]),
-                  "roll": ("roll", ANGLE_MAX_RAD), "pitch": ("pitch", ANGLE_MAX_RAD)}
+                                     else defaults.get("validity.draft_factor")
+                                     * e["relative_heave_limit_m"]),
+                  "roll": ("roll", angle_max), "pitch": ("pitch", angle_max)}
         for what, (key, limit) in limits.items():
             if limit and f"{key}_significant" in e:
                 out[f"{body} {what}"] = float(e[f"{key}_significant"]) / limit

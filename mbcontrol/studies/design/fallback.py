@@ -123,7 +123,7 @@ def saturated_damper(plant, wave, pto_obj, *, share: float | None = None,
                      exceedance: float = 0.01) -> dict:
     """The clipped damper (see the module doc) with the most mean power whose equivalent
     linear motion keeps the stroke peak within stroke_max (m), every envelope quantity within
-    `share` (default analysis.ENVELOPE_SHARE) of its limit and the power within the rated
+    `share` (default "envelope.share") of its limit and the power within the rated
     power. {"damping" c (N s/m, the controller's), "force_max" (N, its clip),
     "equivalent_damping" c_eq, "predicted_W" c_eq sigma_v^2, "stroke_peak_m",
     "envelope_ratio", "inside_envelope", "clipped_share" (the share of the time the force is
@@ -133,8 +133,8 @@ def saturated_damper(plant, wave, pto_obj, *, share: float | None = None,
     holds the stroke, inside_envelope false: the run's validity check, or the nonlinear
     plant (sweep --nonlinear invalid), decides. NoLawForSea, with the numbers at the Coulomb
     limit, if no clipped damper holds the stroke."""
-    from mbcontrol.analysis import ENVELOPE_SHARE
-    share = ENVELOPE_SHARE if share is None else share
+    from mbcontrol import defaults
+    share = defaults.resolve("envelope.share", share)
     f_max, s_max = float(pto_obj.force_max), float(pto_obj.stroke_max)
     if not math.isfinite(f_max) or pto_obj.limited_force() == "hull":
         raise NoLawForSea(f"PTO {pto_obj.name!r}: no force limit on the machine to saturate at "

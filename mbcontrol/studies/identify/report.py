@@ -98,7 +98,10 @@ def forward_validity(problem, values: dict, rows: list[dict]) -> dict:
     hydrodynamics hold and a heave within the body's mean draft
     (`mbcontrol.analysis.validity`); and no fitted hydro correction that makes the model
     create energy (a negative radiation or damping scale). {"valid", "invalid_reasons"}."""
-    from ...analysis import ANGLE_MAX_RAD, DRAFT_FACTOR, mean_draft
+    from ... import defaults
+    from ...analysis import mean_draft
+    angle_max = defaults.get("validity.angle_max")
+    draft_factor = defaults.get("validity.draft_factor")
     reasons = []
     for name, value in values.items():
         dissipative = name.endswith(("__radiation_scale", "__damping")) or "viscous" in name
@@ -114,11 +117,11 @@ def forward_validity(problem, values: dict, rows: list[dict]) -> dict:
         model, where = row["model"], f"run {row['run']}, channel {row['channel']}"
         if not np.isfinite(model):
             reasons.append(f"{where}: the model's amplitude is not finite")
-        elif row["unit"] == "rad" and model > ANGLE_MAX_RAD:
+        elif row["unit"] == "rad" and model > angle_max:
             reasons.append(f"{where}: model amplitude {np.degrees(model):.3g} deg beyond "
-                           f"{np.degrees(ANGLE_MAX_RAD):.0f} deg (linear hydrodynamics)")
+                           f"{np.degrees(angle_max):.0f} deg (linear hydrodynamics)")
         elif (row["unit"] == "m" and "heave" in row["channel"].lower() and draft
-              and model > DRAFT_FACTOR * draft):
+              and model > draft_factor * draft):
             reasons.append(f"{where}: model amplitude {model:.3g} m beyond the mean draft "
                            f"{draft:.3g} m (linear hydrodynamics)")
     return {"valid": not reasons, "invalid_reasons": reasons}

@@ -12,11 +12,8 @@ from dataclasses import asdict, dataclass, field
 
 from ... import defaults
 
-# The seas themselves (SeaState, grids, the site CSV, Te/Tp) live in the waves package;
-# re-exported here so that `from mbcontrol.studies.sweep.cases import SeaState` keeps working.
 from ...errors import InputError
-from ...waves import (WEIGHT_SUM_TOLERANCE, SeaState, grid, read_seas,  # noqa: F401
-                      te_over_tp)
+from ...waves import SeaState
 
 
 WAVE_DIRECTION = "direction"    # --vary direction=0,45: NED headings in degrees, of the hydro data

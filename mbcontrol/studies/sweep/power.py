@@ -1,7 +1,7 @@
 """Power matrices: a sweep's mean power over an (hs, period) table.
 
 Energy flux, annual energy, NDBC spectra, Hm0/Te and occurrence tables live in the waves
-package (`mbcontrol.waves`); they are re-exported here so that old imports keep working.
+package (`mbcontrol.waves`).
 """
 from __future__ import annotations
 
@@ -9,8 +9,6 @@ import numpy as np
 import xarray as xr
 
 from ...errors import InputError
-from ...waves import (HOURS_PER_YEAR, annual_energy_MWh, energy_flux,  # noqa: F401
-                      occurrence, read_ndbc_spectra, spectral_hm0_te)
 
 
 def power_matrix(ds: xr.Dataset, variable: str = "mean_power_W", period: str = "tp",

@@ -15,7 +15,7 @@ m_-1 / m0, and its energy flux J = rho g sum_k var_k c_g(omega_k) from its own c
 of them, as Hs) in the scene's water, so that P / J is its capture width. A record has no
 occurrence weight: the sweep has no annual energy (said in its notes). File names are data:
 rows and JSON carry them as they are, text notes escaped (`textsafe.plain_text`).
-Tests: tests/cli/test_sweep_records.py.
+Tests: tests/features/cli/test_sweep_records.py.
 """
 from __future__ import annotations
 

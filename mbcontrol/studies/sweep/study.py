@@ -36,7 +36,7 @@ def sweep(model: str, seas, *, seeds: int = 1, vary: dict | None = None, params=
           years: dict | None = None, nonlinear: str = "scene", records=None):
     """Run a sweep and return (Dataset, summary).
 
-    seas: SeaStates (`cases.grid`, `cases.read_seas`); vary: name -> values (scene
+    seas: SeaStates (`waves.grid`, `waves.read_seas`); vary: name -> values (scene
     parameter, plant parameter or controller setting); workers: 0 serial, None one Dask
     worker per core, N workers; scheduler: a Dask scheduler address; store: a folder (resume:
     finished cases are not run again; `<store>/sweep.nc` holds the Dataset); width: the

@@ -7,8 +7,7 @@ import numpy as np
 import pytest
 
 from mbcontrol.studies.sweep import annual_energy_MWh, energy_flux, occurrence, read_seas
-from mbcontrol.studies.sweep.cases import te_over_tp
-from mbcontrol.studies.sweep.power import read_ndbc_spectra, spectral_hm0_te
+from mbcontrol.waves import read_ndbc_spectra, spectral_hm0_te, te_over_tp
 
 SITES = Path(__file__).resolve().parents[4] / "shared" / "data" / "sites"
 

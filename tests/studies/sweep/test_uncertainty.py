@@ -9,7 +9,7 @@ import pytest
 from scipy.stats import t as student
 
 from mbcontrol.studies.sweep import budget, sweep
-from mbcontrol.studies.sweep.cases import read_seas
+from mbcontrol.waves import read_seas
 from mbcontrol.studies.sweep.uncertainty import read_identified
 
 H = 8766 / 1e6          # MWh per W over a year
