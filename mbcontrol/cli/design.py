@@ -87,9 +87,10 @@ def _robustness_line(result) -> str:
         how = (" tuned within them (--aggressive: the unconstrained optimum);"
                if result.tuner.get("robust") else " the unconstrained optimum (--aggressive);")
         cost = result.tuner.get("margins_cost") or {}
-        if cost.get("share") is not None:
-            how += (f" they cost {100 * cost['share']:.3g} % of the unconstrained optimum's "
-                    f"{cost['aggressive_predicted_W'] / 1e3:.4g} kW predicted;")
+        if cost.get("share") is not None:     # below 1e-4: the optimum meets them already
+            share = f"{100 * cost['share']:.3g} %" if cost["share"] > 1e-4 else "nothing"
+            how += (f" they cost {share} of the unconstrained optimum's "
+                    f"{_power(cost['aggressive_predicted_W'])} predicted;")
     signed = r.get("phase_margin_signed_deg")
     pc = "" if signed is None else f", python-control's signed phase margin {signed:+.3g} deg"
     gm = "inf" if r["gain_margin"] is None else f"{r['gain_margin']:.3g}"

@@ -256,7 +256,7 @@ def _loop_checks(plant, wave, name, parameters, pto, predicted, others, tuner, n
         notes.append(f"{name}: below the robustness floors: {tuner['robustness']['why']}")
     if len(plant.scene.ptos) == 1 and plant.hydro is not None:
         tuner["share"] = share_explained(plant, wave, pto, predicted, name,
-                                         robust=bool(tuner.get("robust")))
+                                         robust=_floors_cost(tuner))
     return margins
 
 
@@ -380,3 +380,10 @@ def _bounds(plant, wave, pto, limit_values, mode, params=None, whole=False) -> d
                                       harmonics=harmonics, full=mode == "full",
                                       conjugate=cc, whole_period=whole))
     return out
+
+
+def _floors_cost(tuner: dict) -> bool:
+    """Did the robustness floors give up power (more than 1e-4 of the unconstrained optimum's
+    prediction)? Then the share's explanation names them."""
+    cost = (tuner.get("margins_cost") or {}).get("share") or 0.0
+    return bool(tuner.get("robust")) and cost > 1e-4
