@@ -64,11 +64,13 @@ bench: $(VENV)/.installed-test
 	$(PY) benchmarks/mathieu_spar.py --out $(OUT)/bench/mathieu
 	$(PY) benchmarks/moordyn_rm3.py --out $(OUT)/bench/moordyn_rm3
 	$(PY) benchmarks/startup.py --out $(OUT)/bench/startup
+	$(PY) benchmarks/rtf_table.py --out $(OUT)/bench/rtf
 	$(PY) benchmarks/radiation_fit.py --tols 0.1 0.05 0.02 0.01 --out $(OUT)/bench/radiation_barge
 	$(PY) benchmarks/radiation_fit.py --file models/rm3_hydro.nc --omega-max 3.0 \
 	    --tols 0.1 0.05 0.02 0.01 --out $(OUT)/bench/radiation_rm3
 	$(PY) benchmarks/scaling.py --n 2 4 8 16 --out $(OUT)/bench/scaling
 	$(PY) benchmarks/array_scaling.py --n 2 3 4 5 --fit-tol 0.02 0.02 0.02 0.06 --out $(OUT)/bench/array_scaling
+	$(PY) benchmarks/farm_compile.py --n 3 4 5 7 --simulate 60 --out $(OUT)/bench/farm_compile
 	$(PY) benchmarks/interaction_cutoff.py --n 4 --radius 1.0 1.5 --out $(OUT)/bench/interaction_cutoff
 	$(PY) benchmarks/mpc.py --out $(OUT)/bench/mpc
 	$(PY) benchmarks/nmpc.py --out $(OUT)/bench/nmpc
@@ -77,6 +79,8 @@ bench: $(VENV)/.installed-test
 	$(PY) benchmarks/sweep_light.py --out $(OUT)/bench/sweep_light
 	$(PY) benchmarks/sweep_design.py --out $(OUT)/bench/sweep_design
 	$(PY) benchmarks/spectral_scatter.py --out $(OUT)/bench/spectral_scatter
+	$(PY) benchmarks/frequency_sweep.py --out $(OUT)/bench/frequency_sweep
+	$(PY) benchmarks/hull_site_example.py --out $(OUT)/bench/hull_site
 	$(PY) benchmarks/wecopttool_electrical.py --out $(OUT)/bench/wecopttool
 	$(PY) benchmarks/wecopttool_codesign.py --out $(OUT)/bench/wecopttool_codesign
 	$(PY) benchmarks/wecopttool_tste.py --out $(OUT)/bench/wecopttool_tste

@@ -6,10 +6,13 @@ measured in one run on this machine, from the scene file to a 60 s simulation:
   - fit: the radiation model (the scene's method: column by column, symmetric columns shared,
     passivity enforced; tolerance 2 %), with its error, states and peak memory of the process;
   - build: symbolic assembly of the process plant (CasADi);
-  - compile: C code generation and gcc of the RK4 step;
+  - compile: C code generation and gcc of the RK4 step, and the size of its C (bytes: a
+    deterministic proxy of gcc's time; a farm's couplings are data there, module plant.pieces);
   - simulate: 60 s of JONSWAP (Hs 5 cm, Tp 1.1 s, RK4, dt 0.01 s), and the real-time factor.
 "total" is scene to simulated record, the sum. The growth exponent of each cost is the slope
-of log(cost) against log(number of floats). Writes a CSV, a JSON and a log-log chart.
+of log(cost) against log(number of floats); the ratio of the two largest grids' costs is printed
+beside the ratio of their sizes (proportional growth). Writes a CSV, a JSON and a log-log chart.
+benchmarks/farm_compile.py measures build and compile alone up to 49 floats, without the BEM.
 """
 from __future__ import annotations
 
@@ -31,7 +34,9 @@ from mbcontrol.multibody import build_topology
 from mbcontrol.plant import active_hydro_dofs, build_plant
 from mbcontrol.scene import load_scene
 from mbcontrol.sim import simulate
-from mbcontrol.sim.integrators import prepare
+from mbcontrol.sim.integrators import chunk_length, chunk_symbolic, prepare
+
+from farm_compile import c_bytes
 
 DURATION, DT = 60.0, 0.01
 
@@ -52,6 +57,7 @@ def measure(n_side: int, fit_tol: float) -> dict:
     plant = build_plant(scene, hydro)
     t_build = time.perf_counter() - t0
     steps = int(round(DURATION / DT))
+    step_c = c_bytes(chunk_symbolic(plant, "rk4", None, chunk_length(steps)))
     t0 = time.perf_counter()
     prepare(plant, steps, "rk4")
     t_compile = time.perf_counter() - t0
@@ -67,6 +73,7 @@ def measure(n_side: int, fit_tol: float) -> dict:
             "passive": bool(rad.report["passivity"].get("passive")),
             "fit_band_rad_s": fit_band_limit(data, scene.hydro.fit_omega_max),
             "bem_s": t_bem, "fit_s": t_fit, "build_s": t_build, "compile_s": t_compile,
+            "step_c_bytes": step_c,
             "simulate_s": t_sim, "total_s": t_bem + t_fit + t_build + t_compile + t_sim,
             "rtf": DURATION / out.attrs["wall_time_s"], "peak_rss_mb": rss_fit,
             "shunt_terms": len(rad.report["passivity"].get("shunt_terms", [])),
@@ -95,7 +102,7 @@ def main(argv=None) -> int:
     print(f"array_grid (heaving cylinders, 1 m apart), cold cache per grid; {DURATION:.0f} s JONSWAP, "
           f"RK4 dt = {DT} s")
     head = (f"{'floats':>6} {'rad. states':>11} {'fit tol':>7} {'fit err':>8} {'BEM (s)':>8} {'fit (s)':>8} {'build (s)':>9} "
-            f"{'compile (s)':>11} {'sim (s)':>8} {'total (s)':>9} {'RTF':>6} {'peak MB':>8}")
+            f"{'compile (s)':>11} {'C (kB)':>7} {'sim (s)':>8} {'total (s)':>9} {'RTF':>6} {'peak MB':>8}")
     print(head)
     previous = os.environ.get("MBCONTROL_CACHE")
     tols = args.fit_tol or [0.02] * len(args.n)
@@ -113,12 +120,17 @@ def main(argv=None) -> int:
                     os.environ["MBCONTROL_CACHE"] = previous
         rows.append(r)
         print(f"{r['floats']:6d} {r['radiation_states']:11d} {r['fit_tol']:7.0%} {r['fit_error']:8.2%} {r['bem_s']:8.1f} "
-              f"{r['fit_s']:8.1f} {r['build_s']:9.1f} {r['compile_s']:11.1f} {r['simulate_s']:8.1f} "
+              f"{r['fit_s']:8.1f} {r['build_s']:9.1f} {r['compile_s']:11.1f} {r['step_c_bytes'] / 1e3:7.0f} "
+              f"{r['simulate_s']:8.1f} "
               f"{r['total_s']:9.1f} {r['rtf']:6.0f} {r['peak_rss_mb']:8.0f}", flush=True)
     if len(rows) > 1:
         print("growth exponents (cost ~ floats^k): " + ", ".join(
-            f"{k[:-2]} {growth(rows, k):.2f}" for k in ("bem_s", "fit_s", "build_s", "compile_s", "simulate_s",
-                                                         "total_s")))
+            f"{k.removesuffix('_s')} {growth(rows, k):.2f}" for k in (
+                "bem_s", "fit_s", "build_s", "compile_s", "step_c_bytes", "simulate_s", "total_s")))
+        a, b = rows[-2], rows[-1]
+        print(f"{b['floats']} over {a['floats']} floats (proportional: {b['floats'] / a['floats']:.2f}x): "
+              + ", ".join(f"{k.removesuffix('_s')} {b[k] / a[k]:.2f}x"
+                          for k in ("build_s", "compile_s", "step_c_bytes")))
         print(f"total of the largest over the smallest grid: {rows[-1]['total_s'] / rows[0]['total_s']:.2f}x")
     with open(args.out / "array_scaling.csv", "w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=list(rows[0]))

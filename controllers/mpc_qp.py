@@ -4,24 +4,20 @@ A CondensedQp is fixed once built; what a run carries from one solve to the next
 that solved last, the warm-starting active set, counters) is its own `QpWork`."""
 from __future__ import annotations
 
-import contextlib
-import io
-import os
-import sys
-
 import numpy as np
 
-from mbcontrol.console import flush_c_stdio
 from mbcontrol.errors import ControllerError
 
-from .mpc_active_set import ActiveSetQp
+from .mpc_backends import CvxpyBackend, QpoasesBackend
+from .mpc_blocks import block_of_step, expansion, slew_spacing
 
 
 class CondensedQp:
     """The MPC's QP in the forces alone (states eliminated), scaled to O(1) and built once.
 
-    Variables (scaled): U / F_s (N nu, step-major) and, with a finite stroke limit and
-    soft_stroke, slacks s / L_s (N nu). F_s: the force limit (or L_s / lambda_max(G) if
+    Variables (scaled): V / F_s (B nu, block-major: the forces of U = T V, held over each
+    block of `blocks` (step counts summing to N; mpc_blocks); None: one block per step, V =
+    U) and, with a finite stroke limit and soft_stroke, slacks s / L_s (N nu). F_s: the force limit (or L_s / lambda_max(G) if
     unlimited); L_s: the stroke limit (or 1 m). envelope: rows (ne, nz) of outputs of the
     control plant, each scaled by its limit, kept within +-1 at the ends of steps 1..N with a
     slack each (always soft: the sea alone may take a quantity beyond it); solve's offset
@@ -35,7 +31,7 @@ class CondensedQp:
 
     def __init__(self, cp, N: int, limits: dict, *, efficiency, loss_damping,
                  force_penalty: float, stroke_penalty: float, soft_stroke: bool, solver: str,
-                 winding=None, envelope=None, hull=None):
+                 winding=None, envelope=None, hull=None, blocks=None):
         nu, nz = len(cp.ptos), cp.nz
         self.N, self.nu, self.solver = N, nu, solver
         # prediction of the positions at the ends of steps 1..N
@@ -86,13 +82,21 @@ class CondensedQp:
         self.Qz = W @ (L @ Phi - E @ cp.Cp) / Ls             # q = Qz z0 + Qd D (scaled)
         self.Qd = W @ (L @ Om) / Ls
         self.Phi, self.Om, self.Psi = Phi, Om, Psi
+        # move blocking: the QP in V (U = T V); H_u, Qz, Qd stay over U (T'. over V)
+        self.blocks, self.T = blocks, expansion(blocks, N, nu)
+        self.n_b = self.T.shape[1]                           # force variables, B nu
+        self.block_of = block_of_step(blocks, N)             # each step's block
+        self.starts = np.unique(self.block_of, return_index=True)[1]     # each block's first
+        self.H_v, self.Qz_v, self.Qd_v = (self.H_u, self.Qz, self.Qd) if blocks is None else (
+            self.T.T @ self.H_u @ self.T, self.T.T @ self.Qz, self.T.T @ self.Qd)
         self.Fs, self.Ls, self.stroke_penalty = Fs, Ls, stroke_penalty
         self.has_stroke = bool(np.all(np.isfinite(stroke)))
         self.stroke = np.tile(stroke, N) / Ls
-        self.force = np.tile(force, N) / Fs
+        self.force = np.tile(force, self.n_b // nu) / Fs        # per variable of V
         self.has_rate = bool(np.all(np.isfinite(rate)))
-        self.rate = np.tile(rate * cp.dt, N) / Fs
-        backend = _QpoasesBackend if solver == "qpoases" else _CvxpyBackend
+        spacing = slew_spacing(blocks, N)                    # steps per block boundary
+        self.rate = np.kron(spacing, rate * cp.dt) / Fs      # per block boundary
+        backend = QpoasesBackend if solver == "qpoases" else CvxpyBackend
         # the exact L1 penalty makes the soft QP's solution the hard one's whenever the hard
         # QP is feasible: solve the hard QP (half the variables) and the soft one only when
         # it is infeasible
@@ -120,7 +124,7 @@ class CondensedQp:
             free.append(env if offset is None else env + np.asarray(offset, float).reshape(-1))
         if self.n_hull:
             free.append(self.Phi_h @ z0 + self.Om_h @ D.reshape(-1))
-        q = self.Qz @ z0 + self.Qd @ D.reshape(-1)
+        q = self.Qz_v @ z0 + self.Qd_v @ D.reshape(-1)        # over V
         status = "not solved"
         # start with the form that solved last time: the hard QP is infeasible for stretches
         # (a wave group), and an active-set solver takes long to prove infeasibility
@@ -131,7 +135,8 @@ class CondensedQp:
                 # back to the hard form once the slack is no longer used
                 work.last = int(form.soft and slack > 1e-6)
                 work.soft_solves += int(form.soft)
-                return (sol * self.Fs).reshape(self.N, self.nu), status
+                U = sol if self.blocks is None else self.T @ sol
+                return (U * self.Fs).reshape(self.N, self.nu), status
         return None, status
 
 
@@ -148,21 +153,22 @@ class _QpForm:
     """One layout of the condensed QP: hard limits (variables U) or soft ones (U, slacks).
     Rows: stroke (Psi U, or Psi U -/+ s; soft in the soft form when soft_stroke), envelope
     (always soft in the soft form), hull force (soft in the soft form), then force rate
-    (differences of U)."""
+    (differences of V: the force changes only between blocks, within one step), each row
+    over U taken over V by T."""
 
     def __init__(self, qp, *, soft: bool, backend):
-        N, nu = qp.N, qp.nu
-        self.qp, self.soft, self.n_u = qp, soft, N * nu
-        blocks = []                      # (matrix over U, soft), in row order
+        nu, nb, T = qp.nu, qp.n_b, qp.T
+        self.qp, self.soft, self.n_u = qp, soft, nb
+        blocks = []                      # (matrix over V, soft), in row order
         if qp.has_stroke:
-            blocks.append((qp.Fs / qp.Ls * qp.Psi, soft and qp.soft_stroke))
+            blocks.append((qp.Fs / qp.Ls * qp.Psi @ T, soft and qp.soft_stroke))
         if qp.n_env:
-            blocks.append((qp.Fs * qp.Psi_e, soft))
+            blocks.append((qp.Fs * qp.Psi_e @ T, soft))
         if qp.n_hull:
-            blocks.append((qp.Fs * qp.M_h, soft))
+            blocks.append((qp.Fs * qp.M_h @ T, soft))
         self.blocks = [is_soft for _, is_soft in blocks]
         n_s = sum(M.shape[0] for M, is_soft in blocks if is_soft)
-        self.n_var = N * nu + n_s
+        self.n_var = nb + n_s
         rows, col = [], 0
         for M, is_soft in blocks:
             if is_soft:
@@ -173,15 +179,15 @@ class _QpForm:
             else:
                 rows.append(np.hstack([M, np.zeros((M.shape[0], n_s))]))
         if qp.has_rate:
-            Dr = np.eye(N * nu) - np.eye(N * nu, k=-nu)
-            rows += [np.hstack([Dr, np.zeros((N * nu, n_s))])]
+            Dr = np.eye(nb) - np.eye(nb, k=-nu)
+            rows += [np.hstack([Dr, np.zeros((nb, n_s))])]
         self.A = np.vstack(rows) if rows else np.zeros((0, self.n_var))
         self.H = np.zeros((self.n_var, self.n_var))
-        self.H[:N * nu, :N * nu] = qp.H_u
+        self.H[:nb, :nb] = qp.H_v
         self.g_slack = np.zeros(self.n_var)
         if n_s:
-            self.H[N * nu:, N * nu:] = 2 * qp.stroke_penalty * np.eye(n_s)
-            self.g_slack[N * nu:] = qp.stroke_penalty
+            self.H[nb:, nb:] = 2 * qp.stroke_penalty * np.eye(n_s)
+            self.g_slack[nb:] = qp.stroke_penalty
         self.lbx = np.concatenate([-qp.force, np.zeros(n_s)])
         self.ubx = np.concatenate([qp.force, np.full(n_s, np.inf)])
         self.backend = backend(self)
@@ -217,100 +223,13 @@ class _QpForm:
         g, lba, uba = self.bounds(q, free, u_prev)
         x0 = np.zeros(self.n_var)
         if warm is not None:
-            x0[:self.n_u] = np.vstack([warm[1:], warm[-1:]]).ravel() / self.qp.Fs
+            shifted = np.vstack([warm[1:], warm[-1:]])[self.qp.starts]   # each block's first
+            x0[:self.n_u] = shifted.ravel() / self.qp.Fs
         memory = self.backend.memory() if memory is None else memory
         sol, status = self.backend.solve(g, self.lbx, self.ubx, lba, uba, x0, memory)
         if sol is None:
             return None, status, 0.0
         return sol[:self.n_u], status, float(np.max(sol[self.n_u:], initial=0.0))
-
-
-class _QpoasesBackend:
-    """Dense qpOASES through CasADi's conic interface; H and A fixed, built once. On the hard
-    form each call first tries the verified active-set shortcut (mpc_active_set: the same
-    optimum, and CasADi's qpOASES starts cold at every call); not on the soft form (met only
-    when the hard QP is infeasible, 6x the variables: there the shortcut measured slower).
-    A run's memory: the shortcut's active set and whether qpOASES has been called yet."""
-
-    def __init__(self, form):
-        import casadi as ca
-        self.H, self.A = ca.DM(form.H), ca.DM(form.A)      # converted once, not per call
-        self.fast = None if form.soft else ActiveSetQp(form.H, form.A)
-        opts = {"printLevel": "none", "sparse": False, "error_on_fail": False,
-                "hessian_type": "posdef"}
-        self.solver = _quiet(lambda: ca.conic(
-            "mpc_qp", "qpoases", {"h": ca.DM(form.H).sparsity(), "a": ca.DM(form.A).sparsity()},
-            opts))
-
-    def memory(self) -> dict:
-        return {"fast": None if self.fast is None else self.fast.memory(), "called": False}
-
-    def solve(self, g, lbx, ubx, lba, uba, x0, memory):
-        if self.fast is not None:
-            x = self.fast.solve(g, lbx, ubx, lba, uba, memory["fast"])
-            if x is not None:
-                return x, "solved"
-        call = (lambda: self.solver(h=self.H, a=self.A, g=g, lbx=lbx, ubx=ubx, lba=lba,
-                                    uba=uba, x0=x0))
-        if not memory["called"]:            # qpOASES prints its banner on the first solve
-            memory["called"] = True
-            out = _quiet(call)
-        else:
-            # and reports an infeasible QP (counted in the MPC's stats) through CasADi's
-            # stream, which writes to Python's sys.stdout: a --json reader got those lines
-            with contextlib.redirect_stdout(_DISCARD):
-                out = call()
-        stats = self.solver.stats()
-        if not stats.get("success", False):
-            return None, str(stats.get("return_status", "failed"))
-        if self.fast is not None:               # the next call starts from this active set
-            self.fast.remember(np.asarray(out["lam_x"]), np.asarray(out["lam_a"]),
-                               memory["fast"])
-        return np.asarray(out["x"]).ravel(), "solved"
-
-
-class _CvxpyBackend:
-    """cvxpy with Parameters (built once, DPP), solved by Clarabel."""
-
-    def __init__(self, form):
-        import cvxpy as cp
-        n = form.n_var
-        self.x = cp.Variable(n)
-        self.g = cp.Parameter(n)
-        w, V = np.linalg.eigh(form.H)
-        factor = V * np.sqrt(np.clip(w, 0, None))[None, :]
-        lo, hi = np.isfinite(form.lbx), np.isfinite(form.ubx)
-        cons = [self.x[np.flatnonzero(lo)] >= form.lbx[lo]] if lo.any() else []
-        if hi.any():
-            cons.append(self.x[np.flatnonzero(hi)] <= form.ubx[hi])
-        # which rows have finite bounds is fixed by the layout: probe it once
-        qp = form.qp
-        free = ([np.zeros(form.n_u)] if qp.has_stroke else []) + \
-            ([np.zeros(qp.N * qp.n_env)] if qp.n_env else []) + \
-            ([np.zeros(2 * qp.N * qp.n_hull)] if qp.n_hull else [])
-        _, lba, uba = form.bounds(np.zeros(form.n_u), free, np.zeros(qp.nu))
-        self.lo_rows, self.hi_rows = np.flatnonzero(np.isfinite(lba)), np.flatnonzero(np.isfinite(uba))
-        self.lba, self.uba = cp.Parameter(self.lo_rows.size), cp.Parameter(self.hi_rows.size)
-        if self.lo_rows.size:
-            cons.append(form.A[self.lo_rows] @ self.x >= self.lba)
-        if self.hi_rows.size:
-            cons.append(form.A[self.hi_rows] @ self.x <= self.uba)
-        objective = 0.5 * cp.sum_squares(factor.T @ self.x) + self.g @ self.x
-        self.problem = cp.Problem(cp.Minimize(objective), cons)
-
-    memory = staticmethod(lambda: None)   # Clarabel starts afresh; Parameters set per call
-
-    def solve(self, g, lbx, ubx, lba, uba, x0, memory=None):
-        import cvxpy as cp
-        self.g.value = g
-        self.lba.value, self.uba.value = lba[self.lo_rows], uba[self.hi_rows]
-        try:
-            self.problem.solve(solver=cp.CLARABEL)
-        except cp.error.SolverError as exc:
-            return None, f"solver error: {exc}"
-        if self.problem.status not in (cp.OPTIMAL, cp.OPTIMAL_INACCURATE):
-            return None, self.problem.status
-        return np.asarray(self.x.value).ravel(), "solved"
 
 
 def _predictions(cp, C, powers, N):
@@ -364,36 +283,3 @@ def _boundaries(N: int):
     ends = 0.5 * (mid[:-1] + mid[1:])                      # between steps k and k+1
     first, last = 1.5 * mid[0] - 0.5 * mid[1], 1.5 * mid[-1] - 0.5 * mid[-2]
     return np.vstack([first, ends]), np.vstack([ends, last])
-
-
-class _Discard:
-    """A text stream that keeps nothing."""
-
-    def write(self, text: str) -> int:
-        return len(text)
-
-    def flush(self) -> None:
-        pass
-
-
-_DISCARD = _Discard()
-
-
-def _quiet(call):
-    """Run with output silenced: qpOASES prints a banner, through CasADi's stream (which
-    CasADi hands to Python's sys.stdout) or straight to the process's stdout."""
-    sys.stdout.flush()
-    sys.stderr.flush()
-    saved = [os.dup(1), os.dup(2)]
-    try:
-        with open(os.devnull, "w") as null, contextlib.redirect_stdout(io.StringIO()), \
-                contextlib.redirect_stderr(io.StringIO()):
-            os.dup2(null.fileno(), 1)
-            os.dup2(null.fileno(), 2)
-            return call()
-    finally:
-        flush_c_stdio()                 # a pipe's C buffer would print after the restore
-        os.dup2(saved[0], 1)
-        os.dup2(saved[1], 2)
-        for fd in saved:
-            os.close(fd)

@@ -66,6 +66,9 @@ class MpcSettings:
     number or a dict by PTO name, None: the scene's. warm_up_s: passive damping until this
     time, s (None: WARM_UP_PERIODS peak periods with the AR forecast, 0 otherwise).
     objective: "auto", "electrical" or "mechanical". envelope: keep the linear model's range.
+    blocks: move blocking, the force held over blocks of steps (controllers.mpc_blocks): None
+    (one force per step), a count of blocks (a default layout, short blocks first) or the
+    block lengths in steps, summing to horizon_s / dt_s.
     """
     horizon_s: float = 10.0
     dt_s: float = 0.2
@@ -88,6 +91,7 @@ class MpcSettings:
     warm_up_s: float | None = None
     objective: str = "auto"
     envelope: bool = True
+    blocks: int | tuple | None = None
 
     def __post_init__(self):
         forecast = self.forecast or "ar"    # causal by default; the oracle only when asked

@@ -29,6 +29,7 @@ from .control_plant import ControlPlant, build_control_plant, device_frequency, 
 from .estimation import (ArConfig, ArPredictor, ExcitationKalman, KalmanEstimate,
                          wave_frequencies)
 from .limits import command_limit, hull_limits, linear_range, per_pto_values
+from .mpc_blocks import block_lengths
 from .mpc_envelope import MpcEnvelope
 from .mpc_qp import CondensedQp, QpWork
 from .mpc_settings import FrozenDict, MpcSettings
@@ -143,7 +144,7 @@ def build_setup(settings: MpcSettings, plant) -> MpcSetup:
                      loss_damping=pto_impedance(cp, float(np.median(omega))),
                      force_penalty=s.force_penalty, stroke_penalty=s.stroke_penalty,
                      soft_stroke=s.soft_stroke, solver=s.solver, envelope=env.rows(cp),
-                     hull=hull)
+                     hull=hull, blocks=block_lengths(s.blocks, N))
     if s.estimator == "kalman":
         kalman = ExcitationKalman(cp, omega, measurement_noise=s.measurement_noise)
     else:

@@ -55,9 +55,11 @@ _REGISTRY: dict[str, Default] = {
                                      "0 serial in this process", int),
     "sweep.cluster": Default("auto", "", "a sweep's local Dask cluster: auto (only when it "
                                          "pays, timed) or always", str),
-    "sweep.start": Default("spawn", "", "how a sweep's local Dask workers start: spawn (fresh "
-                                        "interpreters) or fork (faster; may hang a threaded "
-                                        "process)", str),
+    "sweep.start": Default("forkserver", "", "how a sweep's local Dask workers start: "
+                                             "forkserver (forks of one fresh interpreter that "
+                                             "imported the code once), spawn (fresh "
+                                             "interpreters) or fork (fastest; may hang a "
+                                             "threaded process)", str),
     "compile.cc": Default("", "", "C compiler of the compiled simulation code (empty: gcc, "
                                   "else cc)", str, env="CC"),
     "dask.host": Default("127.0.0.1", "", "address local Dask clusters (sweeps, co-design) "

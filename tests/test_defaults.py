@@ -146,7 +146,7 @@ MOVED = {"validity.power_allowance": 0.10, "validity.energy_tolerance": 0.05,
          "fidelity.signal_floor": 1e-3, "fidelity.freeze_threshold": 1e-3,
          "waves.breaking_steepness": 1 / 7, "sweep.direction_step": 0.017453292519943295,
          "resource.min_hours_year": 2880, "resource.min_hours_month": 168,
-         "sweep.cluster": "auto", "sweep.start": "spawn", "compile.cc": "",
+         "sweep.cluster": "auto", "sweep.start": "forkserver", "compile.cc": "",
          "validity.angle_max": 0.5235987755982988, "validity.draft_factor": 1.0,
          "envelope.share": 0.9, "design.rate_reversals_per_period": 5}
 

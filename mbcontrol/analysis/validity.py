@@ -102,9 +102,12 @@ def wave_of(ds):
     if "wave_omega" not in ds:
         return None
     desc = record(ds.attrs, "wave", {})
+    # a spread sea records each component's direction; its description holds only the mean
+    direction = ds["wave_direction"].values if "wave_direction" in ds else \
+        float(desc.get("direction_rad", 0.0))
     return Wave(desc.get("type", "components"), ds["wave_omega"].values,
                 ds["wave_amplitude"].values, ds["wave_phase"].values,
-                direction=float(desc.get("direction_rad", 0.0)),
+                direction=direction,
                 ramp_time=float(desc.get("ramp_s", 0.0)),
                 d_omega=ds["wave_omega"].attrs.get("d_omega"))
 

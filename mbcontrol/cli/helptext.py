@@ -75,6 +75,12 @@ labelled result (xarray). --vary NAME=v1,v2 adds a dimension: NAME is a scene pa
 a plant parameter, a setting of the controller, or `direction` (wave headings in degrees, among
 the hydro data's).
 
+Linear theory in milliseconds: --domain frequency computes every sea's mean power under a
+linear law (the scene's PTO law, or --controller passive|reactive) and its complex-conjugate
+bound straight from the BEM data, nothing simulated (a few hundred seas in tens of ms), with
+the time-domain sweep's JSON keys plus "conjugate_bound_W"; --domain both also simulates each
+sea and adds "frequency_domain_power_W" and "relative_difference" (time / frequency - 1).
+
 Short-crested seas: a --seas file's columns `direction` (degrees, NED: where the waves travel
 to, +x towards +y) and `spread` (degrees, the directional spread sigma, the circular standard
 deviation), per sea, or --spread DEG for every sea (it overrides the file's), with the

@@ -84,6 +84,9 @@ def add_parser(sub) -> None:
     p.add_argument("--width", type=float, help="characteristic width, m (capture width ratio)")
     p.add_argument("--plot", metavar="FILE.png", help="power matrix, capture width, energy")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
+    p.add_argument("--domain", choices=("time", "frequency", "both"), default="time",
+                   help="time: simulate (default); frequency: a linear law's linear theory, every sea\n"
+                        "in milliseconds, and its complex-conjugate bound; both: side by side")
     p.add_argument("--allow-invalid", action="store_true",
                    help="exit 0 even when cases fail their physics checks (they are still left\n"
                         "out of every figure); exit status 3 without this flag, 4 when cases\n"
@@ -129,6 +132,27 @@ def _workers(given: int | None) -> int | None:
     return None if n == -1 else n
 
 
+# flags the frequency-domain sweep does not take (attributes of args): the first group also
+# under --domain both (they change the plant or the cases), the second under frequency alone
+_NOT_FREQUENCY = ("records", "isolated", "design", "vary", "identified")
+_TIME_ONLY = ("store", "resource")
+
+
+def _check_domain(args) -> None:
+    """InputError for a flag the --domain frequency (or both) sweep does not take."""
+    alone = args.domain == "frequency"
+    given = [f"--{name}" for name in _NOT_FREQUENCY + (_TIME_ONLY if alone else ())
+             if getattr(args, name) not in (None, [], False)]
+    given += [flag for flag, other in (("--nonlinear", args.nonlinear != "scene"),
+                                       ("--seeds", alone and args.seeds != 1),
+                                       ("--amplitudes", alone and args.amplitudes != "deterministic"))
+              if other]
+    if given:
+        raise InputError(f"{given[0]} with --domain {args.domain}: not built (linear theory's "
+                         f"expected power of one linear law per long-crested sea); run "
+                         f"--domain time")
+
+
 def run_sweep(args) -> int:
     import inspect
 
@@ -136,6 +160,8 @@ def run_sweep(args) -> int:
 
     from ..studies.sweep import sweep
     from .commands import _key_value, _warn_if_absorbs_nothing, parse_settings
+    if args.domain != "time":
+        _check_domain(args)
     seas = _seas(args)
     if args.set and not args.controller:
         raise InputError("--set needs --controller")
@@ -166,11 +192,23 @@ def run_sweep(args) -> int:
         from ..studies import farm_sweep
         ds, summary = farm_sweep(args.model, seas, scene_params=scene_params,
                                  isolated=dict(_key_value(s, "--isolated") for s in args.isolated), **common)
+    elif args.domain == "frequency":
+        from ..studies.sweep import frequency_sweep
+        ds, summary = frequency_sweep(args.model, seas, controller=args.controller,
+                                      settings=settings, params=common["params"],
+                                      scene_params=scene_params, duration=args.duration,
+                                      width=args.width)
     else:
         years = _years(args, seas)
         ds, summary = sweep(args.model, seas, scene_params=scene_params, design=args.design,
                             robust=not args.aggressive, identified=args.identified, years=years,
                             nonlinear=args.nonlinear, records=args.records, **common)
+        if args.domain == "both":
+            from ..studies.sweep import compare_domains, frequency_sweep
+            summary = compare_domains(summary, frequency_sweep(
+                args.model, seas, controller=args.controller, settings=settings,
+                params=common["params"], scene_params=scene_params,
+                duration=args.duration, width=args.width)[1])
     if args.plot:
         from ..studies.sweep import plot_sweep
         plot_sweep(ds, summary, args.plot)
@@ -267,6 +305,20 @@ def _record(row: dict, before: str = "  ") -> str:
     return "" if name is None else before + " " + plain_text(name, 60)
 
 
+_DOMAIN_HEADER = {"frequency": f" {'bound kW':>10s}",
+                  "both": f" {'FD kW':>10s} {'TD/FD-1':>8s} {'bound kW':>10s}"}
+
+
+def _domain_columns(row: dict, domain: str) -> str:
+    """The frequency domain's columns of a row: the complex-conjugate bound (kW); with
+    --domain both, linear theory's power (kW) and the simulation's relative difference."""
+    kw = lambda v: f"{v / 1e3:10.4g}" if isinstance(v, float) else f"{'-':>10s}"  # noqa: E731
+    diff = row.get("relative_difference")
+    return {"time": "", "frequency": f" {kw(row.get('conjugate_bound_W'))}"}.get(domain, (
+        f" {kw(row.get('frequency_domain_power_W'))} "
+        f"{'-' if diff is None else f'{100 * diff:+.2f}%':>8s} {kw(row.get('conjugate_bound_W'))}"))
+
+
 def _kN(value) -> str:
     return f"{value / 1e3:.4g}" if isinstance(value, float) else "-"
 
@@ -274,11 +326,17 @@ def _kN(value) -> str:
 def _print_summary(summary: dict, store) -> None:
     """The sweep's text report: a row per sea, notes, invalid and failed cases, the annual
     energy with its interval and budget, a farm's q factor."""
-    print(f"{summary['model']}: {summary['cases']} cases ({summary['computed']} computed, "
-          f"{summary['reused']} reused) in {summary['wall_time_s']:.1f} s")
+    domain = summary.get("domain", "time")
+    if domain == "frequency":
+        print(f"{summary['model']}: {summary['cases']} seas in the frequency domain (linear "
+              f"theory) in {1e3 * summary['compute_time_s']:.3g} ms after the plant was built")
+    else:
+        print(f"{summary['model']}: {summary['cases']} cases ({summary['computed']} computed, "
+              f"{summary['reused']} reused) in {summary['wall_time_s']:.1f} s")
     farm = summary.get("farm")
     print(f"  {'Hs m':>6s} {'Tp s':>6s} {'weight':>8s} {'power kW':>10s} {'CW m':>8s} {'J kW/m':>8s}"
-          + (f" {'q':>6s}" if farm else "") + ("   record" if _measured(summary) else ""))
+          + (f" {'q':>6s}" if farm else "") + ("   record" if _measured(summary) else "")
+          + _DOMAIN_HEADER.get(domain, ""))
     for row in summary["seas"]:
         power = row["mean_power_W"]
         text = f"{power / 1e3:10.4g}" if isinstance(power, float) else "  (varied)"
@@ -291,7 +349,8 @@ def _print_summary(summary: dict, store) -> None:
         q = row.get("q_factor")
         q_text = "" if not farm else f" {q:6.3f}" if isinstance(q, float) else "  (varied)"
         print(f"  {row['hs']:6.3g} {row['tp']:6.3g} {weight} {text} {cw_text} "
-              f"{row['energy_flux_W_per_m'] / 1e3:8.3g}{q_text}{_record(row)}")
+              f"{row['energy_flux_W_per_m'] / 1e3:8.3g}{q_text}{_record(row)}"
+              + _domain_columns(row, domain))
         if "bound_W" in row:
             print(f"         {_design_line(row)}")
     _print_mooring_loads(summary["seas"])

@@ -104,9 +104,10 @@ def header(spec: ControllerSpec, ident: str) -> str:
               f"void {ident}_reset({ident}_ctx *ctx);",
               f"int {ident}_step({ident}_ctx *ctx, const double *measurements, double t, "
               f"double *force);",
-              "/* timing: steps through rows of measurements, each step's wall time in ns */",
+              "/* timing: steps through rows of measurements, each step's wall time in ns and "
+              "(cpu_ns not NULL) its thread CPU time in ns */",
               f"int {ident}_bench({ident}_ctx *ctx, const double *measurements, int rows, "
-              f"const double *t, double *force, double *ns);",
+              f"const double *t, double *force, double *ns, double *cpu_ns);",
               f"int {ident}_ctx_size(void);", "", "#endif", ""]
     return "\n".join(lines)
 

@@ -80,7 +80,8 @@ def _fmu_check(plant_fmu, controller_fmu, u_ref, reference, duration, dt, pto) -
 def step_timing(controller, exported, record, plant, *, python_steps: int | None = None) -> dict:
     """Step times (us) of the C library over the measurements of `record` (a Dataset of a
     closed-loop run) at the controller's calls, and of the Python controller over the same
-    (the first python_steps of them). Both from a fresh start; the C one timed inside C."""
+    (the first python_steps of them). Both from a fresh start; the C one timed inside C, wall
+    ("c") and thread CPU time ("c_cpu")."""
     period = period_of(controller)
     t = record["time"].values
     if period:                             # the samples the controller acts on
@@ -92,8 +93,12 @@ def step_timing(controller, exported, record, plant, *, python_steps: int | None
         y = y[::every]
     c_ctrl = CController.from_export(exported, period=period)
     c_ctrl.reset(plant)
-    _, ns = c_ctrl.timed_run(y, t)
-    out = {"c": step_statistics(ns)}
+    _, ns, cpu_ns = c_ctrl.timed_run(y, t, cpu=True)
+    # wall time (what a shared machine's scheduler adds included) and thread CPU time
+    out = {"c": step_statistics(ns), "c_cpu": step_statistics(cpu_ns)}
+    counts = c_ctrl.counts()                # the MPC engine's: fallbacks, soft solves, fits
+    if counts is not None:
+        out["c_counts"] = counts
     n_py = len(t) if python_steps is None else min(python_steps, len(t))
     controller = copy.copy(controller)          # a private run: the caller's is left alone
     controller.reset(plant)

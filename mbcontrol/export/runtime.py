@@ -36,7 +36,7 @@ class CController:
         self._step.argtypes = [ctypes.c_void_p, _DOUBLE_P, ctypes.c_double, _DOUBLE_P]
         self._bench = getattr(self.lib, f"{ident}_bench")
         self._bench.argtypes = [ctypes.c_void_p, _DOUBLE_P, ctypes.c_int, _DOUBLE_P, _DOUBLE_P,
-                                _DOUBLE_P]
+                                _DOUBLE_P, _DOUBLE_P]
         self.params = None if params is None else np.ascontiguousarray(params, float)
         self._force = np.zeros(n_force)
         self._index = None
@@ -76,17 +76,35 @@ class CController:
     def describe(self) -> dict:
         return {"name": self.name, "period_s": self.period, "library": str(self.lib._name)}
 
-    def timed_run(self, measurements: np.ndarray, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(forces (rows, n_force), step times ns) of the measurement rows at times t, stepped
-        and timed inside C from a fresh init."""
+    STAT_NAMES = ("solves", "failures", "soft_solves", "ar_fits", "ar_unstable_fits",
+                  "qp_iterations_max")
+
+    def counts(self) -> dict | None:
+        """The run's counters so far (an MPC engine; None for other laws): QP solves,
+        failures (the fallback, the previous plan's next move, fired), soft_solves (the
+        stroke's soft form), AR fits and stabilised ones and the most iterations of one QP
+        solve."""
+        stats = getattr(self.lib, f"{self.ident}_stats", None)
+        if stats is None:
+            return None
+        out = (ctypes.c_long * len(self.STAT_NAMES))()
+        stats.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.c_int]
+        k = stats(self._ctx, out, len(self.STAT_NAMES))
+        return {name: int(out[i]) for i, name in enumerate(self.STAT_NAMES[:k])}
+
+    def timed_run(self, measurements: np.ndarray, t: np.ndarray, cpu: bool = False) -> tuple:
+        """(forces (rows, n_force), step wall times ns) of the measurement rows at times t,
+        stepped and timed inside C from a fresh init; cpu: also each step's thread CPU time,
+        ns (a third item)."""
         self.start()
         m = np.ascontiguousarray(measurements, float)
         t = np.ascontiguousarray(t, float)
         force = np.zeros((len(t), self.n_force))
-        ns = np.zeros(len(t))
-        if self._bench(self._ctx, _ptr(m), len(t), _ptr(t), _ptr(force), _ptr(ns)) != 0:
+        ns, cpu_ns = np.zeros(len(t)), np.zeros(len(t))
+        if self._bench(self._ctx, _ptr(m), len(t), _ptr(t), _ptr(force), _ptr(ns),
+                       _ptr(cpu_ns) if cpu else None) != 0:
             raise RuntimeError(f"{self.ident}_bench: a step failed")
-        return force, ns
+        return (force, ns, cpu_ns) if cpu else (force, ns)
 
 
 def step_statistics(ns: np.ndarray) -> dict:

@@ -205,9 +205,10 @@ def _mpc_spec(c, plant) -> ControllerSpec:
         "MBC_GAMMA": ("double", kal.Gamma), "MBC_K": ("double", kal.K),
         "MBC_C": ("double", kal.C), "MBC_CXI": ("double", kal.C_xi),
         "MBC_PHI_XI": ("double", kal.Phi_xi), "MBC_PPRED": ("double", qp.Phi),
-        "MBC_OM": ("double", qp.Om), "MBC_QZ": ("double", qp.Qz), "MBC_QD": ("double", qp.Qd),
+        "MBC_OM": ("double", qp.Om), "MBC_QZ": ("double", qp.Qz_v), "MBC_QD": ("double", qp.Qd_v),
         "MBC_STROKE": ("double", qp.stroke), "MBC_RATE": ("double", qp.rate),
         "MBC_FORCE_MAX": ("double", setup.limits["force"]),
+        "MBC_BLOCK_OF": ("int", qp.block_of),       # move blocking: each step's block
     }
     form_rows = _qp_form_arrays(forms, arrays)
     nv_max = max(f.n_var for f in forms)
@@ -224,6 +225,7 @@ def _mpc_spec(c, plant) -> ControllerSpec:
     defines = {
         "MBC_NU": str(nu), "MBC_NY": str(len(kalman_inputs)), "MBC_NK": str(kal.Phi.shape[0]),
         "MBC_NZ": str(nz), "MBC_ND": str(nd), "MBC_NXI": str(nxi), "MBC_N": str(N),
+        "MBC_NB": str(qp.n_b),
         "MBC_P": str(ar_order), "MBC_AR_WINDOW": str(window), "MBC_WINDOW_MAX": str(window_max),
         "MBC_AR_REFIT": str(ar.refit if ar is not None else 1),
         "MBC_AR_RIDGE": repr(ar.ridge if ar is not None else 0.0),
@@ -234,7 +236,7 @@ def _mpc_spec(c, plant) -> ControllerSpec:
         "MBC_QP_ITER_PER_VARIABLE": str(QP_MAX_ITER_PER_VARIABLE),
     }
     context = _mpc_context(n_params=len(params), n_kalman=kal.Phi.shape[0], nu=nu, nd=nd, N=N,
-                           ar_order=ar_order, window_max=window_max, nv_max=nv_max,
+                           nb=qp.n_b, ar_order=ar_order, window_max=window_max, nv_max=nv_max,
                            na_max=na_max, n_forms=len(forms))
     return ControllerSpec("mpc", c.name, inputs, [f"u__{n}" for n in names], params,
                           defines=defines, arrays=arrays, engine=["mbc_mpc.c", "mbc_qp.c"],
@@ -267,9 +269,10 @@ def _qp_form_arrays(forms, arrays: dict) -> list:
     return form_rows
 
 
-def _mpc_context(*, n_params, n_kalman, nu, nd, N, ar_order, window_max, nv_max, na_max,
+def _mpc_context(*, n_params, n_kalman, nu, nd, N, nb, ar_order, window_max, nv_max, na_max,
                  n_forms) -> str:
-    """The C engine's per-instance state, sized for this MPC."""
+    """The C engine's per-instance state, sized for this MPC (nb: the QP's force variables,
+    N nu without move blocking)."""
     nv = N * nu
     return "\n    ".join([
         f"double params[{n_params}];",
@@ -278,13 +281,13 @@ def _mpc_context(*, n_params, n_kalman, nu, nd, N, ar_order, window_max, nv_max,
         f"double hist[{window_max * max(nd, 1)}];",
         "int hist_len, hist_start, since_fit, min_samples, window;",
         f"double coef[{max(nd, 1) * ar_order}], maps[{max(nd, 1) * (N + 1) * ar_order}];",
-        f"double D[{max(N * nd, 1)}], plan[{nv}], q[{nv}], freep[{nv}];",
+        f"double D[{max(N * nd, 1)}], plan[{nv}], q[{nb}], freep[{nv}];",
         f"double g[{nv_max}], x[{nv_max}], lba[{na_max}], uba[{na_max}];",
         f"mbc_qp qp[{n_forms}];",
         f"double J0[{n_forms}][{nv_max * nv_max}];",
         f"double qp_work[MBC_QP_WORK({nv_max}, {na_max})];",
         f"int qp_iwork[MBC_QP_IWORK({nv_max}, {na_max})];",
-        "long solves, failures, soft_solves, ar_fits, ar_unstable_fits;"])
+        "long solves, failures, soft_solves, ar_fits, ar_unstable_fits, qp_iterations_max;"])
 
 
 # the law's kind (controllers.law.KINDS) -> the spec of the engine that runs it

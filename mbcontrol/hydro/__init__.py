@@ -26,33 +26,62 @@ conjugate), used by `HydroModel.excitation_phasor`.
 Arrays: a mirror-symmetric layout is solved on its planes (module bem.array_bem); many bodies' radiation
 is fitted column by column (module fit.array_fit, :func:`fit_radiation_columns`).
 """
+from ..lazy import face
 from ..lti import phasor
-from .data.netcdf import read_netcdf, write_netcdf_atomic
-from .fit.baseline import fit_radiation_hankel
-from .bem.solve import cache_key, compute
-from .data.dataset import matrix
-from .data.frames import dof_map, shift_matrix, skew, to_body_frames, zup_to_ned
-from .data.headings import (axisymmetric_headings, covering_headings, covers_circle, heading_matrix,
-                            headings_for_spread, headings_line)
-from .mesh.geometry import RIGID_DOFS, BemBody, hull_mesh, lid_mesh, validate_body
-from .model import HydroModel, fit_hydro_model, fit_method, geometry_dict, load_hydro_data, load_hydro_model
-from .fit.passivity import PassivityReport, absorbed_energy, enforce_passivity, passivity_test
-from .fit.array_fit import fit_radiation_columns
-from .fit.kernel import convolution_force, impulse_response, kernel_data
-from .fit.radiation import RadiationModel, fit_radiation
-from .bem.isolated import compute_isolated
-from .data.headings import SECTOR_SIGMAS
-from .fit.response_error import Device, response_error_on
-from .fit.ssforms import state_blocks
-from .mesh.large_angle import buoyancy
-from .mesh.large_angle import potential as buoyancy_potential
-from .mesh.panels import Panels, body_panels, hydrostatic_pressure, pressure_wrench
-from .mesh.surface_sums import calm_water_function, pressure_wrench_function
-from .mesh.axisymmetric import AxisymmetricFK
-from .mesh.axisymmetric import from_geometry as axisymmetric_fk
-from .model import obstacle_bodies, recording_served_fits, shipped_fits_dir
-from .fit.plots import hydro_figure
-from .source import converted_source, with_displaced_masses
+
+# name -> (submodule, its name there): loaded on first use, so that a plant built from stored
+# data and a cached fit imports no BEM solver, reader, panel method or plotting
+_WHERE = {
+    "read_netcdf": ("data.netcdf", "read_netcdf"),
+    "write_netcdf_atomic": ("data.netcdf", "write_netcdf_atomic"),
+    "fit_radiation_hankel": ("fit.baseline", "fit_radiation_hankel"),
+    "cache_key": ("bem.solve", "cache_key"), "compute": ("bem.solve", "compute"),
+    "matrix": ("data.dataset", "matrix"), "dof_map": ("data.frames", "dof_map"),
+    "shift_matrix": ("data.frames", "shift_matrix"), "skew": ("data.frames", "skew"),
+    "to_body_frames": ("data.frames", "to_body_frames"), "zup_to_ned": ("data.frames", "zup_to_ned"),
+    "axisymmetric_headings": ("data.headings", "axisymmetric_headings"),
+    "covering_headings": ("data.headings", "covering_headings"),
+    "covers_circle": ("data.headings", "covers_circle"),
+    "heading_matrix": ("data.headings", "heading_matrix"),
+    "headings_for_spread": ("data.headings", "headings_for_spread"),
+    "headings_line": ("data.headings", "headings_line"),
+    "SECTOR_SIGMAS": ("data.headings", "SECTOR_SIGMAS"),
+    "RIGID_DOFS": ("mesh.geometry", "RIGID_DOFS"), "BemBody": ("mesh.geometry", "BemBody"),
+    "hull_mesh": ("mesh.geometry", "hull_mesh"), "lid_mesh": ("mesh.geometry", "lid_mesh"),
+    "validate_body": ("mesh.geometry", "validate_body"), "HydroModel": ("model", "HydroModel"),
+    "fit_hydro_model": ("model", "fit_hydro_model"), "fit_method": ("model", "fit_method"),
+    "geometry_dict": ("model", "geometry_dict"), "load_hydro_data": ("model", "load_hydro_data"),
+    "load_hydro_model": ("model", "load_hydro_model"),
+    "obstacle_bodies": ("model", "obstacle_bodies"),
+    "recording_served_fits": ("model", "recording_served_fits"),
+    "shipped_fits_dir": ("model", "shipped_fits_dir"),
+    "PassivityReport": ("fit.passivity", "PassivityReport"),
+    "absorbed_energy": ("fit.passivity", "absorbed_energy"),
+    "enforce_passivity": ("fit.passivity", "enforce_passivity"),
+    "passivity_test": ("fit.passivity", "passivity_test"),
+    "fit_radiation_columns": ("fit.array_fit", "fit_radiation_columns"),
+    "convolution_force": ("fit.kernel", "convolution_force"),
+    "impulse_response": ("fit.kernel", "impulse_response"),
+    "kernel_data": ("fit.kernel", "kernel_data"),
+    "RadiationModel": ("fit.radiation", "RadiationModel"),
+    "fit_radiation": ("fit.radiation", "fit_radiation"),
+    "compute_isolated": ("bem.isolated", "compute_isolated"),
+    "Device": ("fit.response_error", "Device"),
+    "response_error_on": ("fit.response_error", "response_error_on"),
+    "state_blocks": ("fit.ssforms", "state_blocks"),
+    "buoyancy": ("mesh.large_angle", "buoyancy"),
+    "buoyancy_potential": ("mesh.large_angle", "potential"),
+    "Panels": ("mesh.panels", "Panels"), "body_panels": ("mesh.panels", "body_panels"),
+    "hydrostatic_pressure": ("mesh.panels", "hydrostatic_pressure"),
+    "pressure_wrench": ("mesh.panels", "pressure_wrench"),
+    "calm_water_function": ("mesh.surface_sums", "calm_water_function"),
+    "pressure_wrench_function": ("mesh.surface_sums", "pressure_wrench_function"),
+    "AxisymmetricFK": ("mesh.axisymmetric", "AxisymmetricFK"),
+    "axisymmetric_fk": ("mesh.axisymmetric", "from_geometry"),
+    "hydro_figure": ("fit.plots", "hydro_figure"),
+    "converted_source": ("source", "converted_source"),
+    "with_displaced_masses": ("source", "with_displaced_masses"),
+}
 
 __all__ = [
     "read_netcdf", "write_netcdf_atomic", "phasor",
@@ -69,3 +98,5 @@ __all__ = [
     "AxisymmetricFK", "axisymmetric_fk",
     "recording_served_fits", "obstacle_bodies", "shipped_fits_dir", "converted_source", "with_displaced_masses", "hydro_figure",
 ]
+
+__getattr__, __dir__ = face(__name__, globals(), _WHERE)

@@ -10,9 +10,9 @@ from __future__ import annotations
 import functools
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-import xarray as xr
 
 from ..cache import cache_dir, rebuilt_once
 from ..console import status
@@ -21,11 +21,8 @@ from ..lti import phasor
 from ..scene import DOF_NAMES, Scene
 from ..waves import Wave, coefficient_series, excitation_series, interpolate_complex
 from .data.netcdf import read_netcdf
-from .bem.solve import compute
 from .mesh.geometry import BemBody
 from .data.headings import axisymmetric_headings, excitation_over_headings, heading_matrix, headings_remedy
-from .bem.isolated import compute_isolated
-from .bem.neighbours import compute_within
 from .fit.radiation import RadiationModel, coupled_groups
 from .fit.band import default_fit_band
 from .fit.response_error import Device
@@ -34,7 +31,9 @@ from .fit.store import (cached_fit, fit_band_limit, model_from_arrays,  # noqa: 
 from .fit.ssforms import modal_blocks
 from .readers.physical import DAMPING_EIG_TOL, check_physical
 from .readers.layout import force_first, kind_scales
-from .source import converted_source
+
+if TYPE_CHECKING:                  # the data are read by data.netcdf; here only named
+    import xarray as xr
 
 
 @dataclass(frozen=True)
@@ -227,6 +226,7 @@ def load_hydro_data(scene: Scene, dofs) -> tuple[str, xr.Dataset]:
             status(f"{scene.name}: [hydro] source {Path(h.source).name} is used; [hydro] omega "
                    f"(BEM frequencies for Capytaine) is not (remove one of them)", __name__)
         # its cache entry, if unreadable, is set aside by read_netcdf: converted again, once
+        from .source import converted_source       # here: a [hydro] file needs no reader
         source, data = rebuilt_once(lambda: converted_source(scene, dofs))
     elif h.file and not h.omega:
         raise HydroError(_missing_file(scene))
@@ -320,6 +320,10 @@ def _run_bem(scene: Scene, dofs):
     if not scene.hydro.omega:
         raise HydroError(f"{scene.path}: hydro.omega: expected BEM frequencies to compute the "
                          f"hydrodynamics of the scene's geometry (or a hydro.file)")
+    # here: a plant from stored data needs no BEM solver
+    from .bem.isolated import compute_isolated
+    from .bem.neighbours import compute_within
+    from .bem.solve import compute
     bodies = []
     for body in scene.bodies:
         # solve only what the joints can move (and the scene allows): no more than needed

@@ -221,17 +221,27 @@ class Tree:
             c.bv = c.bv + ca.cross(Qw, a) * s[i]
         return c
 
-    def _walk(self, q, s=None, upto: int | None = None) -> list[_State]:
-        """States of the real bodies 0..upto, parents first: O(N) elementary steps."""
-        last = len(self.links) - 1 if upto is None else upto
-        states: list[_State] = []
-        for k in range(last + 1):
+    def _walk(self, q, s=None, upto: int | None = None) -> list:
+        """States of the real bodies, parents first: all of them (O(N) elementary steps), or
+        with upto = k body k and its ancestors only (the others None): O(depth), so that a
+        farm's N per-body queries cost O(N), not O(N^2)."""
+        chain = range(len(self.links)) if upto is None else self._ancestry(upto)
+        states: list = [None] * (len(self.links) if upto is None else upto + 1)
+        for k in chain:
             parent = self.links[k].parent
             state = self._root_state(k, q, s) if parent < 0 else states[parent]
             for step in self._steps[k]:
                 state = self._advance(state, step, q, s)
-            states.append(state)
+            states[k] = state
         return states
+
+    def _ancestry(self, k: int) -> list[int]:
+        """Body k's ancestors among the real bodies, root first, then k."""
+        chain = []
+        while k >= 0:
+            chain.append(k)
+            k = self.links[k].parent
+        return chain[::-1]
 
     # ---- kinematics ---------------------------------------------------------------------
     def K(self, q):

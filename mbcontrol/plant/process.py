@@ -25,7 +25,8 @@ from .mechanical import dof_selector, mechanical_matrices
 from .moordyn_loads import (coupled_points, moordyn_loads, moordyn_names, moored_rest,
                             say_moored_rest)
 from .ownership import linear_params
-from .pieces import plant_parts
+from .pieces import (kinetic_energy, momentum_value, plant_parts, radiation_as_data,
+                     radiation_value, sparse_constant)
 from .rest import preloads
 from .units import DRIVETRAIN_SIGNALS, drivetrain_signals, signal_unit
 
@@ -180,7 +181,10 @@ def assemble_plant(scene: Scene | str, hydro: HydroModel | None = None, *,
     # f sums each surface for its wrench alone; the outputs (restoring) also for its range
     load = nonlinear.pressure_load(scene, topo, q, w[n_w:n_w + n_f], pressure) if pressure \
         else restoring
-    tau_full = ca.substitute(tau, slot, load)
+    # a farm's radiation force is the symbol mu_r in tau (module plant.pieces: the outputs are
+    # also compiled with the force as data); f, h and the checks see its value C_r chi
+    actual = radiation_value(radiation_apart, chi)
+    tau_full = actual(ca.substitute(tau, slot, load))
     extra, balance = preloads(scene, topo, (q, s, u, w, chi, tau_full), pto_signals, params,
                               hydro.buoyancy(scene.water) if hydro else {})
     tau, tau_full = tau + extra + lines_pull, tau_full + extra + lines_pull
@@ -189,14 +193,15 @@ def assemble_plant(scene: Scene | str, hydro: HydroModel | None = None, *,
     notes = checks.rest_checks(scene, topo, q, s, u, w, chi, tau_full, M, params)
     notes["rest_balance"] = balance        # weight against buoyancy, what preloads hold (plant.rest)
     x = ca.vertcat(q, s, chi)
-    x_dot_slot = ca.vertcat(ca.mtimes(tree.K(q), s), ca.solve(M, tau), chi_dot)
+    x_dot_apart = ca.vertcat(ca.mtimes(tree.K(q), s), ca.solve(M, tau), chi_dot)
+    x_dot_slot = actual(x_dot_apart)
     x_dot = ca.substitute(x_dot_slot, slot, load)
-    kinetic = 0.5 * ca.mtimes([s.T, M, s])
-    power["energy"] = kinetic + potential
-    y, output_names = _outputs(scene, topo, q, s, pto_signals, power, tensions,
-                               x_dot_slot[tree.n_q:tree.n_q + tree.n_s], ranges)
-    y = ca.substitute(y, slot, restoring)
-    p = params.vector
+    kinetic, momentum = kinetic_energy(s, M, radiation_apart, ca.vertcat(q, params.vector))
+    power["energy"], p = kinetic + potential, params.vector
+    y_apart, output_names = _outputs(scene, topo, q, s, pto_signals, power, tensions,
+                                     x_dot_apart[tree.n_q:tree.n_q + tree.n_s], ranges)
+    y_apart = ca.substitute(y_apart, slot, restoring)
+    y = momentum_value(actual(y_apart), momentum, M, s)
     held = held_pressure([x, u, w, p], q, slot, x_dot_slot, load) \
         if pressure and scene.hydro.nonlinear_update == "step" else None
 
@@ -207,16 +212,15 @@ def assemble_plant(scene: Scene | str, hydro: HydroModel | None = None, *,
         + moordyn_names(moored)
     f = ca.Function("f", [x, u, w, p], [x_dot], ["x", "u", "w", "p"], ["xdot"])
     h = ca.Function("h", [x, u, w, p], [y], ["x", "u", "w", "p"], ["y"])
-    rest = None
+    rest = moored_rest(scene, f, (tree.n_q, tree.n_s, len(states), u.shape[0], w.shape[0]),
+                       np.array(params.values)) if moored else None
     if moored:
-        rest = moored_rest(scene, f, (tree.n_q, tree.n_s, len(states), u.shape[0], w.shape[0]),
-                           np.array(params.values))
         notes["moored_rest"] = say_moored_rest(scene, states, rest)
+    parts = plant_parts([x, u, w, p], M, tau_full, x_dot[:tree.n_q], chi_dot, radiation_apart,
+                        (y_apart, momentum))
     return ProcessPlant(scene, topo, hydro, tuple(states), tuple(inputs), tuple(disturbances),
                         tuple(output_names), tuple(params.names), np.array(params.values),
-                        f, h, notes, plant_parts([x, u, w, p], M, tau_full, x_dot[:tree.n_q],
-                                                 chi_dot, radiation_apart), pressure, held,
-                        moored, rest)
+                        f, h, notes, parts, pressure, held, moored, rest)
 
 
 def _hydro_loads(hydro, radiation, scale, select, P, s, w, chi):
@@ -225,23 +229,32 @@ def _hydro_loads(hydro, radiation, scale, select, P, s, w, chi):
     chi_dot, power = ca.SX(0, 1), {"radiated_power": 0, "excitation_power": 0}
     if not hydro:
         return None, None, chi_dot, power, None
+    # constants as sparse matrices: their explicit zeros would cost a farm's build (A_r alone
+    # has n_r^2 entries) without changing an expression (CasADi drops products with zeros)
+    sel = sparse_constant(select)
     if scale is None:
-        added_mass = select.T @ hydro.added_mass_inf @ select
+        added_mass = sparse_constant(select.T @ hydro.added_mass_inf @ select)
     else:
         A_inf = ca.mtimes([scale["added_mass"], ca.DM(hydro.added_mass_inf), scale["added_mass"]])
         added_mass = ca.mtimes([ca.DM(select.T), A_inf, ca.DM(select)])
-    nu_h = ca.mtimes(select, ca.mtimes(P.T, s))
+    nu_h = ca.mtimes(sel, ca.mtimes(P.T, s))
     w_h = w if scale is None else ca.mtimes(scale["excitation"], w)
     if not radiation:
-        return (added_mass, ca.mtimes(P, ca.mtimes(select.T, w_h)), chi_dot,
+        return (added_mass, ca.mtimes(P, ca.mtimes(sel.T, w_h)), chi_dot,
                 {"radiated_power": 0, "excitation_power": ca.dot(nu_h, w_h)}, None)
-    A_r, B_r, C_r, D_r = hydro.radiation_matrices()
-    apart = (chi, ca.mtimes(P, select.T), nu_h, (A_r, B_r, C_r, D_r)) if scale is None else None
+    matrices = hydro.radiation_matrices()
+    A_r, B_r, C_r, D_r = (sparse_constant(m) for m in matrices)
+    apart, force = None, ca.mtimes(C_r, chi)
+    if scale is None:
+        # a farm's C_r chi as the symbol mu_r (its value is put back by pieces.radiation_value)
+        mu_r = ca.SX.sym("mu_r", C_r.shape[0]) if radiation_as_data(matrices[2]) else None
+        force = force if mu_r is None else mu_r
+        apart = (chi, ca.mtimes(P, sel.T), nu_h, matrices, mu_r)
     R = scale["radiation"] if scale is not None else ca.DM.eye(select.shape[0])
     nu_r = ca.mtimes(R, nu_h)           # the kernel S^1/2 K S^1/2 as a state-space model
-    mu_h = ca.mtimes(R, ca.mtimes(C_r, chi) + ca.mtimes(D_r, nu_r))
+    mu_h = ca.mtimes(R, force + ca.mtimes(D_r, nu_r))
     chi_dot = ca.mtimes(A_r, chi) + ca.mtimes(B_r, nu_r)
-    return (added_mass, ca.mtimes(P, ca.mtimes(select.T, w_h - mu_h)), chi_dot,
+    return (added_mass, ca.mtimes(P, ca.mtimes(sel.T, w_h - mu_h)), chi_dot,
             {"radiated_power": ca.dot(nu_h, mu_h), "excitation_power": ca.dot(nu_h, w_h)}, apart)
 
 

@@ -45,6 +45,8 @@ FLAGS = ("-O3", "-march=native", "-fno-math-errno", "-fassociative-math", "-fno-
 # output map of array_grid's 16 floats, 706 kB of C): gcc -O3 took 12 s on it, -O0 0.8 s, and
 # the 6,000 samples of a 60 s record are then mapped in 0.25 s. (Its step, run 24,000 times per
 # 60 s, stays optimised: -O0 made those 15x slower.)
+# (Since 2026-12-06 a farm's step and outputs hold its couplings as data, module plant.pieces:
+# short code, compiled with FLAGS.)
 PLAIN_FLAGS = ("-O0", "-shared", "-fPIC")
 # Said-once flags: which warnings this process has given (messages, never results)
 _warned = False

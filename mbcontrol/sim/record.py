@@ -32,6 +32,9 @@ def run_dataset(plant, t, X, U, W, Y, eta, *, wave, controller, method, dt, p, w
                      for name, unit in (("omega", "rad/s"), ("amplitude", "m"), ("phase", "rad"))})
         if wave.d_omega:
             data["wave_omega"][2]["d_omega"] = float(wave.d_omega)
+        if wave.directional:    # a spread sea: each component's own direction
+            data["wave_direction"] = ("wave_component", np.asarray(wave.direction, float),
+                                      {"units": "rad", "long_name": "direction (NED)"})
     ds = xr.Dataset(data, coords={"time": ("time", t, {"units": "s"}),
                                   "state_name": states})
     made_by = provenance(plant)

@@ -15,8 +15,9 @@ import copy
 import time
 import warnings
 
+from typing import TYPE_CHECKING
+
 import numpy as np
-import xarray as xr
 
 from .. import defaults
 from ..console import progress_bar
@@ -32,6 +33,9 @@ from .moordyn_run import prepare_moored, run_moored
 from .moorings import mooring_report
 from .protocol import estimation_report, uses_state
 from .record import run_dataset
+
+if TYPE_CHECKING:                  # the record is made by .record; here only named
+    import xarray as xr
 
 
 def simulate(plant, wave=None, *, duration: float, dt: float | None = None, controller=None,

@@ -9,22 +9,50 @@ measured elevation record, a file or a series, as a wave), `excitation`, `spread
 nonlinear Froude-Krylov forces). Everything public is re-exported here (`from mbcontrol.waves
 import irregular`). The package imports no stage of the flow.
 """
-from .annual import HOURS_PER_YEAR, annual_energy_MWh, bin_seas
-from .dispersion import group_velocities, group_velocity, wavenumber
-from .excitation import (coefficient_offsets, coefficient_series, excitation_at_offsets, excitation_impulse_response,
-                         excitation_series, interpolate_complex)
-from .local_field import LocalField, band_field, choose_field, field_rows_offsets, field_rows_series
-from .direct_field import direct_elevation, direct_pressure
-from .flux import deep_water_flux, energy_flux, spectrum_energy_flux
-from .realisation import (DEFAULT_BAND, Wave, band_limits, from_args, irregular, regular,
-                          repeat_period, variance_outside)
-from .record import from_elevation, from_record, read_elevation
-from .sites import (SPREAD_MAX_DEG, WEIGHT_SUM_TOLERANCE, SeaState, grid, occurrence,
-                    read_ndbc_spectra, read_seas, read_year_weights, site_energy_flux)
-from .spreading import Spreading, component_directions, spread_from_s
-from .spreading import from_settings as spreading_from_settings
-from .spectra import gamma_for_te_over_tp, jonswap_spectrum, moment, spectral_hm0_te, te_over_tp
-from .synthesis import ramp
+from ..lazy import face
+
+# name -> (submodule, its name there): loaded on first use, so that a run's wave imports no
+# site file reader (xarray, pandas) and no special functions it does not use
+_WHERE = {
+    "HOURS_PER_YEAR": ("annual", "HOURS_PER_YEAR"),
+    "annual_energy_MWh": ("annual", "annual_energy_MWh"), "bin_seas": ("annual", "bin_seas"),
+    "group_velocities": ("dispersion", "group_velocities"),
+    "group_velocity": ("dispersion", "group_velocity"), "wavenumber": ("dispersion", "wavenumber"),
+    "coefficient_offsets": ("excitation", "coefficient_offsets"),
+    "coefficient_series": ("excitation", "coefficient_series"),
+    "excitation_at_offsets": ("excitation", "excitation_at_offsets"),
+    "excitation_impulse_response": ("excitation", "excitation_impulse_response"),
+    "excitation_series": ("excitation", "excitation_series"),
+    "interpolate_complex": ("excitation", "interpolate_complex"),
+    "LocalField": ("local_field", "LocalField"), "band_field": ("local_field", "band_field"),
+    "choose_field": ("local_field", "choose_field"),
+    "field_rows_offsets": ("local_field", "field_rows_offsets"),
+    "field_rows_series": ("local_field", "field_rows_series"),
+    "direct_elevation": ("direct_field", "direct_elevation"),
+    "direct_pressure": ("direct_field", "direct_pressure"),
+    "deep_water_flux": ("flux", "deep_water_flux"), "energy_flux": ("flux", "energy_flux"),
+    "spectrum_energy_flux": ("flux", "spectrum_energy_flux"),
+    "DEFAULT_BAND": ("realisation", "DEFAULT_BAND"), "Wave": ("realisation", "Wave"),
+    "band_limits": ("realisation", "band_limits"), "from_args": ("realisation", "from_args"),
+    "irregular": ("realisation", "irregular"), "regular": ("realisation", "regular"),
+    "repeat_period": ("realisation", "repeat_period"),
+    "variance_outside": ("realisation", "variance_outside"),
+    "from_elevation": ("record", "from_elevation"), "from_record": ("record", "from_record"),
+    "read_elevation": ("record", "read_elevation"),
+    "SPREAD_MAX_DEG": ("sites", "SPREAD_MAX_DEG"),
+    "WEIGHT_SUM_TOLERANCE": ("sites", "WEIGHT_SUM_TOLERANCE"),
+    "SeaState": ("sites", "SeaState"), "grid": ("sites", "grid"),
+    "occurrence": ("sites", "occurrence"), "read_ndbc_spectra": ("sites", "read_ndbc_spectra"),
+    "read_seas": ("sites", "read_seas"), "read_year_weights": ("sites", "read_year_weights"),
+    "site_energy_flux": ("sites", "site_energy_flux"), "Spreading": ("spreading", "Spreading"),
+    "component_directions": ("spreading", "component_directions"),
+    "spread_from_s": ("spreading", "spread_from_s"),
+    "spreading_from_settings": ("spreading", "from_settings"),
+    "gamma_for_te_over_tp": ("spectra", "gamma_for_te_over_tp"),
+    "jonswap_spectrum": ("spectra", "jonswap_spectrum"), "moment": ("spectra", "moment"),
+    "spectral_hm0_te": ("spectra", "spectral_hm0_te"), "te_over_tp": ("spectra", "te_over_tp"),
+    "ramp": ("synthesis", "ramp"),
+}
 
 __all__ = [
     "Wave", "regular", "irregular", "from_args", "from_elevation", "band_limits",
@@ -41,3 +69,5 @@ __all__ = [
     "LocalField", "band_field", "choose_field", "direct_elevation", "direct_pressure", "field_rows_offsets",
     "field_rows_series",
 ]
+
+__getattr__, __dir__ = face(__name__, globals(), _WHERE)

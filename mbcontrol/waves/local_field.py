@@ -59,7 +59,6 @@ import warnings
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.special import ive, jv
 
 from ..errors import WaveError
 from .dispersion import wavenumber
@@ -80,6 +79,7 @@ def _count(z_max: float, order: int) -> int:
 
 def _xi_coefficients(kl, count: int) -> np.ndarray:
     """(n, count) complex: Chebyshev coefficients in xh of exp(i k L xh), eps_m i^m J_m(k L)."""
+    from scipy.special import jv       # here: only a nonlinear Froude-Krylov body needs it
     m = np.arange(count)
     eps = np.where(m == 0, 1.0, 2.0)
     i_m = np.array([1, 1j, -1, -1j])[m % 4]          # i^m exactly (1j ** m rounds)
@@ -91,6 +91,7 @@ def _depth_coefficients(k, depth_range: float, water_depth: float, count: int) -
     s = k D / 2, exp(-k d) has eps_n (-1)^n I_n(s) e^-s and exp(k d) has e^(2 s) eps_n I_n(s)
     e^-s; scipy's ive (I_n e^-s) keeps both finite at any s (D <= H, so exp(-k (2 H - D))
     <= 1)."""
+    from scipy.special import ive
     n = np.arange(count)
     eps = np.where(n == 0, 1.0, 2.0)
     k = np.asarray(k, float)[:, None]

@@ -17,13 +17,16 @@ import math
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-import xarray as xr
 
 from ..errors import WaveError
 from .flux import G, RHO, energy_flux
 from .spectra import te_over_tp
+
+if TYPE_CHECKING:
+    import xarray as xr
 
 WEIGHT_SUM_TOLERANCE = 0.02        # a weighted list's weights must sum to 1 within this
 
@@ -220,6 +223,7 @@ def occurrence(hm0, te, hs_edges, te_edges) -> xr.DataArray:
 
     Records outside the edges are not in any bin: attrs["outside"] counts them (the table then
     sums to 1 - outside / records), so an annual energy can say what it left out."""
+    import xarray as xr             # here: reading a site's seas needs no xarray
     hm0, te = np.asarray(hm0, float), np.asarray(te, float)
     counts, _, _ = np.histogram2d(hm0, te, bins=[hs_edges, te_edges])
     share = counts / max(len(hm0), 1)

@@ -27,7 +27,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.special import betainc, gammaln
 
 from ..errors import WaveError
 
@@ -77,6 +76,7 @@ class Spreading:
         (analytically: C(s)); zero outside the sector, where it is renormalised numerically."""
         s = self.s(omega, omega_p)[:, None]
         x = wrap(np.atleast_1d(np.asarray(theta, float)) - self.mean)[None, :]
+        from scipy.special import gammaln    # here: a long-crested sea never needs it
         log_c = gammaln(s + 1) - gammaln(s + 0.5) - math.log(2 * math.sqrt(math.pi))
         d = np.exp(log_c) * np.cos(x / 2) ** (2 * s)
         if self.sector < math.pi:
@@ -88,6 +88,7 @@ class Spreading:
         CDF of D per s, exact at the points: the share of cos^(2s)(u/2) within |u| <= |x| is
         I(sin^2(x/2); 1/2, s + 1/2) (the regularised incomplete beta function; t = sin^2).
         Computed once per distinct s (cos-2s: one)."""
+        from scipy.special import betainc
         x = np.linspace(-self.sector, self.sector, GRID)
         distinct, back = np.unique(s, return_inverse=True)
         F = 0.5 + 0.5 * np.sign(x)[None, :] * betainc(0.5, distinct[:, None] + 0.5,
@@ -99,6 +100,7 @@ class Spreading:
         s = self.s(omega, omega_p)
         if self.sector >= math.pi:
             return np.zeros(s.shape)
+        from scipy.special import betainc
         return 1.0 - betainc(0.5, s + 0.5, math.sin(self.sector / 2) ** 2)
 
     def quantile(self, u, omega=None, omega_p: float | None = None) -> np.ndarray:

@@ -208,3 +208,23 @@ def test_large_angle_hydrostatics_in_waves_says_it_is_not_a_consistent_pair():
                      x0=initial_state(plant, {"heave": 0.5}))
     assert LARGE_ANGLE_IN_WAVES not in assess(decay, plant)["warnings"]
     assert "large_angle" not in REMEDIES["range"]
+
+
+def test_a_spread_sea_is_checked_in_its_own_directions():
+    """A short-crested sea's run, checked from its record alone (as `mbcontrol.simulate` checks
+    it), meets the bound of the wave it ran in: each component in its own direction, between
+    the data's two headings, not the mean direction, which the data do not hold."""
+    import math
+    plant = build_plant(load_scene("array4"))
+    band = (float(plant.hydro.omega[0]), float(plant.hydro.omega[-1]))
+    spread = waves.Spreading("cos2s", math.radians(22.5), math.radians(8), math.radians(22.5))
+    sea = waves.irregular(0.05, 1.2, seed=0, duration=40.0, data_band=band, spreading=spread)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ds = simulate(plant, sea, duration=40.0, dt=0.01, audit=False)
+    from_record = assess(ds.copy(), plant)
+    given = assess(ds.copy(), plant, sea)
+    assert from_record["valid"] and from_record["checks"]["bound_W"] > 0
+    for key in ("bound_W", "window_bound_W"):
+        assert from_record["checks"][key] == given["checks"][key]
+    assert np.array_equal(ds["wave_direction"].values, sea.direction)

@@ -13,6 +13,8 @@
 #include "mbc_controller.h"
 
 #define NV (MBC_N * MBC_NU)                 /* forces over the horizon */
+#define NB (MBC_NB)                         /* the QP's forces: NU per block (move blocking;
+                                             * NV without it), held over MBC_BLOCK_OF's steps */
 
 static void matvec(const double *M, int rows, int cols, const double *x, double *y, int add)
 {
@@ -38,6 +40,7 @@ static void roots(int p, const double *c, double complex *z)
     double bound = 0.0;
     for (k = 1; k <= p; ++k) bound = fmax(bound, fabs(c[k]));
     for (k = 0; k < p; ++k) z[k] = (1.0 + bound) * cexp(I * (2 * M_PI * k / p + 0.4));
+    double last = INFINITY;
     for (it = 0; it < 200; ++it) {
         double change = 0.0;
         for (k = 0; k < p; ++k) {
@@ -49,7 +52,11 @@ static void roots(int p, const double *c, double complex *z)
             z[k] -= w;
             change = fmax(change, cabs(w) / fmax(cabs(z[k]), 1e-300));
         }
-        if (change < 1e-14) break;
+        /* converged; or, clustered roots (an AR fit of a narrow sea), stalled at round-off:
+         * a step no smaller than half the last one, below 1e-9 (iterating on was 200
+         * iterations, 0.5 ms, for no more accuracy) */
+        if (change < 1e-14 || (change < 1e-9 && change > 0.5 * last)) break;
+        last = change;
     }
 }
 
@@ -203,7 +210,7 @@ static void form_bounds(MBC_CTX *c, int f)
 {
     const mbc_form *form = &MBC_FORMS[f];
     int k, n = 0;
-    for (k = 0; k < form->nv; ++k) c->g[k] = form->g_slack[k] + (k < NV ? c->q[k] : 0.0);
+    for (k = 0; k < form->nv; ++k) c->g[k] = form->g_slack[k] + (k < NB ? c->q[k] : 0.0);
     if (MBC_HAS_STROKE) {
         for (k = 0; k < NV; ++k) {
             if (form->soft) {
@@ -215,8 +222,8 @@ static void form_bounds(MBC_CTX *c, int f)
         }
         n = form->soft ? 2 * NV : NV;
     }
-    if (MBC_HAS_RATE)
-        for (k = 0; k < NV; ++k) {
+    if (MBC_HAS_RATE)                       /* between consecutive blocks, the first: u_prev */
+        for (k = 0; k < NB; ++k) {
             double first = k < MBC_NU ? c->u_prev[k] / MBC_FS : 0.0;
             c->lba[n + k] = first - MBC_RATE[k];
             c->uba[n + k] = first + MBC_RATE[k];
@@ -231,14 +238,19 @@ static int solve_qp(MBC_CTX *c)              /* the plan into c->plan; 0 when so
         const mbc_form *form = &MBC_FORMS[f];
         form_bounds(c, f);
         status = mbc_qp_solve(&c->qp[f], c->g, form->lbx, form->ubx, c->lba, c->uba, c->x);
+        if (c->qp[f].iterations > c->qp_iterations_max) c->qp_iterations_max = c->qp[f].iterations;
         if (status != MBC_QP_SOLVED) continue;     /* infeasible or out of iterations */
         {
             double slack = 0.0;
-            for (k = NV; k < form->nv; ++k) slack = fmax(slack, c->x[k]);
+            for (k = NB; k < form->nv; ++k) slack = fmax(slack, c->x[k]);
             c->last_form = form->soft && slack > 1e-6;
         }
         c->soft_solves += form->soft;
-        for (k = 0; k < NV; ++k) c->plan[k] = c->x[k] * MBC_FS;
+        for (k = 0; k < MBC_N; ++k) {       /* the plan: each step its block's forces */
+            int i;
+            for (i = 0; i < MBC_NU; ++i)
+                c->plan[k * MBC_NU + i] = c->x[MBC_BLOCK_OF[k] * MBC_NU + i] * MBC_FS;
+        }
         return 0;
     }
     return -1;
@@ -283,6 +295,7 @@ void MBC_FN(reset)(MBC_CTX *ctx)
     ctx->last_form = 0;
     ctx->first_t = ctx->next_t = ctx->warm_up_end = 0.0;
     ctx->solves = ctx->failures = ctx->soft_solves = ctx->ar_fits = ctx->ar_unstable_fits = 0;
+    ctx->qp_iterations_max = 0;
 }
 
 static void clip(double *u)
@@ -340,8 +353,8 @@ int MBC_FN(step)(MBC_CTX *ctx, const double *measurements, double t, double *for
     matvec(MBC_PPRED, NV, MBC_NZ, ctx->s, ctx->freep, 0);
     matvec(MBC_OM, NV, MBC_N * MBC_ND, ctx->D, ctx->freep, 1);
     for (k = 0; k < NV; ++k) ctx->freep[k] /= MBC_LS;
-    matvec(MBC_QZ, NV, MBC_NZ, ctx->s, ctx->q, 0);
-    matvec(MBC_QD, NV, MBC_N * MBC_ND, ctx->D, ctx->q, 1);
+    matvec(MBC_QZ, NB, MBC_NZ, ctx->s, ctx->q, 0);
+    matvec(MBC_QD, NB, MBC_N * MBC_ND, ctx->D, ctx->q, 1);
     ctx->solves += 1;
     failed = solve_qp(ctx) != 0;
     if (failed) {                           /* infeasible, or past its iteration cap: the */
@@ -369,4 +382,17 @@ int MBC_FN(step)(MBC_CTX *ctx, const double *measurements, double t, double *for
     memcpy(ctx->u_prev, u, sizeof(u));
     memcpy(force, u, sizeof(u));
     return 0;
+}
+
+/* counters of the run so far: solves, failures (the previous plan's next move applied),
+ * soft_solves, ar_fits, ar_unstable_fits, the most iterations of one QP solve; returns how
+ * many it wrote (at most `size`) */
+int MBC_FN(stats)(const MBC_CTX *ctx, long *out, int size)
+{
+    long all[6];
+    int k;
+    all[0] = ctx->solves; all[1] = ctx->failures; all[2] = ctx->soft_solves;
+    all[3] = ctx->ar_fits; all[4] = ctx->ar_unstable_fits; all[5] = ctx->qp_iterations_max;
+    for (k = 0; k < size && k < 6; ++k) out[k] = all[k];
+    return k;
 }

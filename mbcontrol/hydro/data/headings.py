@@ -21,7 +21,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.interpolate import CubicSpline
 
 from ...errors import HydroError
 
@@ -166,6 +165,7 @@ def heading_matrix(headings, direction, source: str) -> np.ndarray:
     basis[np.arange(ext.size), idx] = 1.0
     phi = np.clip(phi, ext[0], ext[-1])
     if ext.size >= 4 + periodic:
+        from scipy.interpolate import CubicSpline    # here: one heading's data need no spline
         spline = CubicSpline(ext, basis, bc_type="periodic" if periodic else "not-a-knot")
         return spline(phi)
     if ext.size == 1:

@@ -33,6 +33,7 @@ force_symmetric=True`` for heave only.
 """
 from __future__ import annotations
 
+from importlib import import_module
 from pathlib import Path
 
 import numpy as np
@@ -41,10 +42,12 @@ import xarray as xr
 from mbcontrol.errors import HydroError
 from mbcontrol.hydro.data.frames import to_body_frames, zup_to_ned
 
-from .bemio import read_bemio
-from .capytaine_nc import read_capytaine
-from .checks import HydroCleaningWarning, clean
-from .wamit import read_wamit
+from ...lazy import face
+
+# the readers load on first use: a plant built from stored data needs only the physical checks
+_WHERE = {"read_wamit": ("wamit", "read_wamit"), "read_bemio": ("bemio", "read_bemio"),
+          "read_capytaine": ("capytaine_nc", "read_capytaine"), "clean": ("checks", "clean"),
+          "HydroCleaningWarning": ("checks", "HydroCleaningWarning")}
 
 __all__ = ["read_wamit", "read_bemio", "read_capytaine", "read_hydro", "clean", "to_scene_frames",
            "HydroCleaningWarning"]
@@ -82,8 +85,8 @@ def read_hydro(path, **kw) -> xr.Dataset:
         raise HydroError(f"{path}: no such file (expected hydrodynamic data: WAMIT .out, BEMIO .h5, Capytaine .nc)")
     ext = path.suffix.lower()
     kind = {".out": "wamit", ".h5": "bemio", ".hdf5": "bemio", ".nc": "capytaine"}.get(ext) or _sniff(path)
-    reader = {"wamit": read_wamit, "bemio": read_bemio, "capytaine": read_capytaine}[kind]
-    return reader(path, **kw)
+    module, name = _WHERE[{"wamit": "read_wamit", "bemio": "read_bemio", "capytaine": "read_capytaine"}[kind]]
+    return getattr(import_module(f"{__name__}.{module}"), name)(path, **kw)
 
 
 def to_scene_frames(ds_data: xr.Dataset, cogs_ned: dict) -> xr.Dataset:
@@ -117,3 +120,6 @@ def to_scene_frames(ds_data: xr.Dataset, cogs_ned: dict) -> xr.Dataset:
     out["center_of_buoyancy"].attrs["units"] = "m (n-frame, NED)"
     out["wave_direction"].attrs.update(units="rad", long_name="NED heading waves travel to, +x towards +y (starboard)")
     return out
+
+
+__getattr__, __dir__ = face(__name__, globals(), _WHERE)

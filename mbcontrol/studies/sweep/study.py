@@ -91,7 +91,7 @@ def sweep(model: str, seas, *, seeds: int = 1, vary: dict | None = None, params=
         cases = with_records(cases, measured)
     case_store = CaseStore(store, inputs)
     run = execute(cases, case_store, workers=workers, scheduler=scheduler, progress=progress,
-                  plants=plants)
+                  plants=plants, meanwhile=_import_statistics)
     depth, rho, g = scene.water.depth, scene.water.rho, scene.water.g
     made_by = sweep_provenance(inputs, controller, settings, vary, roles, amplitudes=amplitudes,
                                nonlinear=nonlinear, identified=identified, design=design,
@@ -367,3 +367,9 @@ def _mooring_loads(ds, k: int) -> dict:
 def _plain(values):
     values = np.asarray(values, float)
     return float(values) if values.ndim == 0 else values.tolist()
+
+
+def _import_statistics() -> None:
+    """Import what the summary and the budget need (scipy.stats: 1-2 s) while workers run the
+    cases, not after them."""
+    import scipy.stats  # noqa: F401

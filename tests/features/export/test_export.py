@@ -34,6 +34,10 @@ SETTINGS = {                               # period (about 5 s); the sea for the
     "mpc-model-forecast": ({"horizon_s": 8.0, "dt_s": 0.2, "wave": SEA, "forecast": "model",
                             "envelope": False,
                             "rate_max": 2e6}, SEA),
+    # move blocking (10 blocks over the 40 steps, controllers.mpc_blocks), the slew limit on
+    # the blocks' boundaries and a stroke limit that binds (peak 0.501 m)
+    "mpc-blocked": ({"horizon_s": 8.0, "dt_s": 0.2, "wave": SEA, "envelope": False,
+                     "rate_max": 2e6, "stroke_max": 0.5, "blocks": 10}, SEA),
 }
 
 

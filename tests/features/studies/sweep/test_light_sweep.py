@@ -50,6 +50,8 @@ def test_spawned_workers_agree_with_serial(monkeypatch):
     serial = CaseStore(None)
     runner.execute(cases, serial, workers=0, progress=False)
     monkeypatch.delenv("MBCONTROL_SWEEP_START", raising=False)
+    assert runner._start_method() == "forkserver"           # the default (its own test:
+    monkeypatch.setenv("MBCONTROL_SWEEP_START", "spawn")     # test_worker_plants); spawn here
     assert runner._start_method() == "spawn"
     monkeypatch.setenv("MBCONTROL_SWEEP_CLUSTER", "always")
     clustered = CaseStore(None)
