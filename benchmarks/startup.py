@@ -115,7 +115,7 @@ def simulate_row(repeat: int, env: dict) -> dict:
           f"{', '.join(f'{t:.2f}' for t in times)} s); heavy modules: "
           f"{', '.join(row['heavy_modules_imported']) or 'none'}")
     print(f"  as a user's Python runs it (modules compiled once, kept); in this process's "
-          f"environment{' (PYTHONDONTWRITEBYTECODE: compiled every time)' if 'PYTHONDONTWRITEBYTECODE' in os.environ else ''}: "
+          f"environment{' (PYTHONDONTWRITEBYTECODE: modules compiled in every process unless one compiled them before)' if 'PYTHONDONTWRITEBYTECODE' in os.environ else ''}: "
           f"{here:.2f} s")
     print("  phases, wall / CPU s (median of fresh processes):")
     for name in phases[0]:

@@ -94,12 +94,13 @@ def test_obstacles_and_contradictory_settings_are_refused(tmp_path):
 
 def test_a_scene_with_a_cutoff_solves_each_float_within_its_radius(monkeypatch):
     from mbcontrol.hydro import model
+    from mbcontrol.hydro.bem import neighbours        # model imports it when it solves
     seen = {}
 
     def solve(bodies, radius, **kwargs):
         seen.update(radius=radius, bodies=len(bodies))
         raise RuntimeError("stop: what the scene asked for is recorded")
-    monkeypatch.setattr(model, "compute_within", solve)
+    monkeypatch.setattr(neighbours, "compute_within", solve)
     scene = load_scene("array_grid", {"n": 3, "cutoff": 1.5})
     with pytest.raises(RuntimeError, match="stop"):
         model.load_hydro_data(scene, [f"float{i + 1}__Heave" for i in range(9)])
