@@ -36,7 +36,7 @@ from mbcontrol.scene import load_scene
 from mbcontrol.sim import simulate
 from mbcontrol.sim.integrators import chunk_length, chunk_symbolic, prepare
 
-from farm_compile import c_bytes
+from farm_compile import c_bytes, growth
 
 DURATION, DT = 60.0, 0.01
 
@@ -78,12 +78,6 @@ def measure(n_side: int, fit_tol: float) -> dict:
             "rtf": DURATION / out.attrs["wall_time_s"], "peak_rss_mb": rss_fit,
             "shunt_terms": len(rad.report["passivity"].get("shunt_terms", [])),
             "valid": bool(out.attrs.get("valid", True))}
-
-
-def growth(rows, key) -> float:
-    n = np.array([r["floats"] for r in rows], float)
-    y = np.array([r[key] for r in rows], float)
-    return float(np.polyfit(np.log(n), np.log(y), 1)[0])
 
 
 def main(argv=None) -> int:
